@@ -1,0 +1,37 @@
+# tfloc: the two commands of the README are `make bench` and `make test`.
+# Both create .venv on first use and (re)install the package when pyproject.toml changes.
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.tfloc-installed
+JOBS   ?= 2
+
+.PHONY: install bench test test-unit timing lint clean-venv
+
+$(STAMP): pyproject.toml
+	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	@touch $(STAMP)
+
+install: $(STAMP)
+
+## The main job: every registered matcher on the bundled scenarios, with a report.
+bench: $(STAMP)
+	$(BIN)/tfloc bench benchmarks/paper-protocol.toml --jobs $(JOBS)
+	$(BIN)/tfloc report results/paper-protocol
+
+## Unit tests, the accuracy regression guard and a benchmark smoke run (CI).
+test: $(STAMP)
+	$(BIN)/python -m pytest -q tests
+	$(BIN)/python -m pytest -q benchmarks --benchmark-disable
+
+## Full pytest-benchmark timing (pinned to 2 cores); not part of CI.
+timing: $(STAMP)
+	$(BIN)/python -m pytest benchmarks --benchmark-only --benchmark-autosave
+
+lint: $(STAMP)
+	$(BIN)/ruff check .
+
+clean-venv:
+	rm -rf $(VENV)

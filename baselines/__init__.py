@@ -1,0 +1,1 @@
+"""Baseline matchers, one module each, registered through the ``tfloc.matchers`` entry points."""

@@ -1,0 +1,35 @@
+"""Every error tfloc raises on purpose derives from :class:`TflocError`.
+
+The CLI catches ``TflocError`` and prints its message as one line (no traceback), so each
+message must name the file, row or field at fault and say what is wrong with it.
+"""
+
+from __future__ import annotations
+
+
+class TflocError(Exception):
+    """Base class of all deliberate tfloc errors."""
+
+
+class MapFormatError(TflocError):
+    """A map file (GeoJSON, ROS YAML/PGM) is malformed."""
+
+
+class DatasetError(TflocError):
+    """A scenario dataset (scenario.json / scans.csv) is malformed."""
+
+
+class LogFormatError(TflocError):
+    """A CARMEN log or relations file is malformed."""
+
+
+class InvalidProblemError(TflocError):
+    """A localization problem cannot be posed: bad ranges, empty scan, pose outside the map."""
+
+
+class MatcherError(TflocError):
+    """A matcher is unknown, misconfigured or its optional library is missing."""
+
+
+class ConfigError(TflocError):
+    """A run configuration (TOML) or a command-line option is invalid."""

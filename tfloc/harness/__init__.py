@@ -1,0 +1,1 @@
+"""The scenario harness: datasets, generation, the runner, metrics and the report."""

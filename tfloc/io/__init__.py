@@ -1,0 +1,1 @@
+"""Readers and writers at the edges: GeoJSON maps, scenario datasets (CARMEN logs, ROS maps later)."""

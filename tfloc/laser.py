@@ -1,0 +1,75 @@
+"""The laser range finder g(m, f, q) of the paper: beam angles (Eq. 3) and ranges → points (Eq. 4)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class LaserSpec:
+    """A planar laser scanner.
+
+    Attributes:
+        max_range: m, the largest range it reports (metres). Ranges ≥ max_range mean no return.
+        fov: f, the field of view (radians).
+        resolution: q, the angle between neighbouring beams (radians).
+        angle_min: the angle of the first beam relative to the robot's heading (radians).
+
+    Eq. 3 numbers the beams from φ₁ = 0 in the scanner's own frame; here that frame is
+    rotated so that beam *i* (0-based) points at ``angle_min + i·resolution`` relative to
+    the heading, which is how scan files store them (-90°…+90° for an LMS200).
+    """
+
+    max_range: float
+    fov: float
+    resolution: float
+    angle_min: float
+
+    @classmethod
+    def lms200(cls) -> LaserSpec:
+        """SICK LMS200-30106 as in the paper: 10 m, 180°, 1° (181 beams from -90°)."""
+        return cls(10.0, math.pi, math.radians(1.0), -math.pi / 2)
+
+    @classmethod
+    def from_degrees(cls, max_range: float, fov_deg: float, resolution_deg: float,
+                     angle_min_deg: float | None = None) -> LaserSpec:
+        """Build a spec from degrees; ``angle_min_deg`` defaults to a field of view centred on the heading."""
+        if angle_min_deg is None:
+            angle_min_deg = -fov_deg / 2.0
+        return cls(float(max_range), math.radians(fov_deg), math.radians(resolution_deg),
+                   math.radians(angle_min_deg))
+
+    @property
+    def n_beams(self) -> int:
+        """n = f/q + 1 (paper, Sec. 3)."""
+        return int(round(self.fov / self.resolution)) + 1
+
+    @cached_property
+    def angles(self) -> np.ndarray:
+        """Eq. 3: beam angles (radians) relative to the robot's heading, shape ``(n_beams,)``."""
+        a = self.angle_min + self.resolution * np.arange(self.n_beams)
+        a.setflags(write=False)
+        return a
+
+    def valid(self, ranges: np.ndarray) -> np.ndarray:
+        """Mask of beams with a return: finite, positive and below ``max_range``."""
+        r = np.asarray(ranges, dtype=float)
+        with np.errstate(invalid="ignore"):
+            return np.isfinite(r) & (r > 0.0) & (r < self.max_range)
+
+    def to_points(self, ranges: np.ndarray, keep_invalid: bool = False) -> np.ndarray:
+        """Eq. 4: ranges (metres) → points in the sensor frame, shape ``(k, 2)``.
+
+        Beams with no return are dropped unless ``keep_invalid``, in which case they are NaN rows.
+        """
+        r = np.asarray(ranges, dtype=float)
+        pts = np.column_stack((np.cos(self.angles) * r, np.sin(self.angles) * r))
+        ok = self.valid(r)
+        if keep_invalid:
+            pts[~ok] = np.nan
+            return pts
+        return pts[ok]
