@@ -24,6 +24,11 @@ GROUP = "tfloc.matchers"
 # Fallback when the package metadata is missing (running from a source tree without install).
 _BUILTIN = {
     "tf": "tfloc.tf:TurningFunctionMatcher",
+    "tf-plus": "tfloc.tf_plus:TurningFunctionPlusMatcher",
+    "o3d-icp": "baselines.o3d_icp:Open3dIcpMatcher",
+    "kiss-icp": "baselines.kiss_icp:KissIcpMatcher",
+    "cv-corners": "baselines.cv_corners:CvCornersMatcher",
+    "csm-corr": "baselines.csm_corr:CorrelativeMatcher",
 }
 
 

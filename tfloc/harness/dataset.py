@@ -34,6 +34,7 @@ class Scan:
     initial: Pose
     true: Pose | None = None
     line: int = 0  # 1-based line in scans.csv, for messages
+    ref_ranges: np.ndarray | None = None  # scan-to-scan datasets: the reference scan (see map_for)
 
 
 @dataclass(frozen=True, eq=False)
@@ -146,10 +147,28 @@ def iter_scans(scenario: Scenario) -> Iterator[Scan]:
             if sid in seen:
                 raise DatasetError(f"{path}:{line}: duplicate scan_id {sid!r}")
             seen.add(sid)
+            ref = row.get("ref_ranges")
             yield Scan(sid, row["group"].strip(),
                        parse_ranges(row["ranges"], scenario.laser, path, line),
                        _pose(row, "init", path, line, optional=False),
-                       _pose(row, "true", path, line, optional=True), line)
+                       _pose(row, "true", path, line, optional=True), line,
+                       parse_ranges(ref, scenario.laser, path, line) if ref else None)
+
+
+def map_for(scenario: Scenario, scan: Scan, cache: dict | None = None):
+    """The map a scan is localized in: the dataset's map file, or, for a scan-to-scan dataset
+    (optional ``ref_ranges`` column), the reference scan as a polyline map with the reference
+    robot at the origin (so ``true``/``init`` are relative poses)."""
+    if scan.ref_ranges is not None:
+        from ..maps.scanmap import polyline_map_from_scan
+
+        return polyline_map_from_scan(scan.ref_ranges, scenario.laser)
+    cache = {} if cache is None else cache
+    if scenario.map_path not in cache:
+        from .. import load_map
+
+        cache[scenario.map_path] = load_map(scenario.map_path)
+    return cache[scenario.map_path]
 
 
 def read_scans(scenario: Scenario) -> list[Scan]:
@@ -173,11 +192,15 @@ def write_scenario(root: str | Path, name: str, map_path: str | Path, laser: Las
                      "resolution_deg": round(math.degrees(laser.resolution), 9),
                      "angle_min_deg": round(math.degrees(laser.angle_min), 9)}, **extra}
     (root / "scenario.json").write_text(json.dumps(doc, indent=2) + "\n")
+    scans = list(scans)
+    with_ref = any(s.ref_ranges is not None for s in scans)
     with (root / "scans.csv").open("w", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow(COLUMNS)
+        w.writerow(COLUMNS + (["ref_ranges"] if with_ref else []))
         for s in scans:
             t = ["", "", ""] if s.true is None else [f"{s.true.x:.6f}", f"{s.true.y:.6f}", f"{s.true.theta:.7f}"]
+            ref = [] if not with_ref else [" ".join(_fmt(v) for v in s.ref_ranges)
+                                           if s.ref_ranges is not None else ""]
             w.writerow([s.scan_id, s.group, *t, f"{s.initial.x:.6f}", f"{s.initial.y:.6f}",
-                        f"{s.initial.theta:.7f}", " ".join(_fmt(v) for v in s.ranges)])
+                        f"{s.initial.theta:.7f}", " ".join(_fmt(v) for v in s.ranges), *ref])
     return root

@@ -1,0 +1,26 @@
+"""A reference scan as a map: its points joined into polylines (for scan-to-scan matching)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..laser import LaserSpec
+from ..pose import Pose
+from .vector import VectorMap
+
+
+def polyline_map_from_scan(ranges: np.ndarray, laser: LaserSpec, pose: Pose = Pose(),
+                           max_gap: float = 0.5, max_gap_ratio: float = 0.15) -> VectorMap:
+    """Join consecutive returns of a scan into wall segments, seen from ``pose`` (metres).
+
+    Neighbouring beams are joined unless one has no return or the points are farther apart
+    than ``max_gap`` metres plus ``max_gap_ratio`` × range (a depth discontinuity, not a wall).
+    """
+    pts = pose.transform(laser.to_points(ranges, keep_invalid=True))
+    r = np.asarray(ranges, dtype=float)
+    ok = laser.valid(r)
+    a, b = pts[:-1], pts[1:]
+    gap = np.hypot(*(b - a).T)
+    with np.errstate(invalid="ignore"):
+        join = ok[:-1] & ok[1:] & (gap <= max_gap + max_gap_ratio * np.fmin(r[:-1], r[1:]))
+    return VectorMap.from_segments(np.hstack((a[join], b[join])), name="scan")
