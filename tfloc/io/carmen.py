@@ -159,6 +159,10 @@ def _flaser(c: _Line) -> LaserRecord:
     n = c.count("num_readings")
     if n == 0:
         raise c.fail("num_readings is 0")
+    want = n + 11  # name, n, n ranges, 2 poses, ipc_timestamp, host, logger_timestamp
+    if len(c.tok) != want:
+        raise c.fail(f"{len(c.tok)} fields, expected {want} for num_readings={n} "
+                     f"({'line is truncated or ' if len(c.tok) < want else ''}wrong beam count)")
     r = c.nums(n, "range")
     if (r < 0).any():
         raise c.fail(f"negative range at beam {int(np.argmax(r < 0))}")
