@@ -57,21 +57,25 @@ def grid_from_scans(ranges: np.ndarray, poses: np.ndarray, laser: LaserSpec, res
 
 
 def rasterize(vmap: VectorMap, resolution: float, margin: float = 0.5, name: str | None = None) -> GridMap:
-    """A grid of a vector map: cells a wall or obstacle edge passes through are occupied (1), cells
-    whose centre is in the map's free space are free (0), the rest unknown (NaN)."""
+    """A grid of a vector map: every cell a wall or obstacle edge passes through is occupied (1,
+    exact grid traversal, so no beam can slip through a diagonal wall), cells whose centre is in
+    the map's free space are free (0), the rest unknown (NaN). The grid is offset by half a cell
+    so that walls on round coordinates run through cell centres."""
     segs = vmap.segments
     pts = np.vstack((segs[:, :2], segs[:, 2:]))
-    origin, W, H = _frame(pts, resolution, margin)
-    a, e = segs[:, :2], segs[:, 2:] - segs[:, :2]
-    n = np.maximum(2, np.ceil(np.hypot(e[:, 0], e[:, 1]) / (0.2 * resolution)).astype(int) + 1)
-    idx = np.repeat(np.arange(len(segs)), n)
-    frac = (np.arange(idx.size) - np.repeat(np.cumsum(n) - n, n)) / (n[idx] - 1)
-    samples = a[idx] + frac[:, None] * e[idx]
-    ij = np.floor((samples - np.array(origin)) / resolution).astype(np.int64)
+    (ox, oy), W, H = _frame(pts, resolution, margin)
+    origin = (ox - 0.5 * resolution, oy - 0.5 * resolution)
+    W, H = W + 1, H + 1
+    a = (segs[:, :2] - np.array(origin)) / resolution
+    b = (segs[:, 2:] - np.array(origin)) / resolution
+    crossed = np.zeros((H, W), dtype=np.int64)
+    carve_grid(crossed, np.ascontiguousarray(a), np.ascontiguousarray(b))
+    ends = np.floor(np.vstack((a, b))).astype(np.int64)
+    crossed[ends[:, 1], ends[:, 0]] += 1
     occ = np.full((H, W), np.nan, dtype=np.float32)
     jj, ii = np.mgrid[0:H, 0:W]
     centres = np.column_stack((origin[0] + (ii.ravel() + 0.5) * resolution,
                                origin[1] + (jj.ravel() + 0.5) * resolution))
     occ.ravel()[vmap.is_free(centres)] = 0.0
-    occ[ij[:, 1], ij[:, 0]] = 1.0
+    occ[crossed > 0] = 1.0
     return GridMap(occ, resolution, origin, name=name or f"{vmap.name}@{resolution:g}m")
