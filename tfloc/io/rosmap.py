@@ -45,6 +45,8 @@ def read_ros_map(yaml_path: str | Path) -> GridMap:
     if not isinstance(doc.get("image"), str):
         raise MapFormatError(f"{path}: missing or non-string key 'image'")
     res = _num(doc, "resolution", path)
+    if res <= 0:
+        raise MapFormatError(f"{path}: resolution must be a positive number of metres per cell, got {res}")
     occ_t = _num(doc, "occupied_thresh", path, 0.65)
     free_t = _num(doc, "free_thresh", path, 0.196)
     negate = _num(doc, "negate", path, 0.0)
