@@ -22,6 +22,7 @@ bench: $(STAMP)
 	$(BIN)/tfloc report results/paper-protocol
 	$(BIN)/tfloc bench benchmarks/real-csail-relations.toml --jobs $(JOBS)
 	$(BIN)/tfloc report results/real-csail-relations
+	$(BIN)/tfloc real-note results/real-csail-relations
 	$(BIN)/tfloc bench benchmarks/real-scan-to-map.toml --jobs $(JOBS)
 	$(BIN)/tfloc report results/real-scan-to-map
 
