@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 import pytest
-
-import tfloc
 from _baseline_cases import OFFSETS, errors, make_problem
 
+import tfloc
 from baselines.kiss_icp import KissIcpMatcher
 
 

@@ -73,7 +73,7 @@ def get_matcher(name: str, **params: Any) -> Matcher:
         mod = __import__(module, fromlist=[attr])
         factory = getattr(mod, attr)
     except ImportError as exc:
-        lib = f"the library {exc.name!r}" if exc.name else "a library"
+        lib = f"the library {exc.name.partition('.')[0]!r}" if exc.name else "a library"
         raise MatcherError(
             f"matcher {name!r} needs {lib}, which is not installed or failed to import: {exc} "
             f"(install the project with its dependencies: pip install -e .)") from None
