@@ -41,6 +41,7 @@ print(json.dumps(out))
 @pytest.mark.parametrize(("name", "module", "other"), [
     ("kiss-icp", "kiss_icp", "csm-corr"),
     ("o3d-icp", "open3d", "kiss-icp"),
+    ("cv-corners", "cv2", "o3d-icp"),
 ])
 def test_missing_library_is_a_clear_matcher_error(name: str, module: str, other: str) -> None:
     code = _SCRIPT.format(module=module, tests=str(ROOT / "tests"), name=name, other=other)
