@@ -77,3 +77,56 @@ def test_resolve_config_rejects_unknown_and_tuples_lists() -> None:
     assert cfg.gates == (0.5, 0.1)
     with pytest.raises(TypeError, match="bogus"):
         resolve_config(O3dConfig, None, {"bogus": 1})
+
+
+class _ProtocolOnlyMap:
+    """A map that offers only the Map protocol (no ``segments``), as a GridMap would."""
+
+    def __init__(self, inner: object) -> None:
+        self._inner = inner
+
+    def raycast(self, poses, laser):  # noqa: ANN001, ANN201
+        return self._inner.raycast(poses, laser)
+
+    def is_free(self, xy, clearance=0.0):  # noqa: ANN001, ANN201
+        return self._inner.is_free(xy, clearance)
+
+    def in_bounds(self, xy):  # noqa: ANN001, ANN201
+        return self._inner.in_bounds(xy)
+
+    def sample_points(self, spacing):  # noqa: ANN001, ANN201
+        return self._inner.sample_points(spacing)
+
+    @property
+    def bounds(self):  # noqa: ANN201
+        return self._inner.bounds
+
+
+NAMES = ["o3d-icp", "kiss-icp", "csm-corr", "cv-corners"]
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_uses_only_the_map_protocol(name: str) -> None:
+    from _baseline_cases import make_problem
+
+    import tfloc
+    problem, true = make_problem()
+    wrapped = tfloc.Problem(_ProtocolOnlyMap(problem.map), problem.laser, problem.ranges, problem.initial)
+    est = tfloc.get_matcher(name).localize(wrapped)
+    assert est.pose.distance_to(true) < 0.02
+
+
+@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("n_returns", [1, 3])
+def test_tiny_scans_do_not_crash(name: str, n_returns: int) -> None:
+    from _baseline_cases import make_problem
+
+    import tfloc
+    problem, _ = make_problem()
+    ranges = np.full_like(problem.ranges, np.inf)
+    ranges[80:80 + n_returns] = problem.ranges[80:80 + n_returns]
+    tiny = tfloc.Problem(problem.map, problem.laser, ranges, problem.initial)
+    matcher = tfloc.get_matcher(name)
+    est = matcher.localize(tiny)
+    assert est.pose.is_finite()
+    assert np.isfinite(matcher.score(tiny, est.pose))
