@@ -18,8 +18,8 @@ Configuration choices and why:
   scale to 0, so candidate rigid transforms are first proposed by every ordered pair of real
   corners and pair of virtual corners whose lengths agree within ``length_tol`` = 15 cm (pairs
   shorter than ``min_pair_length`` = 0.5 m give no usable rotation), restricted to the window the
-  protocol's initial guess is known to lie in (``max_angle_deg`` = 25°, ``max_shift`` = 4 m, the
-  same prior as ``csm-corr``'s ±3.5 m / ±20° plus a margin). Each is scored by its one-to-one
+  protocol's initial guess is known to lie in (``max_angle_deg`` = 25°, ``max_shift`` = 4 m per
+  step, the same prior as ``csm-corr``'s ±3.5 m / ±20° plus a margin). Each is scored by its one-to-one
   (mutual nearest neighbour) inliers within ``inlier_tol`` = 20 cm, ties broken by the summed
   inlier distance. The truth is never used.
 * **Refinement by OpenCV**: the best hypothesis's inlier pairs go to
@@ -111,7 +111,7 @@ class CvCornersMatcher:
         virtual = self._corners(problem.map.raycast(pose, problem.laser), problem)
         if len(real) < 2 or len(virtual) < 2:
             raise _NoAnswer(f"too few corners (real {len(real)}, virtual {len(virtual)})")
-        # The window is about the initial pose; hypotheses are relative to ``pose``.
+        # The window bounds the correction of this step, relative to ``pose``.
         hyp = pair_hypotheses(real, virtual, c.length_tol, c.min_pair_length,
                               math.radians(c.max_angle_deg), c.max_shift)
         if hyp.theta.size == 0:
@@ -123,8 +123,8 @@ class CvCornersMatcher:
             raise _NoAnswer(f"{len(src)} corner inlier(s)")
         m, mask = cv2.estimateAffinePartial2D(
             src.astype(np.float32).reshape(-1, 1, 2), dst.astype(np.float32).reshape(-1, 1, 2),
-            method=cv2.RANSAC, ransacReprojThreshold=c.inlier_tol if first else c.fine_tol, maxIters=c.ransac_max_iters,
-            confidence=c.ransac_confidence)
+            method=cv2.RANSAC, ransacReprojThreshold=c.inlier_tol if first else c.fine_tol,
+            maxIters=c.ransac_max_iters, confidence=c.ransac_confidence)
         if m is None:
             raise _NoAnswer("estimateAffinePartial2D found no transform")
         scale = math.hypot(m[0, 0], m[1, 0])
