@@ -67,7 +67,8 @@ class LaserSpec:
         Beams with no return are dropped unless ``keep_invalid``, in which case they are NaN rows.
         """
         r = np.asarray(ranges, dtype=float)
-        pts = np.column_stack((np.cos(self.angles) * r, np.sin(self.angles) * r))
+        with np.errstate(invalid="ignore"):
+            pts = np.column_stack((np.cos(self.angles) * r, np.sin(self.angles) * r))
         ok = self.valid(r)
         if keep_invalid:
             pts[~ok] = np.nan
