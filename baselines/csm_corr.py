@@ -83,8 +83,10 @@ class CorrelativeMatcher:
 
     def _field(self, problem: Problem) -> LikelihoodField:
         c = self.config
-        pad = problem.laser.max_range + c.window_xy + 1.0
-        return likelihood_field(problem.map, c.resolution, c.sigma, pad)
+        # A zero band twice the translation reach wide: endpoints beyond it are clamped onto it (see
+        # ``localize``), so the field's size does not grow with the laser's range.
+        reach = c.window_xy + (c.block + 1) * c.xy_step_cells * c.resolution
+        return likelihood_field(problem.map, c.resolution, c.sigma, 2.0 * reach + 0.5)
 
     def _grid(self, initial: Pose) -> _Grid:
         c = self.config
@@ -107,10 +109,13 @@ class CorrelativeMatcher:
         wx = problem.initial.x + cos * pts[:, 0] - sin * pts[:, 1]
         wy = problem.initial.y + sin * pts[:, 0] + cos * pts[:, 1]
         cells = field.cells(np.stack((wx, wy), axis=-1))
-        base = cells[..., 1] * w + cells[..., 0]
-        reach = int(grid.steps[-1]) + c.block * c.xy_step_cells
-        if (cells.min() - reach < 0) or (cells[..., 0].max() + reach >= w) or (cells[..., 1].max() + reach >= h):
-            raise ValueError("scan endpoints fall outside the padded likelihood field")  # cannot happen: pad ≥ range + window
+        # Translations move a cell by -lo … +hi cells. An endpoint that far beyond the map scores 0 at
+        # every translation; clamping it keeps all its lookups inside the field's zero band.
+        lo = -int(grid.steps[0])
+        hi = int(grid.steps[-1]) + c.block * c.xy_step_cells
+        cx = np.clip(cells[..., 0], lo, w - 1 - hi)
+        cy = np.clip(cells[..., 1], lo, h - 1 - hi)
+        base = cy * w + cx
 
         # Low resolution: upper bounds for every (rotation, block_y, block_x).
         span = (c.block - 1) * c.xy_step_cells + 1

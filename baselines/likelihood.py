@@ -2,9 +2,9 @@
 
 The map's geometry is rasterised at ``resolution`` metres, ``scipy.ndimage.distance_transform_edt``
 gives every cell its distance to the nearest wall, and a beam endpoint at distance ``d`` has
-likelihood ``exp(-d² / 2σ²)``. The grid covers the map's bounds plus ``pad`` metres on every side
-(cells beyond the map have likelihood 0), so that every endpoint of a scan taken within ``pad −
-max_range`` metres of the map can be looked up by integer index without clipping.
+likelihood ``exp(-d² / 2σ²)``. The grid covers the map's bounds plus ``pad`` metres on every side;
+cells more than 1 m beyond the map's bounds have likelihood 0 (a search uses that band to look up
+shifted endpoints by integer index without clipping every lookup).
 """
 
 from __future__ import annotations
