@@ -73,8 +73,9 @@ def get_matcher(name: str, **params: Any) -> Matcher:
         mod = __import__(module, fromlist=[attr])
         factory = getattr(mod, attr)
     except ImportError as exc:
+        lib = f"the library {exc.name.partition('.')[0]!r}" if exc.name else "a library"
         raise MatcherError(
-            f"matcher {name!r} needs a library that is not installed: {exc} "
+            f"matcher {name!r} needs {lib}, which is not installed or failed to import: {exc} "
             f"(install the project with its dependencies: pip install -e .)") from None
     try:
         return factory(**params)
