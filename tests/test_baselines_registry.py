@@ -130,3 +130,11 @@ def test_tiny_scans_do_not_crash(name: str, n_returns: int) -> None:
     est = matcher.localize(tiny)
     assert est.pose.is_finite()
     assert np.isfinite(matcher.score(tiny, est.pose))
+
+
+def test_missing_matcher_module_is_not_blamed_on_a_library(monkeypatch: pytest.MonkeyPatch) -> None:
+    import tfloc.matcher as registry
+
+    monkeypatch.setitem(registry._registry(), "ghost", "baselines.no_such_module:Ghost")
+    with pytest.raises(registry.MatcherError, match="its module 'baselines.no_such_module' is not part"):
+        registry.get_matcher("ghost")
