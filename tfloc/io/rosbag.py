@@ -174,7 +174,7 @@ class Bag:
             elif spec != ref[0]:
                 names = ("beam count", "angle_min", "angle_increment", "range_min", "range_max")
                 k = next(k for k in range(5) if spec[k] != ref[0][k])
-                raise BagError(f"{where}: {names[k]} {spec[k]:g} differs from message 0's {ref[0][0][k]:g}; "
+                raise BagError(f"{where}: {names[k]} {spec[k]:g} differs from message 0's {ref[0][k]:g}; "
                                "one topic must keep one laser spec")
             r = np.asarray(m.ranges, dtype=float)
             with np.errstate(invalid="ignore"):
