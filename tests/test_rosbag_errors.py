@@ -231,3 +231,12 @@ def test_missing_bag_and_missing_rosbags(tmp_path, map_yaml, monkeypatch) -> Non
     monkeypatch.setattr(builtins, "__import__", fake)
     with pytest.raises(TflocError, match=r"pip install 'tfloc\[ros\]'"):
         _import(tmp_path / "nope.bag", tmp_path / "ds", map_yaml)
+
+
+def test_frame_pair_on_a_pose_topic(tmp_path, sim, map_yaml) -> None:
+    t, P, R = sim
+    bag = write_bag(bag_path(tmp_path, "ros1"), "ros1",
+                    scan_items("/scan", t, R) + pose_items("/gt", "PoseStamped", POSE_T))
+    with pytest.raises(BagError, match=r"/gt has type geometry_msgs/msg/PoseStamped; a frame pair applies "
+                                       r"to tf topics only"):
+        _import(bag, tmp_path / "ds", map_yaml, pose_frames=("map", "base_link"))

@@ -198,6 +198,8 @@ class Bag:
             if frames is None:
                 raise BagError(f"{self.path}: {topic} is a tf topic: name the frame pair (parent child)")
             return self._tf_poses(topic, frames)
+        if frames is not None and types is not None:
+            raise BagError(f"{self.path}: {topic} has type {types}; a frame pair applies to tf topics only")
         stamps, poses, frame, child = [], [], "", ""
         for i, t_ns, m in self.messages(topic, POSE_TYPES):
             p = m.pose if m.__msgtype__ == "geometry_msgs/msg/PoseStamped" else m.pose.pose
