@@ -220,11 +220,24 @@ def test_imported_scans_fit_the_map(tmp_path, sim, map_yaml) -> None:
 
 
 def test_bench_runs_on_an_imported_dataset(tmp_path, sim, map_yaml) -> None:
-    """End to end: bag → import-bag → bench (needs the harness runner)."""
+    """End to end: bag → import-bag → bench → export → evo reads the estimates (needs the
+    harness runner; the run configuration follows benchmarks/*.toml)."""
     pytest.importorskip("tfloc.harness.runner")
+    file_interface = pytest.importorskip("evo.tools.file_interface")
     bag = write_bag(bag_path(tmp_path, "mcap"), "mcap",
                     scan_items("/scan", sim[0], sim[2]) + pose_items("/gt", "PoseStamped", POSE_T))
-    out = tmp_path / "scenarios" / "mybag"
+    ds = tmp_path / "scenarios" / "mybag"
     assert main(["import-bag", str(bag), "--scan-topic", "/scan", "--pose-topic", "/gt",
-                 "--map", str(map_yaml), "--out", str(out), "--limit", "4"]) == 0
-    pytest.skip("the bench invocation is written when the runner lands")
+                 "--map", str(map_yaml), "--out", str(ds), "--limit", "3", "--seed", "1"]) == 0
+    run = tmp_path / "results" / "mybag"
+    cfg = tmp_path / "mybag.toml"
+    cfg.write_text(f'name = "mybag"\nout = "{run}"\ndatasets = ["{ds}"]\nmatchers = ["tf"]\n'
+                   'jobs = 1\ntimeout_s = 120\n')
+    assert main(["bench", str(cfg), "--jobs", "1"]) == 0
+    assert main(["export", str(run), "--tum", str(tmp_path / "tum"), "--datasets", str(ds.parent)]) == 0
+    scans = read_scans(read_scenario(ds))
+    ref = file_interface.read_tum_trajectory_file(str(tmp_path / "tum" / "mybag" / "reference.tum"))
+    np.testing.assert_allclose(ref.timestamps, [s.stamp for s in scans], atol=1e-6)
+    np.testing.assert_allclose(ref.positions_xyz[:, :2], [[s.true.x, s.true.y] for s in scans], atol=1e-6)
+    est = file_interface.read_tum_trajectory_file(str(tmp_path / "tum" / "mybag" / "tf.tum"))
+    assert 1 <= est.num_poses <= len(scans)

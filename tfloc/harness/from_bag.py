@@ -129,12 +129,15 @@ def import_bag(cfg: BagImport) -> ImportSummary:
         init_p = np.array([Pose.from_array(p).compose(off).as_array() for p in ip])
         groups = [cfg.initial_topic.strip("/").replace("/", "-")] * rows.size
         how = {"initial_topic": cfg.initial_topic, "align_initial": cfg.align_initial}
+        init_text = f"initial poses from {cfg.initial_topic}" + (" (aligned at the first scan)"
+                                                                  if cfg.align_initial else "")
     else:
         pcfg = Perturbation(clearance_m=cfg.clearance_m) if cfg.seed is None else \
             Perturbation(seed=cfg.seed, clearance_m=cfg.clearance_m)
         init_p, groups = perturb(true_p, the_map, pcfg)
         how = {"perturbation": {"seed": pcfg.seed, "clearance_m": pcfg.clearance_m,
                                 "bins": "0-1/1-2/2-3 m x 0-5/5-10/10-15 deg, groups d{i}-a{j}"}}
+        init_text = f"initial poses perturbed in the paper's 3x3 offset bins (seed {pcfg.seed})"
     rows_out = [Scan(f"s{scans.index[pick[k]]:05d}", g, scans.ranges[pick[k]], Pose.from_array(ip_),
                      Pose.from_array(tp), stamp=float(t[k]))
                 for k, g, ip_, tp in zip(rows, groups, init_p, true_p, strict=True)]
@@ -154,7 +157,8 @@ def import_bag(cfg: BagImport) -> ImportSummary:
     name = cfg.name or out.name
     write_scenario(out, name, map_path, las, rows_out,
                    description=(f"Imported from ROS bag {Path(cfg.bag).name}: {cfg.scan_topic} scans, "
-                                f"reference poses from {cfg.pose_topic} interpolated to the scan stamps."),
+                                f"reference poses from {cfg.pose_topic} interpolated to the scan stamps, "
+                                f"{init_text}."),
                    source=source)
     return ImportSummary(out, int(scans.index.size), int(rows.size), int(np.count_nonzero(~covered)),
                          outside_init, n_empty)
