@@ -142,6 +142,18 @@ def test_export_without_stamps_uses_scan_index(tmp_path) -> None:
     np.testing.assert_allclose(P[0], scans[-1].true.as_array(), atol=1e-8)  # the run lists them reversed
 
 
+def test_dataset_named_by_path(tmp_path, monkeypatch) -> None:
+    """A run may name its datasets by path (as in benchmarks/*.toml): found there, files under
+    the directory's name."""
+    scans = _dataset(tmp_path / "data" / "scenarios" / "mybag", stamps=True)
+    monkeypatch.chdir(tmp_path)
+    _run(tmp_path / "run", "data/scenarios/mybag", scans)
+    done = export_tum(tmp_path / "run", tmp_path / "tum", None)
+    assert {e.stamps for e in done} == {"stamp"}
+    t, _ = read_tum(tmp_path / "tum" / "mybag" / "reference.tum")
+    np.testing.assert_allclose(t, [s.stamp for s in scans], atol=1e-6)
+
+
 def test_export_errors(tmp_path) -> None:
     with pytest.raises(DatasetError, match="no such results file"):
         export_tum(tmp_path / "none", tmp_path / "tum")

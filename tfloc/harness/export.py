@@ -117,7 +117,8 @@ def _safe(name: str) -> str:
 
 
 def export_tum(run_dir: str | Path, out_dir: str | Path, datasets_root: Path | None = None) -> list[Exported]:
-    """Write ``out_dir/<dataset>/{reference,initial,<matcher>}.tum`` for a run; returns what was written."""
+    """Write ``out_dir/<dataset>/{reference,initial,<matcher>}.tum`` for a run (``<dataset>``: the
+    last part of the run's dataset name or path); returns what was written."""
     run_dir, out_dir = Path(run_dir), Path(out_dir)
     rows = read_estimates(run_dir / "estimates.csv")
     by_ds: dict[str, list[dict]] = {}
@@ -148,6 +149,6 @@ def export_tum(run_dir: str | Path, out_dir: str | Path, datasets_root: Path | N
             P = np.array([poses[s] for _, s in ok]).reshape(-1, 3)
             name = kind if not matcher else (_safe(matcher) if matcher not in ("reference", "initial")
                                              else f"matcher-{matcher}")
-            path = write_tum(out_dir / _safe(ds) / f"{name}.tum", t, P) if ok else None
+            path = write_tum(out_dir / _safe(Path(ds).name or ds) / f"{name}.tum", t, P) if ok else None
             written.append(Exported(path, ds, matcher or kind, len(ok), len(poses) - len(ok), how))
     return written
