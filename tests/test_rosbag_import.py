@@ -94,6 +94,15 @@ def test_scans_and_poses_round_trip(tmp_path, sim, map_yaml, kind, ptype) -> Non
         assert math.radians(5 * (j - 1)) <= abs(angdiff(s.initial.theta, s.true.theta)) <= math.radians(5 * j)
 
 
+@pytest.mark.parametrize("kind", ["sqlite3", "mcap"])
+def test_ros2_storage_file_given_directly(tmp_path, sim, kind) -> None:
+    t, P, R = sim
+    bag = write_bag(bag_path(tmp_path, kind), kind, scan_items("/scan", t, R))
+    f = next(x for x in bag.iterdir() if x.suffix in (".db3", ".mcap"))
+    with Bag(f) as b:
+        np.testing.assert_allclose(b.scans("/scan").ranges, R, atol=1e-5)
+
+
 def test_perturbation_is_seeded(tmp_path, sim, map_yaml) -> None:
     t, P, R = sim
     bag = write_bag(bag_path(tmp_path, "ros1"), "ros1", scan_items("/scan", t, R)
