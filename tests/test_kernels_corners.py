@@ -4,14 +4,51 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from numba import njit
 
-from tfloc.corners import corner_candidates, merge_lines, resample, shortstraw
+from tfloc.corners import _resample_into, corner_candidates, merge_lines, resample, shortstraw
 from tfloc.laser import LaserSpec
 from tfloc.maps.vector import VectorMap
 from tfloc.pose import Pose
 
 
 # --- oracles: the implementations before the numba rewrite, verbatim -------------------------
+@njit(cache=True)
+def resample_ref(points, spacing):
+    n = points.shape[0]
+    out = np.empty((max(2, n) * 4 + 16, 2))
+    if n == 0:
+        return out[:0]
+    m = 0
+    p1x, p1y = points[0, 0], points[0, 1]
+    out[m, 0], out[m, 1] = p1x, p1y
+    m += 1
+    i = 1
+    while i < n:
+        p2x, p2y = points[i, 0], points[i, 1]
+        dx, dy = p2x - p1x, p2y - p1y
+        d = np.sqrt(dx * dx + dy * dy)
+        if d > spacing:
+            p1x, p1y = p1x + dx / d * spacing, p1y + dy / d * spacing
+            if m >= out.shape[0]:
+                grown = np.empty((out.shape[0] * 2, 2))
+                grown[:m] = out[:m]
+                out = grown
+            out[m, 0], out[m, 1] = p1x, p1y
+            m += 1
+        else:
+            i += 1
+    lx, ly = points[n - 1, 0] - p1x, points[n - 1, 1] - p1y
+    if np.sqrt(lx * lx + ly * ly) > 0.5 * spacing:
+        if m >= out.shape[0]:
+            grown = np.empty((out.shape[0] + 1, 2))
+            grown[:m] = out[:m]
+            out = grown
+        out[m, 0], out[m, 1] = points[n - 1, 0], points[n - 1, 1]
+        m += 1
+    return out[:m].copy()
+
+
 def straws_ref(points, window=1):
     d = points[2 * window:] - points[:-2 * window]
     return np.einsum("ij,ij->i", d, d)
@@ -47,7 +84,7 @@ def shortstraw_ref(points, spacing, window=1, t=0.99, line_threshold=0.95):
     pts = np.ascontiguousarray(points, dtype=float)
     if len(pts) < 2:
         return pts.copy()
-    res = resample(pts, float(spacing))
+    res = resample_ref(pts, float(spacing))
     cand = corner_candidates_ref(res, window, t)
     return res[merge_lines_ref(res, cand.astype(np.int64), float(line_threshold))]
 # ------------------------------------------------------------------------------------------------
@@ -81,6 +118,7 @@ def test_candidates_merge_and_shortstraw_match_oracles(spacing, window, t):
     checked = 0
     for pts in _polylines(int(spacing * 100) + window, 60):
         res = resample(pts, spacing)
+        np.testing.assert_array_equal(res, resample_ref(pts, spacing))
         cand = corner_candidates(res, window, t)
         ref = corner_candidates_ref(res, window, t)
         np.testing.assert_array_equal(cand, ref)
@@ -100,6 +138,26 @@ def test_degenerate_inputs_match_oracles():
         for window in (1, 3):
             np.testing.assert_array_equal(corner_candidates(pts, window), corner_candidates_ref(pts, window))
             np.testing.assert_array_equal(shortstraw(pts, 1.0, window), shortstraw_ref(pts, 1.0, window))
+
+
+def test_resample_on_exact_spacings():
+    """Points exactly ``spacing`` apart (the sqrt-free shortcut must not change the test d > S)."""
+    for spacing in (1.0, 0.1, 0.3, 0.25):
+        for n in (2, 5, 40):
+            pts = np.column_stack((np.arange(n) * spacing, np.zeros(n)))
+            np.testing.assert_array_equal(resample(pts, spacing), resample_ref(pts, spacing))
+            diag = pts @ np.array([[np.cos(0.7), np.sin(0.7)], [-np.sin(0.7), np.cos(0.7)]])
+            np.testing.assert_array_equal(resample(diag, spacing), resample_ref(diag, spacing))
+
+
+def test_resample_into_counts_and_reports_overflow():
+    pts = np.random.default_rng(0).uniform(0, 10, (50, 2))
+    ref = resample_ref(pts, 0.3)
+    assert _resample_into(pts, 0.3, np.empty((0, 2))) == len(ref)
+    assert _resample_into(pts, 0.3, np.empty((len(ref) - 1, 2))) == -1
+    out = np.empty((len(ref), 2))
+    assert _resample_into(pts, 0.3, out) == len(ref)
+    np.testing.assert_array_equal(out, ref)
 
 
 def test_merge_lines_handles_short_corner_lists():

@@ -26,6 +26,46 @@ from numba import njit
 
 
 @njit(cache=True, nogil=True)
+def _resample_into(points: np.ndarray, spacing: float, out: np.ndarray) -> int:
+    """Algorithm 1 written into ``out``; returns the number of points, or -1 if ``out`` is too
+    small (``out`` of shape ``(0, 2)`` just counts)."""
+    n = points.shape[0]
+    cap = out.shape[0]
+    count_only = cap == 0
+    m = 0
+    p1x, p1y = points[0, 0], points[0, 1]
+    if not count_only:
+        out[0, 0], out[0, 1] = p1x, p1y
+    m += 1
+    i = 1
+    surely_inside = spacing * spacing * (1.0 - 1e-9)   # d² below this ⇒ d ≤ spacing, no sqrt
+    while i < n:
+        dx, dy = points[i, 0] - p1x, points[i, 1] - p1y
+        d2 = dx * dx + dy * dy
+        if d2 < surely_inside:
+            i += 1
+            continue
+        d = np.sqrt(d2)
+        if d > spacing:
+            p1x, p1y = p1x + dx / d * spacing, p1y + dy / d * spacing
+            if not count_only:
+                if m >= cap:
+                    return -1
+                out[m, 0], out[m, 1] = p1x, p1y
+            m += 1
+        else:
+            i += 1
+    lx, ly = points[n - 1, 0] - p1x, points[n - 1, 1] - p1y
+    if np.sqrt(lx * lx + ly * ly) > 0.5 * spacing:
+        if not count_only:
+            if m >= cap:
+                return -1
+            out[m, 0], out[m, 1] = points[n - 1, 0], points[n - 1, 1]
+        m += 1
+    return m
+
+
+@njit(cache=True, nogil=True)
 def resample(points: np.ndarray, spacing: float) -> np.ndarray:
     """Algorithm 1: walk along ``points`` ``(N, 2)`` and emit points exactly ``spacing`` metres
     apart (chord length from the last emitted point towards the next input point).
@@ -34,37 +74,21 @@ def resample(points: np.ndarray, spacing: float) -> np.ndarray:
     appended when it lies more than ``spacing/2`` beyond the last emitted point.
     """
     n = points.shape[0]
-    out = np.empty((max(2, n) * 4 + 16, 2))
     if n == 0:
-        return out[:0]
-    m = 0
-    p1x, p1y = points[0, 0], points[0, 1]
-    out[m, 0], out[m, 1] = p1x, p1y
-    m += 1
-    i = 1
-    while i < n:
-        p2x, p2y = points[i, 0], points[i, 1]
-        dx, dy = p2x - p1x, p2y - p1y
-        d = np.sqrt(dx * dx + dy * dy)
-        if d > spacing:
-            p1x, p1y = p1x + dx / d * spacing, p1y + dy / d * spacing
-            if m >= out.shape[0]:
-                grown = np.empty((out.shape[0] * 2, 2))
-                grown[:m] = out[:m]
-                out = grown
-            out[m, 0], out[m, 1] = p1x, p1y
-            m += 1
-        else:
-            i += 1
-    lx, ly = points[n - 1, 0] - p1x, points[n - 1, 1] - p1y
-    if np.sqrt(lx * lx + ly * ly) > 0.5 * spacing:
-        if m >= out.shape[0]:
-            grown = np.empty((out.shape[0] + 1, 2))
-            grown[:m] = out[:m]
-            out = grown
-        out[m, 0], out[m, 1] = points[n - 1, 0], points[n - 1, 1]
-        m += 1
-    return out[:m].copy()
+        return np.empty((0, 2))
+    path = 0.0                 # M ≤ path/spacing + 2 per input point (each emission walks S)
+    for i in range(1, n):
+        dx, dy = points[i, 0] - points[i - 1, 0], points[i, 1] - points[i - 1, 1]
+        path += np.sqrt(dx * dx + dy * dy)
+    cap = 3 * n + 16
+    if np.isfinite(path) and path / spacing < 1e9:
+        cap += int(path / spacing)
+    out = np.empty((cap, 2))
+    m = _resample_into(points, spacing, out)
+    if m < 0:                  # not expected; count exactly and redo
+        out = np.empty((_resample_into(points, spacing, np.empty((0, 2))), 2))
+        m = _resample_into(points, spacing, out)
+    return out[:m]
 
 
 def straws(points: np.ndarray, window: int = 1) -> np.ndarray:
