@@ -127,3 +127,14 @@ def test_non_uniform_angles_fall_back_to_bruteforce():
     poses = np.ascontiguousarray(np.column_stack((rng.uniform(-5, 5, (5, 2)), np.zeros(5))))
     np.testing.assert_array_equal(raycast_segments(poses, angles, segs, 10.0),
                                   raycast_segments_bruteforce(poses, angles, segs, 10.0))
+
+
+def test_fast_atan2_error_bound():
+    """The arc computation's atan2 approximation stays far inside the kernel's angle margin."""
+    from tfloc.maps._raycast import _ANGLE_MARGIN, _atan2
+
+    rng = np.random.default_rng(0)
+    pts = np.vstack((rng.normal(size=(20000, 2)) * 10.0 ** rng.uniform(-6, 3, (20000, 1)),
+                     [[1, 0], [0, 1], [-1, 0], [0, -1], [1, 1], [-1, -1], [-1, 1e-300], [-1, -1e-300]]))
+    err = [abs(math.remainder(_atan2(y, x) - math.atan2(y, x), 2 * math.pi)) for x, y in pts]
+    assert max(err) < 1e-5 < _ANGLE_MARGIN / 5

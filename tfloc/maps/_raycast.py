@@ -14,7 +14,26 @@ import numpy as np
 from numba import njit
 
 _U_TOL = 1e-9          # hits within this fraction of a segment's length beyond its ends count
-_ANGLE_MARGIN = 1e-7   # radians added on both sides of a segment's arc, for rounding
+_ANGLE_MARGIN = 1e-4   # radians added on both sides of a segment's arc (≫ the error of _atan2)
+
+
+@njit(cache=True, nogil=True)
+def _atan2(y: float, x: float) -> float:
+    """Approximate ``atan2(y, x)`` (error below 1e-5 rad; tests check it), for beam intervals
+    only: ranges are always computed exactly."""
+    ax, ay = abs(x), abs(y)
+    mx, mn = max(ax, ay), min(ax, ay)
+    if mx == 0.0:
+        return 0.0
+    a = mn / mx
+    s = a * a
+    r = (((((-0.013480470 * s + 0.057477314) * s - 0.121239071) * s + 0.195635925) * s
+          - 0.332994597) * s + 0.999995630) * a
+    if ay > ax:
+        r = 0.5 * np.pi - r
+    if x < 0.0:
+        r = np.pi - r
+    return -r if y < 0.0 else r
 
 
 @njit(cache=True, nogil=True)
@@ -135,7 +154,9 @@ def raycast_segments(poses: np.ndarray, rel_angles: np.ndarray, segs: np.ndarray
             dxs[b], dys[b] = np.cos(a), np.sin(a)
             best[b] = max_range
         k = _near_segments(ox, oy, segs, max_range, near, dist)
-        for j in range(k):
+        order = np.argsort(dist[:k])
+        for jj in range(k):
+            j = order[jj]
             m = near[j]
             seg = segs[m]
             ax, ay = seg[0] - ox, seg[1] - oy
@@ -148,10 +169,20 @@ def raycast_segments(poses: np.ndarray, rel_angles: np.ndarray, segs: np.ndarray
                     best[b] = _hit(ox, oy, dxs[b], dys[b], seg, best[b])
                 continue
             # arc [start, start + width] (relative to the first beam) the segment subtends
-            alpha = np.arctan2(ay, ax)
-            beta = np.arctan2(by, bx)
+            alpha = _atan2(ay, ax)
+            beta = _atan2(by, bx)
             d = beta - alpha
             d = d - two_pi * np.floor((d + np.pi) / two_pi)   # in [-π, π)
+            if abs(d) > np.pi - 1e-3:         # nearly through the sensor: every beam
+                for b in range(B):
+                    best[b] = _hit(ox, oy, dxs[b], dys[b], seg, best[b])
+                continue
+            # A beam hit (within the u tolerance) lies ≥ h − slack away; with |den| ≥ den_min the
+            # computed t is within 1e-9 (relative) of the true one, so a beam whose nearest hit
+            # so far is below h_safe cannot be hit here (segments are visited front to back).
+            ex, ey = bx - ax, by - ay
+            h_safe = (h - slack) * (1.0 - 1e-9)
+            den_min = 1e-5 * length * (1.0 + length / h)
             start = alpha if d >= 0.0 else beta
             width = abs(d)
             margin = _ANGLE_MARGIN + dev + 2.0 * slack / (h - slack)
@@ -165,6 +196,9 @@ def raycast_segments(poses: np.ndarray, rel_angles: np.ndarray, segs: np.ndarray
                     continue
                 lo, hi = int(max(lo_f, 0.0)), int(min(hi_f, B - 1.0))
                 for b in range(lo, hi + 1):
+                    if best[b] <= h_safe:      # occluded: t ≥ h > best, unless t is ill-conditioned
+                        if abs(dxs[b] * ey - dys[b] * ex) >= den_min:
+                            continue
                     best[b] = _hit(ox, oy, dxs[b], dys[b], seg, best[b])
         for b in range(B):
             if best[b] < max_range:
