@@ -3,7 +3,7 @@
 :func:`raycast_segments` rasterises each segment onto the beams it can hit: from the pose, a
 segment not passing through the sensor subtends an arc shorter than π, and only the beams whose
 angles fall in that arc (plus a small safety margin) are intersected with it. The cost is
-O(P·(M + B + hits)) instead of the brute force's O(P·B·M). The intersection arithmetic is the
+O(P·(M log M + B + hits)) instead of the brute force's O(P·B·M). The intersection arithmetic is the
 brute force's, term for term, so both give the same ranges; :func:`raycast_segments_bruteforce`
 is kept as the reference (tests compare them) and as the path for non-uniform beam angles.
 """
@@ -132,7 +132,9 @@ def raycast_segments(poses: np.ndarray, rel_angles: np.ndarray, segs: np.ndarray
     brute-force kernel is used. Segments farther than ``max_range`` are culled; each remaining
     segment is intersected only with the beams inside the arc it subtends (wrap-around of
     360° scanners included). A segment within rounding distance of the sensor is intersected
-    with every beam, so the answer never depends on the arc computation.
+    with every beam, so the answer never depends on the arc computation. Segments are visited
+    nearest first, and a beam whose hit so far is nearer than a segment's distance skips it
+    (only when the skip provably agrees with the brute force's test).
     """
     P = poses.shape[0]
     B = rel_angles.shape[0]
