@@ -71,7 +71,8 @@ def resample(points: np.ndarray, spacing: float) -> np.ndarray:
     apart (chord length from the last emitted point towards the next input point).
 
     Returns ``(M, 2)``; the first input point is always kept, and the last input point is
-    appended when it lies more than ``spacing/2`` beyond the last emitted point.
+    appended when it lies more than ``spacing/2`` beyond the last emitted point. As written,
+    the walk follows chords, not the input path, so it cuts corners by up to ``spacing``.
     """
     n = points.shape[0]
     if n == 0:

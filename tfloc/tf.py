@@ -205,8 +205,9 @@ class TurningFunctionMatcher:
         cost = _Cost(problem, cfg, real)
         rng = np.random.default_rng(cfg.seed)
         pose, size, iters, converged = problem.initial, cfg.simplex_size, 0, False
-        err = cost.function1(pose.xy, pose.theta)[0]
-        for outer in range(cfg.max_outer):
+        err, outer = cost.function1(pose.xy, pose.theta)[0], 0
+        while outer < cfg.max_outer:
+            outer += 1
             xy, n = simplex(cost, pose, size, rng)
             iters += n
             err, heading, rot = cost.function1(xy, pose.theta)
@@ -218,7 +219,7 @@ class TurningFunctionMatcher:
                 converged = True
                 break
         return Estimate(pose, converged, iters, cost.evaluations,
-                        {"err": float(err), "outer": outer + 1, "corners": int(real.n_edges)})
+                        {"err": float(err), "outer": outer, "corners": int(real.n_edges)})
 
     def score(self, problem: Problem, pose: Pose) -> float:
         """Eq. 13's Err at exactly ``pose`` (no orientation search); ``penalty`` if degenerate."""

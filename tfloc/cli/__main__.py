@@ -1,0 +1,7 @@
+"""``python -m tfloc.cli`` = ``tfloc``."""
+
+import sys
+
+from . import main
+
+sys.exit(main())
