@@ -18,6 +18,7 @@ def problem(office, lms200, office_pose):
 
 
 def test_scan_turning_function(benchmark, problem):
+    scan_turning_function(problem.ranges, problem.laser, TfConfig())  # warm-up (JIT)
     tf = benchmark(scan_turning_function, problem.ranges, problem.laser, TfConfig())
     assert tf is not None and tf.n_edges >= 3
 
@@ -27,6 +28,7 @@ def test_cost_one_pose(benchmark, problem):
     cfg = TfConfig()
     cost = _Cost(problem, cfg, scan_turning_function(problem.ranges, problem.laser, cfg))
     pose = problem.initial.as_array()[None, :]
+    cost.errors(pose)  # warm-up (JIT)
     errs, rots = benchmark(cost.errors, pose)
     assert errs.shape == (1,) and errs[0] < cfg.penalty
 
@@ -38,5 +40,6 @@ def test_cost_seven_orientations(benchmark, problem):
     p = problem.initial
     th = p.theta + np.radians(np.arange(-3, 4))
     poses = np.column_stack((np.full(7, p.x), np.full(7, p.y), th))
+    cost.errors(poses)  # warm-up (JIT)
     errs, _ = benchmark(cost.errors, poses)
     assert (errs < cfg.penalty).all()

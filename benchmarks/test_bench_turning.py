@@ -20,11 +20,13 @@ def polygons(office, lms200, office_pose):
 
 
 def test_turning_function(benchmark, polygons):
+    turning_function(polygons[0])  # warm-up (JIT)
     tf = benchmark(turning_function, polygons[0])
     assert tf.n_edges >= 3
 
 
 def test_match(benchmark, polygons):
     real, virtual = (turning_function(p) for p in polygons)
+    match(real, virtual)  # warm-up (JIT)
     m = benchmark(match, real, virtual)
     assert m.distance >= 0.0 and 0 <= m.shift < virtual.n_edges
