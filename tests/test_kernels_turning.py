@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -131,3 +133,14 @@ def test_match_of_scan_polygons_matches_oracle():
         got, (ref, _) = match(real, virtual), match_ref(real, virtual)
         assert (got.shift, got.distance, got.rotation) == pytest.approx(
             (ref.shift, ref.distance, ref.rotation), abs=1e-12, rel=0)
+
+
+def test_mod1_is_python_modulo():
+    from tfloc.turning import _mod1
+
+    xs = np.concatenate((np.random.default_rng(0).uniform(-3, 3, 20000),
+                         [0.0, -0.0, 1.0, -1.0, 1 - 1e-17, -1e-300, 5e-324, -5e-324,
+                          np.nextafter(-1, 0), np.nextafter(1, 0), 2.0, -2.5]))
+    for x in xs:
+        got, want = _mod1(float(x)), float(x) % 1.0
+        assert got == want and math.copysign(1, got) == math.copysign(1, want), x

@@ -20,6 +20,7 @@ the mean of ``Θ_R − Θ_V`` (Arkin et al. 1991), so the search over θ is exac
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -191,6 +192,18 @@ def _dot(a: np.ndarray, b: np.ndarray, n: int) -> float:
 
 
 @njit(cache=True, nogil=True)
+def _mod1(x: float) -> float:
+    """``x % 1.0`` (Python's float modulo), without the library call for ``-1 < x < 1``."""
+    if 0.0 < x < 1.0:
+        return x
+    if x == 0.0:
+        return 0.0
+    if -1.0 < x < 0.0:
+        return x + 1.0
+    return x % 1.0
+
+
+@njit(cache=True, nogil=True)
 def _match(rb: np.ndarray, ra: np.ndarray, vb: np.ndarray, va: np.ndarray) -> tuple[float, float, int]:
     """(err², rot, shift) of :func:`match`: one merge sweep per cyclic shift, O(n_v·(n_r + n_v))."""
     n_r, n_v = ra.shape[0], va.shape[0]
@@ -204,7 +217,7 @@ def _match(rb: np.ndarray, ra: np.ndarray, vb: np.ndarray, va: np.ndarray) -> tu
     for k in range(n_v):
         start = vb[k]
         for j in range(n_v):                   # virtual breaks re-started at vertex k, sorted
-            moved[j] = (vb[(k + j) % n_v] - start) % 1.0
+            moved[j] = _mod1(vb[k + j - n_v if k + j >= n_v else k + j] - start)
         for j in range(1, n_v):                # already sorted but for rounding ties
             x = moved[j]
             i = j - 1
@@ -253,4 +266,4 @@ def match(real: TurningFunction, virtual: TurningFunction) -> Match:
     """
     err2, rot, k = _match(real.breaks, real.angles, virtual.breaks, virtual.angles)
     rotation = (float(rot) + np.pi) % TWO_PI - np.pi
-    return Match(float(np.sqrt(max(err2, 0.0))), rotation, int(k))
+    return Match(math.sqrt(max(err2, 0.0)), rotation, int(k))
