@@ -8,7 +8,7 @@ import pytest
 
 from tfloc.pose import Pose
 from tfloc.problem import Problem
-from tfloc.tf import TfConfig, _Cost, scan_turning_function
+from tfloc.tf import TfConfig, TurningFunctionMatcher, _Cost, scan_turning_function
 
 
 @pytest.fixture(scope="module")
@@ -43,3 +43,12 @@ def test_cost_seven_orientations(benchmark, problem):
     cost.errors(poses)  # warm-up (JIT)
     errs, _ = benchmark(cost.errors, poses)
     assert (errs < cfg.penalty).all()
+
+
+def test_tf_localize_one_scan(benchmark, problem):
+    """A whole ``tf`` localization (Alg. 5 with outer iterations) of one office scan."""
+    matcher = TurningFunctionMatcher()
+    matcher.localize(problem)  # warm-up (JIT)
+    est = benchmark.pedantic(matcher.localize, args=(problem,), rounds=5, iterations=1)
+    assert est.evaluations > 0
+    benchmark.extra_info["evaluations"] = est.evaluations
