@@ -48,7 +48,6 @@ from .pose import Pose, wrap_angle
 from .problem import Estimate, Problem
 from .turning import TurningFunction, match, turning_function
 
-
 _ORIGIN = np.zeros((1, 2))
 
 
