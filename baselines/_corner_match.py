@@ -16,11 +16,30 @@ class Hypotheses:
     t: np.ndarray
 
 
+def _length_matches(la: np.ndarray, lb: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """All index pairs (i, j) with ``|la[i] − lb[j]| ≤ tol``, found by a sorted window: memory
+    grows with the number of matches, not with ``len(la) · len(lb)``."""
+    order = np.argsort(lb, kind="stable")
+    sb = lb[order]
+    lo = np.searchsorted(sb, la - tol, side="left")
+    hi = np.searchsorted(sb, la + tol, side="right")
+    counts = hi - lo
+    pa = np.repeat(np.arange(len(la)), counts)
+    starts = np.repeat(np.cumsum(counts) - counts, counts)
+    pb = order[np.repeat(lo, counts) + (np.arange(pa.size) - starts)]
+    keep = np.abs(la[pa] - lb[pb]) <= tol  # exact test (searchsorted works on the same floats)
+    return pa[keep], pb[keep]
+
+
 def pair_hypotheses(a: np.ndarray, b: np.ndarray, length_tol: float, min_length: float,
-                    max_angle: float, max_shift: float) -> Hypotheses:
+                    max_angle: float, max_shift: float, max_hypotheses: int = 20000) -> Hypotheses:
     """Every rigid transform mapping an ordered corner pair of ``a`` onto one of ``b`` whose
     lengths agree within ``length_tol`` metres (pairs shorter than ``min_length`` are skipped), with
-    rotation within ``±max_angle`` radians and translation within ``max_shift`` metres."""
+    rotation within ``±max_angle`` radians and translation within ``max_shift`` metres.
+
+    Real scans can have 100+ corners (10⁴ ordered pairs each side); when more than
+    ``max_hypotheses`` survive, an evenly strided, deterministic subset of them is kept, so the
+    cost and memory stay bounded."""
     ia, ja = np.nonzero(~np.eye(len(a), dtype=bool))
     ib, jb = np.nonzero(~np.eye(len(b), dtype=bool))
     va, vb = a[ja] - a[ia], b[jb] - b[ib]
@@ -28,7 +47,9 @@ def pair_hypotheses(a: np.ndarray, b: np.ndarray, length_tol: float, min_length:
     keep_a, keep_b = la >= min_length, lb >= min_length
     ia, va, la = ia[keep_a], va[keep_a], la[keep_a]
     ib, vb, lb = ib[keep_b], vb[keep_b], lb[keep_b]
-    pa, pb = np.nonzero(np.abs(la[:, None] - lb[None, :]) <= length_tol)
+    pa, pb = _length_matches(la, lb, length_tol)
+    order = np.lexsort((pb, pa))  # the (a-pair, b-pair) order of the former all-pairs search
+    pa, pb = pa[order], pb[order]
     theta = np.arctan2(vb[pb, 1], vb[pb, 0]) - np.arctan2(va[pa, 1], va[pa, 0])
     theta = (theta + np.pi) % (2 * np.pi) - np.pi
     c, s = np.cos(theta), np.sin(theta)
@@ -36,7 +57,9 @@ def pair_hypotheses(a: np.ndarray, b: np.ndarray, length_tol: float, min_length:
     ma = a[ia[pa]] + 0.5 * va[pa]
     mb = b[ib[pb]] + 0.5 * vb[pb]
     t = mb - np.column_stack((c * ma[:, 0] - s * ma[:, 1], s * ma[:, 0] + c * ma[:, 1]))
-    ok = (np.abs(theta) <= max_angle) & (np.hypot(t[:, 0], t[:, 1]) <= max_shift)
+    ok = np.flatnonzero((np.abs(theta) <= max_angle) & (np.hypot(t[:, 0], t[:, 1]) <= max_shift))
+    if ok.size > max_hypotheses:
+        ok = ok[np.linspace(0, ok.size - 1, max_hypotheses).astype(int)]
     return Hypotheses(theta[ok], t[ok])
 
 
@@ -68,7 +91,11 @@ def best_hypothesis(a: np.ndarray, b: np.ndarray, hyp: Hypotheses, tol: float) -
 
     Returns its index, the ``(N,)`` partner indices (−1 = none) and the ``(N,)`` distances.
     """
-    partner, dist = mutual_inliers(transform(hyp.theta, hyp.t, a), b, tol)
+    chunk = max(1, int(2e7 // max(1, len(a) * len(b))))  # ≤ 2·10⁷ distances (160 MB) at a time
+    parts = [mutual_inliers(transform(hyp.theta[k:k + chunk], hyp.t[k:k + chunk], a), b, tol)
+             for k in range(0, len(hyp.theta), chunk)]
+    partner = np.concatenate([p for p, _ in parts])
+    dist = np.concatenate([d for _, d in parts])
     inl = partner >= 0
     count = inl.sum(axis=1)
     resid = np.where(inl, dist, 0.0).sum(axis=1)
