@@ -20,7 +20,7 @@ from . import sections as S
 from .metrics import Thresholds, prepare, summarize
 from .paper import CITATION
 from .results import COLUMNS, read_estimates
-from .summary import SCENARIO_I, POOL, scenario_summary, summary_table, write_summary
+from .summary import POOL, SCENARIO_I, scenario_summary, summary_table, write_summary
 
 
 @dataclass(frozen=True)
