@@ -62,6 +62,7 @@ def test_improvement_is_the_mean_of_per_scan_values_including_a_negative_one():
     # per scan 90, 90, 90, 90 and 100·(1 − 50/25) = −100  →  mean 52
     assert m["dist_impr_mean_pct"] == pytest.approx(52.0)
     assert m["dist_impr_min_pct"] == pytest.approx(-100.0)
+    assert m["dist_impr_median_pct"] == pytest.approx(90.0)
     # per scan 90, 80, 70, 62, 50  →  mean 70.4
     assert m["orient_impr_mean_pct"] == pytest.approx((90 + 80 + 70 + 62 + 50) / 5)
 

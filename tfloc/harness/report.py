@@ -186,6 +186,13 @@ def render(run_dir: Path, run: dict, p: pd.DataFrame, thr: Thresholds, s2s: set[
         parts.append("## All datasets pooled\n")
         parts.append(S.accuracy(summarize(truth, ["matcher"])))
         parts.append(S.outcomes(summarize(truth, ["matcher"])))
+        s2m = truth[~truth["dataset"].isin(s2s)]
+        if s2m["dataset"].nunique() > 1:
+            names = ", ".join(s2m["dataset"].unique())
+            parts.append(f"Success rate (%) by initial distance offset, scan-to-map datasets pooled ({names}):\n")
+            parts.append(S.success_by(s2m, "dist_bin", " cm"))
+            parts.append(f"Success rate (%) by initial angle offset, scan-to-map datasets pooled ({names}):\n")
+            parts.append(S.success_by(s2m, "angle_bin", "°"))
     parts.append("## Tasks without an answer (timeouts, errors)\n")
     parts.append(S.failures(p))
     if figs:
