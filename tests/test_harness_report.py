@@ -109,3 +109,9 @@ def test_missing_column_is_named(tmp_path):
     (tmp_path / "run.json").write_text(json.dumps({}))
     with pytest.raises(ConfigError, match="dist_err_m"):
         write_report(tmp_path)
+
+
+def test_empty_run_is_a_one_line_error(tmp_path):
+    frame([]).to_csv(tmp_path / "estimates.csv", index=False)
+    with pytest.raises(ConfigError, match="no results yet"):
+        write_report(tmp_path)

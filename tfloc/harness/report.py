@@ -43,6 +43,8 @@ def load_run(run_dir: Path) -> tuple[pd.DataFrame, dict]:
     missing = [c for c in COLUMNS if c not in df.columns and c not in ("score_est", "score_true", "info")]
     if missing:
         raise ConfigError(f"{run_dir / 'estimates.csv'}: missing column(s) {', '.join(missing)}")
+    if df.empty:
+        raise ConfigError(f"{run_dir / 'estimates.csv'}: no results yet (no task of the run has finished)")
     run_json = run_dir / "run.json"
     try:
         run = json.loads(run_json.read_text()) if run_json.is_file() else {}
