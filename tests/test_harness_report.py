@@ -52,6 +52,8 @@ def test_report_has_per_dataset_and_scan_to_scan_tables(report):
     assert "### real-x-relations" in md and "Trans. error (m) mean ± std" in md
     section = md.split("### real-x-relations")[1]
     assert "| `tf` | loop |" in section and "| `tf` | all |" in section
+    pooled = md.split("## Scan-to-map datasets pooled (detail-1, detail-2, detail-3, office-pool)")[1]
+    assert "Scan-to-scan datasets are left out" in pooled
 
 
 def test_summary_csv_has_every_grouping(report):
@@ -59,7 +61,7 @@ def test_summary_csv_has_every_grouping(report):
     t = pd.read_csv(files.summary)
     assert list(t.columns) == SUMMARY_KEYS + list(METRIC_COLUMNS)
     assert {"scenario-I", "scenario-II", "scenario-III", "dataset", "dataset-dist_bin",
-            "dataset-angle_bin", "dataset-group", "overall"} <= set(t["grouping"])
+            "dataset-angle_bin", "dataset-group", "overall", "overall-scan-to-map"} <= set(t["grouping"])
     # the relations dataset is scan-to-scan (by its name here): grouped by its groups, not binned
     assert not ((t["grouping"] == "dataset-dist_bin") & (t["dataset"] == "real-x-relations")).any()
     assert set(t.loc[t["grouping"] == "overall", "matcher"]) == {"tf", "csm-corr"}
