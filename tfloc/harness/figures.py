@@ -180,8 +180,9 @@ def fig_runtime(p: pd.DataFrame, path: Path) -> Path | None:
     fig = Figure(figsize=(max(5.0, 1.3 * len(matchers) + 2), 4.4), layout="constrained")
     ax = fig.subplots()
     data = [np.maximum(t.loc[t["matcher"] == m, "runtime_ms"].to_numpy(), 1e-3) for m in matchers]
-    bp = ax.boxplot(data, tick_labels=matchers, whis=(5, 95), showfliers=True, patch_artist=True,
+    bp = ax.boxplot(data, positions=range(len(matchers)), whis=(5, 95), showfliers=True, patch_artist=True,
                     medianprops={"color": "black"}, flierprops={"markersize": 2.5, "alpha": 0.5})
+    ax.set_xticks(range(len(matchers)), matchers)
     for patch, m in zip(bp["boxes"], matchers, strict=True):
         patch.set_facecolor(col[m])
         patch.set_alpha(0.6)

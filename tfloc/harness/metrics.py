@@ -36,7 +36,8 @@ METRIC_COLUMNS = (
     "n", "n_truth", "n_est", "n_excluded", "n_timeout", "n_error",
     "dist_mean_cm", "dist_std_cm", "dist_median_cm", "dist_p90_cm", "dist_max_cm",
     "orient_mean_deg", "orient_std_deg", "orient_median_deg", "orient_p90_deg", "orient_max_deg",
-    "dist_impr_mean_pct", "dist_impr_min_pct", "orient_impr_mean_pct", "orient_impr_min_pct",
+    "dist_impr_mean_pct", "dist_impr_median_pct", "dist_impr_min_pct",
+    "orient_impr_mean_pct", "orient_impr_median_pct", "orient_impr_min_pct",
     "success_rate_pct",
     *(f"n_{o.replace('-', '_')}" for o in (*OUTCOMES, UNSCORED)),
     *(f"share_{o.replace('-', '_')}_pct" for o in OUTCOMES),
@@ -159,6 +160,7 @@ def group_metrics(g: pd.DataFrame) -> dict[str, float]:
     for k in ("dist", "orient"):
         s = g[f"{k}_impr_pct"].dropna()
         m[f"{k}_impr_mean_pct"] = s.mean() if len(s) else np.nan
+        m[f"{k}_impr_median_pct"] = _q(s, 50)
         m[f"{k}_impr_min_pct"] = s.min() if len(s) else np.nan
     counts = g["outcome_eval"].value_counts()
     for o in (*OUTCOMES, UNSCORED):

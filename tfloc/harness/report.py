@@ -43,6 +43,8 @@ def load_run(run_dir: Path) -> tuple[pd.DataFrame, dict]:
     missing = [c for c in COLUMNS if c not in df.columns and c not in ("score_est", "score_true", "info")]
     if missing:
         raise ConfigError(f"{run_dir / 'estimates.csv'}: missing column(s) {', '.join(missing)}")
+    if df.empty:
+        raise ConfigError(f"{run_dir / 'estimates.csv'}: no results yet (no task of the run has finished)")
     run_json = run_dir / "run.json"
     try:
         run = json.loads(run_json.read_text()) if run_json.is_file() else {}
@@ -182,10 +184,20 @@ def render(run_dir: Path, run: dict, p: pd.DataFrame, thr: Thresholds, s2s: set[
                      "the paper's tables are not shown._\n")
     parts.append("## Results per dataset\n")
     parts += [_dataset_section(p, d, s2s) for d in p["dataset"].unique()]
-    if p["dataset"].nunique() > 1 and not truth.empty:
-        parts.append("## All datasets pooled\n")
-        parts.append(S.accuracy(summarize(truth, ["matcher"])))
-        parts.append(S.outcomes(summarize(truth, ["matcher"])))
+    s2m = truth[~truth["dataset"].isin(s2s)]
+    if s2m["dataset"].nunique() > 1:
+        names = ", ".join(s2m["dataset"].unique())
+        parts.append(f"## Scan-to-map datasets pooled ({names})\n")
+        if s2s:
+            parts.append("Scan-to-scan datasets are left out: their initial offsets are odometry, often "
+                         "under a millimetre, which makes the improvement meaningless.\n")
+        parts.append(S.accuracy(summarize(s2m, ["matcher"])))
+        parts.append("Outcomes:\n")
+        parts.append(S.outcomes(summarize(s2m, ["matcher"])))
+        parts.append("Success rate (%) by initial distance offset:\n")
+        parts.append(S.success_by(s2m, "dist_bin", " cm"))
+        parts.append("Success rate (%) by initial angle offset:\n")
+        parts.append(S.success_by(s2m, "angle_bin", "°"))
     parts.append("## Tasks without an answer (timeouts, errors)\n")
     parts.append(S.failures(p))
     if figs:

@@ -20,6 +20,13 @@ PAPER_COLS = ["Mean Distance Error (cm)", "Mean Orientation Error (°)",
               "Distance Improvement (%)", "Orientation Improvement (%)"]
 
 
+READING = """Reading these tables: a mean error is pulled up by a few diverged scans and a mean
+improvement down (one scan can contribute −1000 % or less); the success rate, the medians
+(next section, summary.csv: `dist_median_cm`, `dist_impr_median_pct`) and the outcome tables
+show how typical scans fare. The paper reports means only.
+"""
+
+
 def _samples(sc: pd.DataFrame, scenario: str) -> list[str]:
     measured = list(dict.fromkeys(sc.loc[sc["scenario"] == scenario, "sample"]))
     paper = [r.key for r in PAPER_TF if r.scenario == scenario]
@@ -70,6 +77,8 @@ def paper_vs_tf(sc: pd.DataFrame, matcher: str = "tf") -> str:
                 rows.append([_label(scenario, key), _n(m), f"tfloc `{matcher}` (measured)", *_measured(m),
                              num(m["success_rate_pct"], 1)])
         out.append(table(["Scenario", "Sample", "Source", *PAPER_COLS, "Success (%)"], rows, "lrl" + "r" * 5))
+    if out:
+        out.append(READING)
     return "\n".join(out)
 
 

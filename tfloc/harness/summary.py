@@ -57,7 +57,8 @@ def summary_table(p: pd.DataFrame, scan_to_scan: Iterable[str] = ()) -> pd.DataF
     groupings: ``scenario-I`` (bin = all), ``scenario-II`` (bin = angle bin), ``scenario-III``
     (bin = distance bin), ``dataset`` (bin = all), ``dataset-dist_bin``, ``dataset-angle_bin``
     (scan-to-map datasets with truth), ``dataset-group`` (scan-to-scan datasets: their groups),
-    ``overall`` (dataset = bin = all).
+    ``overall`` (dataset = bin = all), and ``overall-scan-to-map`` (only when the run mixes
+    scan-to-scan and scan-to-map datasets).
     """
     s2s = set(scan_to_scan)
     parts = []
@@ -78,6 +79,8 @@ def summary_table(p: pd.DataFrame, scan_to_scan: Iterable[str] = ()) -> pd.DataF
         t = summarize(s2s_rows, ["dataset", "group", "matcher"])
         parts.append(t.rename(columns={"group": "bin"}).assign(grouping="dataset-group"))
     parts.append(summarize(p, ["matcher"]).assign(grouping="overall", dataset="all", bin="all"))
+    if len(s2s_rows) and len(s2m):
+        parts.append(summarize(s2m, ["matcher"]).assign(grouping="overall-scan-to-map", dataset="all", bin="all"))
     out = pd.concat([x.astype({"bin": object}) for x in parts if len(x)], ignore_index=True)
     return out[SUMMARY_KEYS + list(METRIC_COLUMNS)]
 
