@@ -10,6 +10,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+import os
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -186,7 +187,7 @@ def write_scenario(root: str | Path, name: str, map_path: str | Path, laser: Las
     relative to ``root``. Ranges are written with 0.1 mm precision."""
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
-    rel = Path(map_path).resolve().relative_to(root.resolve(), walk_up=True)
+    rel = Path(os.path.relpath(Path(map_path).resolve(), root.resolve()))  # walk_up needs 3.12
     doc = {"name": name, "map": rel.as_posix(), "description": description, "units": "metres, radians",
            "laser": {"max_range": laser.max_range, "fov_deg": round(math.degrees(laser.fov), 9),
                      "resolution_deg": round(math.degrees(laser.resolution), 9),

@@ -1,0 +1,7 @@
+"""``python -m tfloc.cli``."""
+
+import sys
+
+from . import main
+
+sys.exit(main())
