@@ -50,30 +50,23 @@ class IdentityMatcher:
 
 
 class FalseOptimumMatcher:
-    """Objective with a known false optimum: f(p) = min(|p − true|², |p − false| ² − 1) where the
-    false optimum (true shifted by +2 m in x) is *deeper*. The matcher answers the false optimum,
-    so its failures are ``ambiguous``; with ``deep=False`` the false optimum is shallower and the
-    failures are ``local-optimum``. It reads the true pose from ``problem.where`` only to build
-    its synthetic objective (a test device, not a localization method)."""
+    """Objective with a known false optimum, for a dataset whose true position ``(tx, ty)`` is
+    given as a parameter: f(p) = min(|p − t|², |p − t − (2, 0)|² + c) with c = −1 (``deep``: the
+    false optimum is the global one, so answering it is ``ambiguous``) or c = +1 (a shallower
+    false optimum: answering it is a ``local-optimum`` failure). It always answers the false one."""
 
     name = "false-optimum"
-    TRUTH: dict = {}
 
-    def __init__(self, deep: bool = True):
-        self.deep = deep
-
-    def _true(self, problem: Problem) -> Pose:
-        return Pose(*self.TRUTH[problem.where]) if problem.where in self.TRUTH else problem.initial
+    def __init__(self, tx: float = 0.0, ty: float = 0.0, deep: bool = True):
+        self.tx, self.ty, self.c = tx, ty, (-1.0 if deep else 1.0)
 
     def localize(self, problem: Problem) -> Estimate:
-        t = self._true(problem)
-        return Estimate(Pose(t.x + 2.0, t.y, t.theta), True)
+        return Estimate(Pose(self.tx + 2.0, self.ty, problem.initial.theta), True)
 
     def score(self, problem: Problem, pose: Pose) -> float:
-        t = self._true(problem)
-        d_true = (pose.x - t.x) ** 2 + (pose.y - t.y) ** 2
-        d_false = (pose.x - t.x - 2.0) ** 2 + (pose.y - t.y) ** 2
-        return min(d_true, d_false + (-1.0 if self.deep else 1.0))
+        d_true = (pose.x - self.tx) ** 2 + (pose.y - self.ty) ** 2
+        d_false = (pose.x - self.tx - 2.0) ** 2 + (pose.y - self.ty) ** 2
+        return min(d_true, d_false + self.c)
 
 
 class RaisingMatcher:
