@@ -1,4 +1,4 @@
-"""Toy matchers for harness tests (loaded as ``tests.toy_matchers:Class`` by worker processes)."""
+"""Toy matchers for harness tests (imported by spawned workers as ``toy_matchers:Class``)."""
 
 from __future__ import annotations
 
@@ -6,101 +6,82 @@ import math
 import time
 
 import numpy as np
-from scipy.optimize import minimize
 
 from tfloc.pose import Pose
 from tfloc.problem import Estimate, Problem
 
 
-def _mismatch(problem: Problem, pose: Pose) -> float:
-    """Mean absolute range difference (m) between the real scan and the map raycast at ``pose``."""
-    sim = problem.map.raycast(pose, problem.laser)
-    ok = problem.laser.valid(problem.ranges) & problem.laser.valid(sim)
-    return float(np.mean(np.abs(sim[ok] - problem.ranges[ok]))) if ok.any() else 1e9
+class Stay:
+    """Returns the initial pose; objective = distance to the initial pose."""
 
+    name = "stay"
 
-class GridSearchMatcher:
-    """Honest matcher: exhaustive search on a fine grid around the initial guess, then Nelder-Mead."""
-
-    name = "grid"
-
-    def __init__(self, radius: float = 0.3, step: float = 0.05):
-        self.radius, self.step = radius, step
+    def __init__(self, sleep_s: float = 0.0) -> None:
+        self.sleep_s = sleep_s
 
     def localize(self, problem: Problem) -> Estimate:
-        f = lambda v: _mismatch(problem, Pose(*v))  # noqa: E731
-        res = minimize(f, problem.initial.as_array(), method="Nelder-Mead",
-                       options={"xatol": 1e-4, "fatol": 1e-6, "initial_simplex": None})
-        return Estimate(Pose(*res.x), bool(res.success), int(res.nit), int(res.nfev))
+        time.sleep(self.sleep_s)
+        return Estimate(problem.initial, True, 1, 1)
 
     def score(self, problem: Problem, pose: Pose) -> float:
-        return _mismatch(problem, pose)
+        return pose.distance_to(problem.initial)
 
 
-class IdentityMatcher:
-    """Returns the initial guess; its score is the scan mismatch (so it stops at a false optimum)."""
+class SlowStay(Stay):
+    """:class:`Stay` taking 0.25 s per scan, so that a run can be killed mid-way (resume test)."""
 
-    name = "identity"
+    name = "slow-stay"
+
+    def __init__(self, sleep_s: float = 0.25) -> None:
+        super().__init__(sleep_s)
+
+
+class Raises(Stay):
+    """Raises on every ``fail_every``-th call in a worker (a data-dependent crash)."""
+
+    def __init__(self, fail_every: int = 2) -> None:
+        super().__init__()
+        self.fail_every, self.calls = fail_every, 0
 
     def localize(self, problem: Problem) -> Estimate:
-        return Estimate(problem.initial, True)
+        self.calls += 1
+        if self.calls % self.fail_every == 0:
+            raise ValueError("toy failure\nwith a second line")
+        return super().localize(problem)
 
-    def score(self, problem: Problem, pose: Pose) -> float:
-        return _mismatch(problem, pose)
 
+class Hangs(Stay):
+    """Hangs (sleeps far past any time limit) on every ``hang_every``-th call in a worker."""
 
-class FalseOptimumMatcher:
-    """Objective with a known false optimum, for a dataset whose true position ``(tx, ty)`` is
-    given as a parameter: f(p) = min(|p − t|², |p − t − (2, 0)|² + c) with c = −1 (``deep``: the
-    false optimum is the global one, so answering it is ``ambiguous``) or c = +1 (a shallower
-    false optimum: answering it is a ``local-optimum`` failure). It always answers the false one."""
-
-    name = "false-optimum"
-
-    def __init__(self, tx: float = 0.0, ty: float = 0.0, deep: bool = True):
-        self.tx, self.ty, self.c = tx, ty, (-1.0 if deep else 1.0)
+    def __init__(self, hang_every: int = 2) -> None:
+        super().__init__()
+        self.hang_every, self.calls = hang_every, 0
 
     def localize(self, problem: Problem) -> Estimate:
-        return Estimate(Pose(self.tx + 2.0, self.ty, problem.initial.theta), True)
-
-    def score(self, problem: Problem, pose: Pose) -> float:
-        d_true = (pose.x - self.tx) ** 2 + (pose.y - self.ty) ** 2
-        d_false = (pose.x - self.tx - 2.0) ** 2 + (pose.y - self.ty) ** 2
-        return min(d_true, d_false + self.c)
+        self.calls += 1
+        if self.calls % self.hang_every == 0:
+            time.sleep(3600)
+        return super().localize(problem)
 
 
-class RaisingMatcher:
-    name = "raising"
+class TwoMinima:
+    """An objective with a global minimum 0 at ``init + to_true`` (the truth, by construction of
+    the test dataset) and a second minimum of value ``false_value`` at ``init + to_false``.
+    ``localize`` returns the second one, so the outcome is known: a ``local-optimum`` when
+    ``false_value`` > 0, ``ambiguous`` when it is ≤ 0."""
 
-    def localize(self, problem: Problem) -> Estimate:
-        raise RuntimeError("boom\nsecond line")
+    name = "two-minima"
 
-    def score(self, problem: Problem, pose: Pose) -> float:
-        return 0.0
+    def __init__(self, to_true=(0.0, 0.0), to_false=(1.0, 0.0), false_value: float = 0.5) -> None:
+        self.to_true, self.to_false, self.false_value = np.array(to_true), np.array(to_false), false_value
 
-
-class HangingMatcher:
-    name = "hanging"
-
-    def localize(self, problem: Problem) -> Estimate:
-        time.sleep(3600)
-        return Estimate(problem.initial, False)
-
-    def score(self, problem: Problem, pose: Pose) -> float:
-        return 0.0
-
-
-class SlowMatcher:
-    """Returns the initial guess after ``delay`` seconds (for the resume test)."""
-
-    name = "slow"
-
-    def __init__(self, delay: float = 0.2):
-        self.delay = delay
+    def _at(self, problem: Problem, d) -> Pose:
+        return Pose(problem.initial.x + d[0], problem.initial.y + d[1], problem.initial.theta)
 
     def localize(self, problem: Problem) -> Estimate:
-        time.sleep(self.delay)
-        return Estimate(problem.initial, True)
+        return Estimate(self._at(problem, self.to_false), True, 3, 10)
 
     def score(self, problem: Problem, pose: Pose) -> float:
-        return math.hypot(pose.x, pose.y)
+        t, f = self._at(problem, self.to_true), self._at(problem, self.to_false)
+        return min(pose.distance_to(t) + abs(math.remainder(pose.theta - t.theta, math.tau)),
+                   pose.distance_to(f) + self.false_value)

@@ -1,4 +1,4 @@
-"""``python -m tfloc.cli``."""
+"""``python -m tfloc.cli`` = ``tfloc``."""
 
 import sys
 

@@ -1,121 +1,189 @@
-"""Metrics of DESIGN.md as pure functions over an ``estimates.csv`` DataFrame.
+"""Accuracy, success, failure-outcome and runtime metrics over a run's estimates (pure functions).
 
-Errors: distance ‖(x̂, ŷ) − (x, y)‖ (metres inside, cm in summaries) and orientation
-|angdiff(θ̂, θ)| (radians inside, degrees in summaries). The paper's *improvement* is
-100·(1 − err/initial_err) per scan; summaries give its mean over scans with an answer and a
-non-zero initial error. Success: dist ≤ ``dist_m`` and orient ≤ ``orient_rad``. Outcome of a
-scan: ``success``; else ``no-answer`` (error, timeout or no finite estimate); else
-``local-optimum`` if the matcher's own score is lower at the true pose than at its answer;
-else ``ambiguous`` (or ``unscored`` if a score could not be computed).
+Input is the ``estimates.csv`` DataFrame (:func:`tfloc.harness.results.read_estimates`); errors
+there are in metres and radians, the metrics here are reported in cm, degrees, ms and percent.
+
+Which rows count where (stated in every report):
+
+* **rows with truth**: the true pose is known. They all count in the success rate and in the
+  outcome shares; a scan without an answer (``failed``, ``timeout``, ``error:*``) counts as a
+  failure with outcome ``no-answer``.
+* **rows with an estimate**: status ``ok`` or ``failed`` with a finite pose, hence finite
+  errors. Error and improvement statistics use only these; the others are *excluded* and
+  counted in ``n_excluded``.
+* **timed rows**: status ``ok`` or ``failed`` with a runtime (timeouts and errors have none).
+
+Bins are left-closed, right-open: ``[0, 100)``, ``[100, 200)``, ``[200, 300)`` cm and
+``[300, ∞)``; an initial offset of exactly 100 cm falls in ``100–200``. Angle bins likewise
+``[0, 5)``, ``[5, 10)``, ``[10, 15)``, ``[15, ∞)`` degrees. Offsets are rounded to 1e-6 cm /
+1e-6 ° before binning, so unit conversions cannot move a value across an edge.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import pandas as pd
 
-OUTCOMES = ("success", "local-optimum", "ambiguous", "no-answer", "unscored")
-ANGLE_BINS_DEG = (0.0, 5.0, 10.0, 15.0)
-DIST_BINS_CM = (0.0, 100.0, 200.0, 300.0)
+DIST_EDGES_CM = (0.0, 100.0, 200.0, 300.0)
+ANGLE_EDGES_DEG = (0.0, 5.0, 10.0, 15.0)
+DIST_BINS = ("0–100", "100–200", "200–300", "≥300")
+ANGLE_BINS = ("0–5", "5–10", "10–15", "≥15")
+OUTCOMES = ("success", "local-optimum", "ambiguous", "no-answer")
+UNSCORED = "unscored"  # failed under overridden thresholds but the run recorded no scores
+METRIC_COLUMNS = (
+    "n", "n_truth", "n_est", "n_excluded", "n_timeout", "n_error",
+    "dist_mean_cm", "dist_std_cm", "dist_median_cm", "dist_p90_cm", "dist_max_cm",
+    "orient_mean_deg", "orient_std_deg", "orient_median_deg", "orient_p90_deg", "orient_max_deg",
+    "dist_impr_mean_pct", "dist_impr_min_pct", "orient_impr_mean_pct", "orient_impr_min_pct",
+    "success_rate_pct",
+    *(f"n_{o.replace('-', '_')}" for o in (*OUTCOMES, UNSCORED)),
+    *(f"share_{o.replace('-', '_')}_pct" for o in OUTCOMES),
+    "runtime_median_ms", "runtime_p95_ms", "n_timed")
 
 
-def pose_errors(true: np.ndarray, est: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Distance (m) and absolute orientation (rad, Eq. 6) errors of ``(N, 3)`` poses."""
-    t, e = np.asarray(true, float).reshape(-1, 3), np.asarray(est, float).reshape(-1, 3)
-    d = np.hypot(e[:, 0] - t[:, 0], e[:, 1] - t[:, 1])
-    a = np.abs(np.arctan2(np.sin(e[:, 2] - t[:, 2]), np.cos(e[:, 2] - t[:, 2])))
-    return d, a
+@dataclass(frozen=True)
+class Thresholds:
+    """Success: distance error ≤ ``dist_m`` (metres) and orientation error ≤ ``orient_deg``."""
+
+    dist_m: float = 0.10
+    orient_deg: float = 2.0
+
+    @classmethod
+    def from_run(cls, run: dict) -> Thresholds:
+        """The thresholds recorded in a ``run.json`` document (defaults if absent)."""
+        s = run.get("config", {}).get("success", {})
+        return cls(float(s.get("dist_m", 0.10)), float(s.get("orient_deg", 2.0)))
 
 
-def with_errors(df: pd.DataFrame) -> pd.DataFrame:
-    """Copy of ``df`` with dist/orient errors of the estimate and of the initial pose (re)computed."""
+def _bin(values: pd.Series, edges: tuple[float, ...], labels: tuple[str, ...]) -> pd.Series:
+    v = np.round(values.to_numpy(dtype=float), 6)
+    idx = np.searchsorted(np.asarray(edges), v, side="right") - 1  # [lo, hi)
+    ok = np.isfinite(v) & (v >= 0)
+    out = np.where(ok, np.asarray(labels, dtype=object)[np.clip(idx, 0, len(labels) - 1)], None)
+    return pd.Series(pd.Categorical(out, categories=list(labels), ordered=True), index=values.index)
+
+
+def dist_bin(init_dist_err_m: pd.Series) -> pd.Series:
+    """Initial distance offset bins (labels :data:`DIST_BINS`, cm) of metres; NaN → missing."""
+    return _bin(pd.to_numeric(init_dist_err_m, errors="coerce") * 100.0, DIST_EDGES_CM, DIST_BINS)
+
+
+def angle_bin(init_orient_err_rad: pd.Series) -> pd.Series:
+    """Initial angle offset bins (labels :data:`ANGLE_BINS`, degrees) of radians; NaN → missing."""
+    deg = np.degrees(pd.to_numeric(init_orient_err_rad, errors="coerce").abs())
+    return _bin(deg, ANGLE_EDGES_DEG, ANGLE_BINS)
+
+
+def has_truth(df: pd.DataFrame) -> pd.Series:
+    """Rows whose true pose is known."""
+    return pd.to_numeric(df["true_x"], errors="coerce").notna()
+
+
+def has_estimate(df: pd.DataFrame) -> pd.Series:
+    """Rows with status ok/failed and finite errors (the rows of the error statistics)."""
+    d = pd.to_numeric(df["dist_err_m"], errors="coerce")
+    o = pd.to_numeric(df["orient_err_rad"], errors="coerce")
+    return df["status"].isin(["ok", "failed"]) & np.isfinite(d) & np.isfinite(o)
+
+
+def classify(df: pd.DataFrame, thr: Thresholds) -> pd.Series:
+    """The outcome of each row under thresholds ``thr`` (the runner's rule, recomputed).
+
+    No truth → missing; status not ``ok`` → ``no-answer``; within both thresholds →
+    ``success``; otherwise ``local-optimum`` if the matcher scored the truth lower than its
+    answer, ``ambiguous`` if not. A row that failed only under stricter thresholds than the
+    run's has no recorded scores: it keeps a recorded failure outcome, else ``unscored``.
+    """
+    d = pd.to_numeric(df["dist_err_m"], errors="coerce")
+    o = np.degrees(pd.to_numeric(df["orient_err_rad"], errors="coerce"))
+    nan = pd.Series(np.nan, index=df.index)
+    s_est = pd.to_numeric(df.get("score_est", nan), errors="coerce")
+    s_true = pd.to_numeric(df.get("score_true", nan), errors="coerce")
+    recorded = df.get("outcome", pd.Series("", index=df.index)).fillna("").astype(str)
+    scored = s_est.notna() & s_true.notna()
+    fail = np.where(scored, np.where(s_true < s_est, "local-optimum", "ambiguous"),
+                    np.where(recorded.isin(["local-optimum", "ambiguous"]), recorded, UNSCORED))
+    within = (d <= thr.dist_m) & (o <= thr.orient_deg)
+    out = np.where(df["status"] != "ok", "no-answer", np.where(within, "success", fail))
+    return pd.Series(np.where(has_truth(df), out, None), index=df.index, dtype=object)
+
+
+def prepare(df: pd.DataFrame, thr: Thresholds) -> pd.DataFrame:
+    """``df`` plus derived columns: bins, errors in cm/deg, improvements (%), outcome, runtime (ms)."""
     out = df.copy()
-    true = out[["true_x", "true_y", "true_theta"]].to_numpy(float)
-    out["dist_err_m"], out["orient_err_rad"] = pose_errors(true, out[["est_x", "est_y", "est_theta"]].to_numpy(float))
-    out["init_dist_err_m"], out["init_orient_err_rad"] = pose_errors(
-        true, out[["init_x", "init_y", "init_theta"]].to_numpy(float))
+    num = {c: pd.to_numeric(out[c], errors="coerce") for c in
+           ("dist_err_m", "orient_err_rad", "init_dist_err_m", "init_orient_err_rad", "runtime_s")}
+    est = has_estimate(out)
+    out["dist_bin"] = dist_bin(num["init_dist_err_m"])
+    out["angle_bin"] = angle_bin(num["init_orient_err_rad"])
+    out["truth"] = has_truth(out)
+    out["estimate"] = est & out["truth"]
+    out["dist_err_cm"] = (num["dist_err_m"] * 100.0).where(out["estimate"])
+    out["orient_err_deg"] = np.degrees(num["orient_err_rad"]).where(out["estimate"])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        di = 100.0 * (1.0 - num["dist_err_m"] / num["init_dist_err_m"])
+        oi = 100.0 * (1.0 - num["orient_err_rad"] / num["init_orient_err_rad"])
+    out["dist_impr_pct"] = di.where(out["estimate"] & (num["init_dist_err_m"] > 0))
+    out["orient_impr_pct"] = oi.where(out["estimate"] & (num["init_orient_err_rad"] > 0))
+    out["outcome_eval"] = classify(out, thr)
+    timed = out["status"].isin(["ok", "failed"]) & num["runtime_s"].notna()
+    out["runtime_ms"] = (num["runtime_s"] * 1000.0).where(timed)
     return out
 
 
-def answered(df: pd.DataFrame) -> pd.Series:
-    """Rows with status ok and a finite estimate."""
-    est = df[["est_x", "est_y", "est_theta"]].to_numpy(float)
-    return (df["status"].astype(str) == "ok") & pd.Series(np.isfinite(est).all(axis=1), index=df.index)
+def _q(s: pd.Series, q: float) -> float:
+    s = s.dropna()
+    return float(np.percentile(s, q)) if len(s) else np.nan
 
 
-def classify(df: pd.DataFrame, dist_m: float = 0.10, orient_rad: float = np.radians(2.0)) -> pd.Series:
-    """The outcome of every row (see module docstring); needs the error and score columns."""
-    ans = answered(df)
-    ok = ans & (df["dist_err_m"] <= dist_m) & (df["orient_err_rad"] <= orient_rad)
-    st, se = df["score_true"].astype(float), df["score_est"].astype(float)
-    scored = np.isfinite(st) & np.isfinite(se)
-    out = np.where(~ans, "no-answer", np.where(ok, "success", np.where(
-        ~scored, "unscored", np.where(st < se, "local-optimum", "ambiguous"))))
-    return pd.Series(out, index=df.index, name="outcome")
+def _stats(s: pd.Series, name: str, unit: str) -> dict[str, float]:
+    s = s.dropna()
+    return {f"{name}_mean_{unit}": s.mean() if len(s) else np.nan,
+            f"{name}_std_{unit}": s.std(ddof=1) if len(s) > 1 else np.nan,
+            f"{name}_median_{unit}": _q(s, 50), f"{name}_p90_{unit}": _q(s, 90),
+            f"{name}_max_{unit}": s.max() if len(s) else np.nan}
 
 
-def improvement(err: pd.Series, init_err: pd.Series) -> pd.Series:
-    """The paper's per-scan improvement 100·(1 − err/initial_err) (%); NaN where initial_err = 0."""
-    init = init_err.astype(float).where(init_err.astype(float) > 0)
-    return 100.0 * (1.0 - err.astype(float) / init)
+def group_metrics(g: pd.DataFrame) -> dict[str, float]:
+    """All metrics of one group of :func:`prepare`-d rows (see :data:`METRIC_COLUMNS`)."""
+    n_truth = int(g["truth"].sum())
+    status = g["status"].fillna("").astype(str)
+    m: dict[str, float] = {
+        "n": len(g), "n_truth": n_truth, "n_est": int(g["estimate"].sum()),
+        "n_excluded": n_truth - int(g["estimate"].sum()),
+        "n_timeout": int((status == "timeout").sum()), "n_error": int(status.str.startswith("error").sum())}
+    m.update(_stats(g["dist_err_cm"], "dist", "cm"))
+    m.update(_stats(g["orient_err_deg"], "orient", "deg"))
+    for k in ("dist", "orient"):
+        s = g[f"{k}_impr_pct"].dropna()
+        m[f"{k}_impr_mean_pct"] = s.mean() if len(s) else np.nan
+        m[f"{k}_impr_min_pct"] = s.min() if len(s) else np.nan
+    counts = g["outcome_eval"].value_counts()
+    for o in (*OUTCOMES, UNSCORED):
+        m[f"n_{o.replace('-', '_')}"] = int(counts.get(o, 0))
+    for o in OUTCOMES:
+        m[f"share_{o.replace('-', '_')}_pct"] = 100.0 * counts.get(o, 0) / n_truth if n_truth else np.nan
+    m["success_rate_pct"] = m["share_success_pct"]
+    rt = g["runtime_ms"].dropna()
+    m.update(runtime_median_ms=_q(rt, 50), runtime_p95_ms=_q(rt, 95), n_timed=len(rt))
+    return m
 
 
-def add_bins(df: pd.DataFrame) -> pd.DataFrame:
-    """Copy with ``angle_bin`` (1–3: initial angle offset 0–5, 5–10, 10–15°) and ``dist_bin``
-    (1–3: initial distance offset 0–100, 100–200, 200–300 cm), from the poses; 0 = outside."""
-    out = df.copy()
-    a = np.degrees(out["init_orient_err_rad"].to_numpy(float))
-    d = 100.0 * out["init_dist_err_m"].to_numpy(float)
-    for col, v, edges in (("angle_bin", a, ANGLE_BINS_DEG), ("dist_bin", d, DIST_BINS_CM)):
-        b = np.searchsorted(np.asarray(edges), v, side="right")
-        out[col] = np.where((v >= edges[0]) & (v <= edges[-1]), np.clip(b, 1, len(edges) - 1), 0)
-    return out
+def summarize(df: pd.DataFrame, by: list[str] | tuple[str, ...] = ("matcher",),
+              thresholds: Thresholds | None = None) -> pd.DataFrame:
+    """One row of metrics per group of ``by`` (``[]`` = one overall row).
 
-
-def summarize_frame(g: pd.DataFrame) -> dict:
-    """All metrics of one group of rows (units: cm, degrees, %, ms)."""
-    ans = answered(g)
-    a = g[ans]
-    d_cm, o_deg = 100.0 * a["dist_err_m"].astype(float), np.degrees(a["orient_err_rad"].astype(float))
-    rt = 1000.0 * g.loc[ans, "runtime_s"].astype(float)
-    out = {"n": len(g), "n_answered": int(ans.sum())}
-    for name, v in (("dist_cm", d_cm), ("orient_deg", o_deg)):
-        out[f"mean_{name}"] = v.mean() if len(v) else np.nan
-        out[f"median_{name}"] = v.median() if len(v) else np.nan
-        out[f"p90_{name}"] = v.quantile(0.9) if len(v) else np.nan
-        out[f"max_{name}"] = v.max() if len(v) else np.nan
-    out["dist_improvement_pct"] = improvement(a["dist_err_m"], a["init_dist_err_m"]).mean()
-    out["orient_improvement_pct"] = improvement(a["orient_err_rad"], a["init_orient_err_rad"]).mean()
-    oc = g["outcome"].astype(str)
-    out["success_rate"] = float((oc == "success").mean()) if len(g) else np.nan
-    for o in OUTCOMES[1:]:
-        out[f"n_{o}"] = int((oc == o).sum())
-    out["runtime_median_ms"] = rt.median() if len(rt) else np.nan
-    out["runtime_p95_ms"] = rt.quantile(0.95) if len(rt) else np.nan
-    return out
-
-
-def summarize(df: pd.DataFrame, by: list[str]) -> pd.DataFrame:
-    """One row of :func:`summarize_frame` metrics per group of ``by``."""
-    rows = [{**dict(zip(by, key if isinstance(key, tuple) else (key,), strict=True)), **summarize_frame(g)}
-            for key, g in df.groupby(by, sort=True)]
-    return pd.DataFrame(rows)
-
-
-def scenario_rows(df: pd.DataFrame, pool: str = "office-pool", detail_prefix: str = "detail-") -> pd.DataFrame:
-    """Long frame with ``scenario`` and ``group`` columns as the paper bins its scans:
-    I = datasets named ``detail-*`` (group = dataset); II = the pool by initial angle offset bin;
-    III = the pool by initial distance offset bin; ``dataset`` = each dataset; ``all`` = everything."""
-    b = add_bins(df)
-    parts = [b[b["dataset"].astype(str).str.startswith(detail_prefix)].assign(scenario="I", group=lambda x: x["dataset"])]
-    p = b[b["dataset"] == pool]
-    parts.append(p[p["angle_bin"] > 0].assign(scenario="II", group=lambda x: x["angle_bin"].astype(str)))
-    parts.append(p[p["dist_bin"] > 0].assign(scenario="III", group=lambda x: x["dist_bin"].astype(str)))
-    parts.append(b.assign(scenario="dataset", group=lambda x: x["dataset"]))
-    parts.append(b.assign(scenario="all", group="all"))
-    return pd.concat(parts, ignore_index=True)
-
-
-def summary_table(df: pd.DataFrame, **kw) -> pd.DataFrame:
-    """``summary.csv``: one row per matcher × scenario × group with every metric."""
-    return summarize(scenario_rows(df, **kw), ["matcher", "scenario", "group"])
+    ``df`` is raw estimates or already :func:`prepare`-d (detected by the ``outcome_eval``
+    column); ``thresholds`` defaults to 10 cm / 2°. Empty groups of categorical bins are omitted.
+    """
+    p = df if "outcome_eval" in df.columns else prepare(df, thresholds or Thresholds())
+    by = list(by)
+    if not by:
+        return pd.DataFrame([group_metrics(p)], columns=list(METRIC_COLUMNS))
+    rows = []
+    for key, g in p.groupby(by, observed=True, sort=True, dropna=False):
+        key = key if isinstance(key, tuple) else (key,)
+        rows.append({**dict(zip(by, key, strict=True)), **group_metrics(g)})
+    return pd.DataFrame(rows, columns=[*by, *METRIC_COLUMNS])

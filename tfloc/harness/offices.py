@@ -26,7 +26,7 @@ DOOR = 0.9  # door width (m)
 def _wall(points: list[tuple[float, float]], doors: list[float] = ()) -> list[LineString]:
     """An axis-aligned polyline wall with ``DOOR``-wide gaps centred at the given positions
     (measured along the first segment's axis, which must be straight)."""
-    (x0, y0), (x1, y1) = points[0], points[-1]
+    (x0, y0), (_, y1) = points[0], points[-1]
     line = LineString(points)
     for c in doors:
         if abs(y1 - y0) < 1e-9:  # horizontal wall

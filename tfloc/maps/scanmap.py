@@ -9,13 +9,14 @@ from ..pose import Pose
 from .vector import VectorMap
 
 
-def polyline_map_from_scan(ranges: np.ndarray, laser: LaserSpec, pose: Pose = Pose(),
+def polyline_map_from_scan(ranges: np.ndarray, laser: LaserSpec, pose: Pose | None = None,
                            max_gap: float = 0.5, max_gap_ratio: float = 0.15) -> VectorMap:
-    """Join consecutive returns of a scan into wall segments, seen from ``pose`` (metres).
+    """Join consecutive returns of a scan into wall segments, seen from ``pose`` (default: the origin; metres).
 
     Neighbouring beams are joined unless one has no return or the points are farther apart
     than ``max_gap`` metres plus ``max_gap_ratio`` × range (a depth discontinuity, not a wall).
     """
+    pose = Pose() if pose is None else pose
     pts = pose.transform(laser.to_points(ranges, keep_invalid=True))
     r = np.asarray(ranges, dtype=float)
     ok = laser.valid(r)

@@ -1,0 +1,208 @@
+"""ShortStraw corner finding (Wolin et al. 2008) as the paper gives it: Algorithms 1–3.
+
+Readings of the paper's text, each chosen because the literal text does not work:
+
+* **Alg. 1 divides by a squared distance.** Its ``D ← ‖P1 − P2‖²`` followed by
+  ``P3 = P1 + (P2 − P1)/D·S`` would put P3 at ``S/‖P1P2‖`` from P1, while the text says P3
+  lies "exactly S Euclidean distance away from P1". We use the Euclidean distance ``D``.
+  With the paper's S = 1 the test ``D > S`` is the same either way.
+* **Alg. 1 starts with** ``P1 ← points_i`` (i = 2); we start at the first point and keep it
+  (ShortStraw keeps it; without it the first corner would be lost).
+* **Alg. 2 squares the straws** (``‖p(i−w) − p(i+w)‖²``) and thresholds them at
+  ``median × t``. That is well defined, so we keep it: it equals an unsquared threshold of
+  ``√t·median`` (t = 0.99 → 0.995). Every index below the threshold is a candidate (no
+  local-minimum selection, as written); Alg. 3 then thins them.
+* **Alg. 2 uses w = 1** where Wolin et al. use w = 3: the default follows the paper; the
+  window is a parameter.
+* **Alg. 3 sums squared steps** (``PathD ← PathD + ‖p_i − p_{i+1}‖²``). For points resampled at
+  spacing S that makes ``D/PathD`` scale as 1/S, so the test only means "straight" when S = 1.
+  We sum the plain step lengths (ShortStraw's IS-LINE), which is identical at S = 1.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, nogil=True)
+def _resample_into(points: np.ndarray, spacing: float, out: np.ndarray) -> int:
+    """Algorithm 1 written into ``out``; returns the number of points, or -1 if ``out`` is too
+    small (``out`` of shape ``(0, 2)`` just counts)."""
+    n = points.shape[0]
+    cap = out.shape[0]
+    count_only = cap == 0
+    m = 0
+    p1x, p1y = points[0, 0], points[0, 1]
+    if not count_only:
+        out[0, 0], out[0, 1] = p1x, p1y
+    m += 1
+    i = 1
+    surely_inside = spacing * spacing * (1.0 - 1e-9)   # d² below this ⇒ d ≤ spacing, no sqrt
+    while i < n:
+        dx, dy = points[i, 0] - p1x, points[i, 1] - p1y
+        d2 = dx * dx + dy * dy
+        if d2 < surely_inside:
+            i += 1
+            continue
+        d = np.sqrt(d2)
+        if d > spacing:
+            p1x, p1y = p1x + dx / d * spacing, p1y + dy / d * spacing
+            if not count_only:
+                if m >= cap:
+                    return -1
+                out[m, 0], out[m, 1] = p1x, p1y
+            m += 1
+        else:
+            i += 1
+    lx, ly = points[n - 1, 0] - p1x, points[n - 1, 1] - p1y
+    if np.sqrt(lx * lx + ly * ly) > 0.5 * spacing:
+        if not count_only:
+            if m >= cap:
+                return -1
+            out[m, 0], out[m, 1] = points[n - 1, 0], points[n - 1, 1]
+        m += 1
+    return m
+
+
+@njit(cache=True, nogil=True)
+def resample(points: np.ndarray, spacing: float) -> np.ndarray:
+    """Algorithm 1: walk along ``points`` ``(N, 2)`` and emit points exactly ``spacing`` metres
+    apart (chord length from the last emitted point towards the next input point).
+
+    Returns ``(M, 2)``; the first input point is always kept, and the last input point is
+    appended when it lies more than ``spacing/2`` beyond the last emitted point. As written,
+    the walk follows chords, not the input path, so it cuts corners by up to ``spacing``.
+    """
+    n = points.shape[0]
+    if n == 0:
+        return np.empty((0, 2))
+    path = 0.0                 # M ≤ path/spacing + 2 per input point (each emission walks S)
+    for i in range(1, n):
+        dx, dy = points[i, 0] - points[i - 1, 0], points[i, 1] - points[i - 1, 1]
+        path += np.sqrt(dx * dx + dy * dy)
+    cap = 3 * n + 16
+    if np.isfinite(path) and path / spacing < 1e9:
+        cap += int(path / spacing)
+    out = np.empty((cap, 2))
+    m = _resample_into(points, spacing, out)
+    if m < 0:                  # not expected; count exactly and redo
+        out = np.empty((_resample_into(points, spacing, np.empty((0, 2))), 2))
+        m = _resample_into(points, spacing, out)
+    return out[:m]
+
+
+def straws(points: np.ndarray, window: int = 1) -> np.ndarray:
+    """Eq. 7 / Alg. 2: squared straw ``‖p(i−w) − p(i+w)‖²`` for ``i = w … N−w−1`` (metres²)."""
+    d = points[2 * window:] - points[:-2 * window]
+    return np.einsum("ij,ij->i", d, d)
+
+
+@njit(cache=True, nogil=True)
+def _median(values: np.ndarray) -> float:
+    """``np.median`` of a 1-D array (the mean of the two middle values when the size is even)."""
+    v = np.sort(values)
+    n = v.shape[0]
+    h = n // 2
+    if n % 2 == 1:
+        return v[h]
+    return (v[h - 1] + v[h]) / 2.0
+
+
+@njit(cache=True, nogil=True)
+def _candidates(points: np.ndarray, window: int, t: float) -> np.ndarray:
+    """Algorithm 2 for ``len(points) > 2·window`` (see :func:`corner_candidates`)."""
+    n = points.shape[0]
+    m = n - 2 * window
+    s = np.empty(m)
+    for i in range(m):
+        dx = points[i + 2 * window, 0] - points[i, 0]
+        dy = points[i + 2 * window, 1] - points[i, 1]
+        s[i] = dx * dx + dy * dy
+    cut = _median(s) * t
+    out = np.empty(m + 2, dtype=np.int64)
+    out[0] = 0
+    k = 1
+    for i in range(m):
+        if s[i] < cut:
+            out[k] = i + window
+            k += 1
+    out[k] = n - 1
+    return out[:k + 1].copy()
+
+
+def corner_candidates(points: np.ndarray, window: int = 1, t: float = 0.99) -> np.ndarray:
+    """Algorithm 2: indices of the first point, every point whose squared straw is below
+    ``median × t``, and the last point (sorted, unique)."""
+    n = len(points)
+    if n <= 2 * window:
+        return np.arange(n) if n < 2 else np.array([0, n - 1])
+    return _candidates(np.asarray(points, dtype=float), int(window), float(t))
+
+
+@njit(cache=True, nogil=True)
+def merge_lines(points: np.ndarray, corners: np.ndarray, threshold: float = 0.95) -> np.ndarray:
+    """Algorithm 3 applied to consecutive corner triples: drop the middle corner ``c_m``
+    whenever the path from ``c_l`` to ``c_n`` is a line, i.e. chord / path length > threshold.
+
+    One pass: the last kept corner, the pending middle corner and the next candidate form the
+    triple; a dropped middle is replaced by the next candidate (the same triples, in the same
+    order, as removing it from the list and testing again)."""
+    n = points.shape[0]
+    cum = np.zeros(n)
+    for i in range(1, n):
+        dx, dy = points[i, 0] - points[i - 1, 0], points[i, 1] - points[i - 1, 1]
+        cum[i] = cum[i - 1] + np.sqrt(dx * dx + dy * dy)
+    k = corners.shape[0]
+    if k < 3:
+        return corners.astype(np.int64)
+    keep = np.empty(k, dtype=np.int64)
+    keep[0] = corners[0]
+    m = 1
+    mid = corners[1]
+    for j in range(2, k):
+        a, b = keep[m - 1], corners[j]
+        path = cum[b] - cum[a]
+        dx, dy = points[b, 0] - points[a, 0], points[b, 1] - points[a, 1]
+        if not (path > 0.0 and np.sqrt(dx * dx + dy * dy) / path > threshold):
+            keep[m] = mid
+            m += 1
+        mid = b
+    keep[m] = mid
+    return keep[:m + 1].copy()
+
+
+@njit(cache=True, nogil=True)
+def _shortstraw(points: np.ndarray, spacing: float, window: int, t: float,
+                line_threshold: float) -> np.ndarray:
+    """Algs. 1–3 in one compiled call (see :func:`shortstraw`)."""
+    res = resample(points, spacing)
+    n = res.shape[0]
+    if n <= 2 * window:
+        cand = np.arange(n) if n < 2 else np.array([0, n - 1], dtype=np.int64)
+    else:
+        cand = _candidates(res, window, t)
+    keep = merge_lines(res, cand, line_threshold)
+    out = np.empty((keep.shape[0], 2))
+    for i in range(keep.shape[0]):
+        out[i, 0], out[i, 1] = res[keep[i], 0], res[keep[i], 1]
+    return out
+
+
+def is_line(points: np.ndarray, a: int, b: int, threshold: float = 0.95) -> bool:
+    """Algorithm 3 (Is-Line): whether the resampled path ``points[a..b]`` is straight."""
+    path = np.sum(np.hypot(*np.diff(points[a:b + 1], axis=0).T))
+    return bool(path > 0 and np.hypot(*(points[b] - points[a])) / path > threshold)
+
+
+def shortstraw(points: np.ndarray, spacing: float, window: int = 1, t: float = 0.99,
+               line_threshold: float = 0.95) -> np.ndarray:
+    """ShortStraw corners of an ordered polyline ``(N, 2)`` (metres) → corner points ``(K, 2)``.
+
+    Alg. 1 (resample at ``spacing``), Alg. 2 (straw candidates, ``window``, ``t``), Alg. 3
+    (Is-Line merging at ``line_threshold``). The first and last points are always corners.
+    """
+    pts = np.ascontiguousarray(points, dtype=float)
+    if len(pts) < 2:
+        return pts.copy()
+    return _shortstraw(pts, float(spacing), int(window), float(t), float(line_threshold))
