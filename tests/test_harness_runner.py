@@ -76,7 +76,7 @@ def test_resume_after_sigkill_has_every_task_exactly_once(tmp_path, test_room, l
     ds = make_dataset(tmp_path / "ds", test_room, lms200, n=12)
     out = tmp_path / "run"
     cmd = [sys.executable, "-m", "tfloc.cli", "bench", str(ds), "--out", str(out), "--jobs", "2",
-           "--matchers", "toy_matchers:Stay,toy_matchers:TwoMinima", "--no-progress", "--timeout", "30"]
+           "--matchers", "toy_matchers:SlowStay,toy_matchers:TwoMinima", "--no-progress", "--timeout", "30"]
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(TESTS), str(ROOT)])}
     proc = subprocess.Popen(cmd, env=env, start_new_session=True, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE)
@@ -91,7 +91,7 @@ def test_resume_after_sigkill_has_every_task_exactly_once(tmp_path, test_room, l
     n_before = est.read_text().count("\n") - 1
     # a torn last line, as a kill in the middle of a write leaves it
     with est.open("a") as fh:
-        fh.write("ds,s99,g0,toy_matchers:Stay,3.0,3.5")
+        fh.write("ds,s99,g0,toy_matchers:SlowStay,3.0,3.5")
     r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     df = read_estimates(out)

@@ -27,6 +27,15 @@ class Stay:
         return pose.distance_to(problem.initial)
 
 
+class SlowStay(Stay):
+    """:class:`Stay` taking 0.25 s per scan, so that a run can be killed mid-way (resume test)."""
+
+    name = "slow-stay"
+
+    def __init__(self, sleep_s: float = 0.25) -> None:
+        super().__init__(sleep_s)
+
+
 class Raises(Stay):
     """Raises on every ``fail_every``-th call in a worker (a data-dependent crash)."""
 
