@@ -27,9 +27,32 @@ from tfloc import LaserSpec, Pose, Problem
 
 ROOT = Path(__file__).resolve().parents[1]
 
+
+def office_map() -> tfloc.VectorMap:
+    """A 20 × 12 m office-like floor built in code: a corridor, six rooms with doorways, desks and
+    cabinets (the bigger map of the ablation, until a bundled office map exists)."""
+    from shapely.geometry import LineString, box
+    walls = [LineString([(0, 7), (8.1, 7)]), LineString([(9.1, 7), (14.1, 7)]),
+             LineString([(15.1, 7), (20, 7)]),                           # corridor north wall
+             LineString([(0, 4), (2.9, 4)]), LineString([(3.9, 4), (11.9, 4)]),
+             LineString([(12.9, 4), (20, 4)]),                          # corridor south wall
+             LineString([(6, 7), (6, 12)]), LineString([(13, 7), (13, 12)]),
+             LineString([(7, 0), (7, 4)]), LineString([(14, 0), (14, 4)])]
+    obstacles = [box(1, 9, 3, 10), box(8, 10.5, 11, 11.4), box(16, 9, 17.5, 9.6),
+                 box(1, 0.5, 1.6, 2.5), box(9, 1, 11, 2), box(16.5, 0.4, 19.5, 1.0),
+                 box(4.5, 8.5, 5.0, 9.0), box(18.6, 5.0, 19.2, 5.6)]
+    return tfloc.VectorMap(walls=tuple(walls), obstacles=tuple(obstacles),
+                           outline=box(0, 0, 20, 12), name="office-gen")
+
+
+def load(name: str) -> tfloc.Map:
+    """A map file, or ``office-gen`` for :func:`office_map`."""
+    return office_map() if name == "office-gen" else tfloc.load_map(name)
+
 VARIANTS: dict[str, tuple[str, dict]] = {
     "tf-plus (all stages)": ("tf-plus", {}),
     "no turning-function seed": ("tf-plus", {"tf_seed": False}),
+    "no heading sweep (TF seed only)": ("tf-plus", {"heading_sweep": False}),
     "no grid (refine from VP)": ("tf-plus", {"grid": False}),
     "no refinement (grid only)": ("tf-plus", {"refine": False}),
     "select by TF Err": ("tf-plus", {"select": "tf"}),
@@ -60,11 +83,12 @@ def make_problems(m: tfloc.Map, laser: LaserSpec, per_cell: int, seed: int) -> l
     return out
 
 
-def run(variants: dict, maps: list[Path], per_cell: int, seed: int) -> pd.DataFrame:
+def run(variants: dict, maps: list[str], per_cell: int, seed: int) -> pd.DataFrame:
     laser = LaserSpec.lms200()
     rows = []
     for path in maps:
-        m = tfloc.load_map(path)
+        m = load(path)
+        path = Path(path)
         probs = make_problems(m, laser, per_cell, seed)
         for label, (name, kw) in variants.items():
             matcher = tfloc.get_matcher(name, **kw)
@@ -110,7 +134,8 @@ def markdown(df: pd.DataFrame) -> str:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--maps", nargs="+", type=Path, default=[ROOT / "data/maps/test-room.geojson"])
+    ap.add_argument("--maps", nargs="+", default=[str(ROOT / "data/maps/test-room.geojson"), "office-gen"],
+                    help="map files, or office-gen (an office floor built in code)")
     ap.add_argument("--per-cell", type=int, default=10)
     ap.add_argument("--seed", type=int, default=7)
     ap.add_argument("--with-tf", action="store_true", help="also run the faithful tf (≈1 s/scan)")

@@ -48,7 +48,8 @@ class TfPlusConfig:
     """Parameters of ``tf-plus`` (metres, radians).
 
     Attributes:
-        tf_seed: seed the headings with the turning-function rotation estimate.
+        tf_seed: add headings seeded by the turning-function rotation estimates.
+        heading_sweep: sweep the headings θ_VP ± ``heading_span``.
         grid: run the coarse grid search over positions (else only the VP's position).
         refine: run the point-to-line refinement.
         select: how the final answer is picked among refined candidates: ``"residual"``
@@ -60,7 +61,7 @@ class TfPlusConfig:
         rotation_seeds: rotation offsets taken from the turning functions' edge-direction
             histograms (:mod:`tfloc.heading_histogram`) ...
         max_rotation: ... searched within ± this of the VP's heading.
-        heading_span: without the turning-function seed, headings cover θ_VP ± this ...
+        heading_span: the heading sweep covers θ_VP ± this ...
         heading_step: ... at this spacing.
         field_resolution: cell size of the distance field.
         field_truncation: truncation of the distance field.
@@ -76,16 +77,17 @@ class TfPlusConfig:
     """
 
     tf_seed: bool = True
+    heading_sweep: bool = True
     grid: bool = True
     refine: bool = True
     select: str = "residual"
     search_radius: float = 3.3
     grid_step: float = 0.2
     clearance: float = 0.1
-    heading_offsets: tuple[float, ...] = tuple(math.radians(d) for d in (-2.0, 0.0, 2.0))
+    heading_offsets: tuple[float, ...] = tuple(math.radians(d) for d in (-1.0, 0.0, 1.0))
     rotation_seeds: int = 3
     max_rotation: float = math.radians(20.0)
-    heading_span: float = math.radians(16.0)
+    heading_span: float = math.radians(17.0)
     heading_step: float = math.radians(2.0)
     field_resolution: float = 0.05
     field_truncation: float = 0.3
@@ -114,24 +116,28 @@ def _field(map_: Map, cfg: TfPlusConfig) -> DistanceField:
 
 
 def heading_seeds(problem: Problem, cfg: TfPlusConfig) -> tuple[np.ndarray, dict]:
-    """Headings (radians) for the coarse search, and what the turning function said."""
+    """Headings (radians) for the coarse search, and what the turning function said.
+
+    The sweep θ_VP ± ``heading_span`` (``heading_sweep``) and/or the turning-function seeds with
+    ``heading_offsets`` around each (``tf_seed``); θ_VP with its offsets if neither is on."""
     th0 = problem.initial.theta
     info: dict = {}
-    seeds = [th0]
+    offsets = np.asarray(cfg.heading_offsets)
+    heads = []
+    if cfg.heading_sweep:
+        k = int(round(cfg.heading_span / cfg.heading_step))
+        heads.append(th0 + np.arange(-k, k + 1) * cfg.heading_step)
+    else:
+        heads.append(th0 + offsets)
     if cfg.tf_seed:
         real = scan_turning_function(problem.ranges, problem.laser, cfg.tf)
         virtual = scan_turning_function(problem.map.raycast(problem.initial, problem.laser),
                                         problem.laser, cfg.tf)
         if real is not None and virtual is not None:
             rots = rotation_candidates(real, virtual, cfg.max_rotation, cfg.rotation_seeds)
-            seeds = [th0 - r for r in rots] + seeds
+            heads += [th0 - r + offsets for r in rots]
             info = {"tf_rotations": [float(r) for r in rots]}
-        offsets = np.asarray(cfg.heading_offsets)
-        heads = np.concatenate([s + offsets for s in seeds])
-    else:
-        k = int(round(cfg.heading_span / cfg.heading_step))
-        heads = th0 + np.arange(-k, k + 1) * cfg.heading_step
-    return heads, info
+    return np.concatenate(heads), info
 
 
 def tf_errs(problem: Problem, poses: np.ndarray, cfg: TfPlusConfig) -> np.ndarray:
