@@ -19,8 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .laser import LaserSpec
 from ._tfplus_kernels import pairs_kernel
+from .laser import LaserSpec
 from .maps.base import Map
 
 

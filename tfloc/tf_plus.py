@@ -34,12 +34,12 @@ import numpy as np
 
 from .coarse import best_candidates, lattice, pose_scores, search
 from .distance_field import DistanceField, distance_field
+from .heading_histogram import rotation_candidates
 from .maps.base import Map
 from .pose import Pose
 from .problem import Estimate, Problem
 from .refine import RefineConfig, line_residuals, refine, truncated_cost
 from .tf import TfConfig, scan_turning_function
-from .heading_histogram import rotation_candidates
 from .turning import match
 
 
