@@ -6,7 +6,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.tfloc-installed
 JOBS   ?= 2
 
-.PHONY: install bench test test-unit timing lint clean-venv
+.PHONY: install bench test test-unit timing lint clean-venv real-data
 
 $(STAMP): pyproject.toml
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -20,6 +20,15 @@ install: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/tfloc bench benchmarks/paper-protocol.toml --jobs $(JOBS)
 	$(BIN)/tfloc report results/paper-protocol
+	$(BIN)/tfloc bench benchmarks/real-csail-relations.toml --jobs $(JOBS)
+	$(BIN)/tfloc report results/real-csail-relations
+	$(BIN)/tfloc real-note results/real-csail-relations
+	$(BIN)/tfloc bench benchmarks/real-scan-to-map.toml --jobs $(JOBS)
+	$(BIN)/tfloc report results/real-scan-to-map
+
+## Rebuild the real-log datasets and grid maps from data/real/ (deterministic).
+real-data: $(STAMP)
+	$(BIN)/tfloc real-data --out data
 
 ## Unit tests, the accuracy regression guard and a benchmark smoke run (CI).
 test: $(STAMP)

@@ -16,7 +16,7 @@ import numpy as np
 
 from .errors import InvalidProblemError, MapFormatError, MatcherError, TflocError
 from .laser import LaserSpec
-from .maps import Map, VectorMap
+from .maps import GridMap, Map, VectorMap
 from .matcher import Matcher, available_matchers, get_matcher
 from .pose import Pose, angdiff
 from .problem import Estimate, Problem
@@ -24,7 +24,7 @@ from .problem import Estimate, Problem
 __version__ = "0.1.0"
 
 __all__ = [
-    "Estimate", "InvalidProblemError", "LaserSpec", "Map", "MapFormatError", "Matcher",
+    "Estimate", "GridMap", "InvalidProblemError", "LaserSpec", "Map", "MapFormatError", "Matcher",
     "MatcherError", "Pose", "Problem", "TflocError", "VectorMap", "angdiff",
     "available_matchers", "get_matcher", "load_map", "localize",
 ]

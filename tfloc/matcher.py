@@ -73,8 +73,12 @@ def get_matcher(name: str, **params: Any) -> Matcher:
         mod = __import__(module, fromlist=[attr])
         factory = getattr(mod, attr)
     except ImportError as exc:
+        missing = exc.name or ""
+        if missing and (module == missing or module.startswith(missing + ".")):
+            raise MatcherError(f"matcher {name!r}: its module {module!r} is not part of this installation") from None
+        lib = f"the library {missing.partition('.')[0]!r}" if missing else "a library"
         raise MatcherError(
-            f"matcher {name!r} needs a library that is not installed: {exc} "
+            f"matcher {name!r} needs {lib}, which is not installed or failed to import: {exc} "
             f"(install the project with its dependencies: pip install -e .)") from None
     try:
         return factory(**params)

@@ -1,6 +1,7 @@
-"""Maps: the :class:`Map` protocol, :class:`VectorMap` (segments) and, later, ``GridMap``."""
+"""Maps: the :class:`Map` protocol, :class:`VectorMap` (segments) and :class:`GridMap` (occupancy grid)."""
 
 from .base import Map
+from .grid import GridMap
 from .vector import VectorMap
 
-__all__ = ["Map", "VectorMap"]
+__all__ = ["GridMap", "Map", "VectorMap"]

@@ -1,0 +1,140 @@
+"""Baselines in the registry: a missing optional library gives a clear message, others still run."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from baselines._config import resolve_config
+from baselines._geometry import matrix_to_pose, polyline_normals, pose_to_matrix
+from baselines.o3d_icp import Config as O3dConfig
+from tfloc import Pose
+
+ROOT = Path(__file__).resolve().parents[1]
+
+_SCRIPT = """
+import json, sys
+sys.modules[{module!r}] = None  # simulate the library being absent
+sys.path.insert(0, {tests!r})
+import tfloc
+from _baseline_cases import make_problem
+out = {{}}
+try:
+    tfloc.get_matcher({name!r})
+    out["missing"] = None
+except tfloc.MatcherError as exc:
+    out["missing"] = str(exc)
+problem, true = make_problem()
+est = tfloc.get_matcher({other!r}).localize(problem)
+out["other_error_m"] = est.pose.distance_to(true)
+print(json.dumps(out))
+"""
+
+
+@pytest.mark.parametrize(("name", "module", "other"), [
+    ("kiss-icp", "kiss_icp", "csm-corr"),
+    ("o3d-icp", "open3d", "kiss-icp"),
+    ("cv-corners", "cv2", "o3d-icp"),
+])
+def test_missing_library_is_a_clear_matcher_error(name: str, module: str, other: str) -> None:
+    code = _SCRIPT.format(module=module, tests=str(ROOT / "tests"), name=name, other=other)
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,
+                          cwd=ROOT, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert out["missing"] is not None
+    assert repr(name) in out["missing"] and module in out["missing"] and "not installed" in out["missing"]
+    assert out["other_error_m"] < 0.02
+
+
+def test_se2_round_trip_and_projection() -> None:
+    pose = Pose(1.5, -2.0, 2.9)
+    for dim in (3, 4):
+        back = matrix_to_pose(pose_to_matrix(pose, dim))
+        assert np.allclose(back.as_array(), pose.as_array())
+    t = pose_to_matrix(pose, 4)
+    t[:3, :3] = t[:3, :3] @ np.array([[1, 0, 0], [0, math.cos(0.01), -math.sin(0.01)], [0, math.sin(0.01), math.cos(0.01)]])
+    t[2, 3] = 0.3
+    assert abs(matrix_to_pose(t).theta - 2.9) < 1e-3
+
+
+def test_polyline_normals_are_unit_and_perpendicular() -> None:
+    pts = np.column_stack((np.linspace(0, 1, 11), np.full(11, 2.0)))
+    n = polyline_normals(pts)
+    assert np.allclose(n, [[0.0, 1.0]] * 11)
+
+
+def test_resolve_config_rejects_unknown_and_tuples_lists() -> None:
+    cfg = resolve_config(O3dConfig, None, {"gates": [0.5, 0.1]})
+    assert cfg.gates == (0.5, 0.1)
+    with pytest.raises(TypeError, match="bogus"):
+        resolve_config(O3dConfig, None, {"bogus": 1})
+
+
+class _ProtocolOnlyMap:
+    """A map that offers only the Map protocol (no ``segments``), as a GridMap would."""
+
+    def __init__(self, inner: object) -> None:
+        self._inner = inner
+
+    def raycast(self, poses, laser):  # noqa: ANN001, ANN201
+        return self._inner.raycast(poses, laser)
+
+    def is_free(self, xy, clearance=0.0):  # noqa: ANN001, ANN201
+        return self._inner.is_free(xy, clearance)
+
+    def in_bounds(self, xy):  # noqa: ANN001, ANN201
+        return self._inner.in_bounds(xy)
+
+    def sample_points(self, spacing):  # noqa: ANN001, ANN201
+        return self._inner.sample_points(spacing)
+
+    @property
+    def bounds(self):  # noqa: ANN201
+        return self._inner.bounds
+
+
+NAMES = ["o3d-icp", "kiss-icp", "csm-corr", "cv-corners"]
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_uses_only_the_map_protocol(name: str) -> None:
+    from _baseline_cases import make_problem
+
+    import tfloc
+    problem, true = make_problem()
+    wrapped = tfloc.Problem(_ProtocolOnlyMap(problem.map), problem.laser, problem.ranges, problem.initial)
+    est = tfloc.get_matcher(name).localize(wrapped)
+    assert est.pose.distance_to(true) < 0.02
+
+
+@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("n_returns", [1, 3])
+def test_tiny_scans_do_not_crash(name: str, n_returns: int) -> None:
+    from _baseline_cases import make_problem
+
+    import tfloc
+    problem, _ = make_problem()
+    ranges = np.full_like(problem.ranges, np.inf)
+    ranges[80:80 + n_returns] = problem.ranges[80:80 + n_returns]
+    tiny = tfloc.Problem(problem.map, problem.laser, ranges, problem.initial)
+    matcher = tfloc.get_matcher(name)
+    est = matcher.localize(tiny)
+    assert est.pose.is_finite()
+    assert np.isfinite(matcher.score(tiny, est.pose))
+
+
+def test_missing_matcher_module_is_not_blamed_on_a_library(monkeypatch: pytest.MonkeyPatch) -> None:
+    import tfloc.matcher as registry
+
+    monkeypatch.setitem(registry._registry(), "ghost", "baselines.no_such_module:Ghost")
+    with pytest.raises(registry.MatcherError, match="its module 'baselines.no_such_module' is not part"):
+        registry.get_matcher("ghost")

@@ -1,0 +1,104 @@
+"""ROS map_server maps (YAML + PGM/PNG image) ↔ :class:`~tfloc.maps.grid.GridMap`.
+
+YAML keys: ``image`` (path relative to the YAML), ``resolution`` (m/cell), ``origin`` ``[x, y, yaw]``
+(pose of the lower-left pixel, yaw must be 0), ``occupied_thresh``, ``free_thresh``, ``negate``
+(0/1) and optionally ``mode`` (``trinary`` or ``scale``). As in map_server, a pixel's occupancy is
+``p = (255 − v) / 255`` (``v / 255`` if ``negate``); ``p > occupied_thresh`` is occupied,
+``p < free_thresh`` is free and anything between is unknown. Image row 0 is the top (largest y).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import yaml
+from PIL import Image, UnidentifiedImageError
+
+from ..errors import MapFormatError
+from ..maps.grid import GridMap
+
+
+def _num(doc: dict, key: str, path: Path, default: float | None = None) -> float:
+    if key not in doc:
+        if default is None:
+            raise MapFormatError(f"{path}: missing key {key!r}")
+        return default
+    v = doc[key]
+    if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+        raise MapFormatError(f"{path}: key {key!r} must be a finite number, got {v!r}")
+    return float(v)
+
+
+def read_ros_map(yaml_path: str | Path) -> GridMap:
+    """Read a map_server YAML and its image into a GridMap (unknown pixels become NaN)."""
+    path = Path(yaml_path)
+    try:
+        doc = yaml.safe_load(path.read_text())
+    except FileNotFoundError:
+        raise MapFormatError(f"{path}: no such map file") from None
+    except (yaml.YAMLError, UnicodeDecodeError) as exc:
+        raise MapFormatError(f"{path}: not valid YAML ({str(exc).splitlines()[0]})") from None
+    if not isinstance(doc, dict):
+        raise MapFormatError(f"{path}: expected a mapping of map_server keys")
+    if not isinstance(doc.get("image"), str):
+        raise MapFormatError(f"{path}: missing or non-string key 'image'")
+    res = _num(doc, "resolution", path)
+    if res <= 0:
+        raise MapFormatError(f"{path}: resolution must be a positive number of metres per cell, got {res}")
+    occ_t = _num(doc, "occupied_thresh", path, 0.65)
+    free_t = _num(doc, "free_thresh", path, 0.196)
+    negate = _num(doc, "negate", path, 0.0)
+    origin = doc.get("origin")
+    if (not isinstance(origin, list) or len(origin) != 3
+            or not all(isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v) for v in origin)):
+        raise MapFormatError(f"{path}: 'origin' must be [x, y, yaw] numbers, got {origin!r}")
+    if origin[2] != 0:
+        raise MapFormatError(f"{path}: rotated maps (origin yaw {origin[2]}) are not supported")
+    mode = doc.get("mode", "trinary")
+    if mode not in ("trinary", "scale"):
+        raise MapFormatError(f"{path}: mode {mode!r} is not supported (trinary or scale)")
+    img_path = path.parent / doc["image"]
+    try:
+        with Image.open(img_path) as im:
+            im.load()
+            if im.mode not in ("L", "LA", "RGB", "RGBA", "I", "I;16", "P", "1"):
+                raise MapFormatError(f"{img_path}: unsupported image mode {im.mode}")
+            v = np.asarray(im.convert("L"), dtype=np.float32)
+    except FileNotFoundError:
+        raise MapFormatError(f"{path}: image {doc['image']!r} not found next to the YAML") from None
+    except (UnidentifiedImageError, OSError, SyntaxError, ValueError) as exc:
+        raise MapFormatError(f"{img_path}: cannot read map image ({exc})") from None
+    p = v / 255.0 if negate else (255.0 - v) / 255.0
+    occ = np.where((p > occ_t) | (p < free_t), p, np.nan).astype(np.float32)
+    return GridMap(np.flipud(occ), res, (float(origin[0]), float(origin[1])), occ_t, free_t,
+                   name=path.stem)
+
+
+def write_ros_map(grid: GridMap, yaml_path: str | Path) -> Path:
+    """Write ``grid`` as ``<stem>.pgm`` + ``<stem>.yaml`` (mode ``scale``, negate 0).
+
+    Known cells keep their probability (to 1/255); unknown cells get a value between the
+    thresholds, so reading the files back gives the same occupied, free and unknown cells."""
+    path = Path(yaml_path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    img = path.with_suffix(".pgm")
+    p = np.array(grid.occupancy, dtype=float)
+    unknown = 0.5 * (grid.occupied_thresh + grid.free_thresh)
+    v = np.round(255.0 * (1.0 - np.where(np.isnan(p), unknown, p))).astype(np.uint8)
+    # keep the class of every cell despite rounding (compare as the reader does, in float32)
+    occ_t, free_t = grid.occupied_thresh, grid.free_thresh
+    back = lambda v: (255.0 - v.astype(np.float32)) / np.float32(255.0)  # noqa: E731
+    v = np.where(grid.occupied & (back(v) <= occ_t), v - 1, v).astype(np.uint8)
+    v = np.where(grid.free & (back(v) >= free_t), v + 1, v).astype(np.uint8)
+    mid = ~grid.occupied & ~grid.free
+    v = np.where(mid & (back(v) > occ_t), v + 1, v).astype(np.uint8)
+    v = np.where(mid & (back(v) < free_t), v - 1, v).astype(np.uint8)
+    Image.fromarray(np.flipud(v), mode="L").save(img)
+    doc = {"image": img.name, "mode": "scale", "resolution": grid.resolution,
+           "origin": [grid.origin[0], grid.origin[1], 0.0], "negate": 0,
+           "occupied_thresh": grid.occupied_thresh, "free_thresh": grid.free_thresh}
+    path.write_text(f"# tfloc GridMap {grid.name!r}: {grid.shape[1]} x {grid.shape[0]} cells\n"
+                    + yaml.safe_dump(doc, sort_keys=False))
+    return path
