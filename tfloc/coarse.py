@@ -54,7 +54,10 @@ def search(field: DistanceField, points: np.ndarray, positions: np.ndarray, head
     """Two-level grid search: every position × heading on every ``stride``-th point, then the best
     ``shortlist`` of them on all points. Returns those poses ``(S, 3)`` and their scores ``(S,)``."""
     coarse = grid_scores(field, points[::stride], positions, headings).ravel()
-    top = np.argsort(coarse, kind="stable")[:shortlist]
+    if shortlist < coarse.size:
+        top = np.argpartition(coarse, shortlist)[:shortlist]
+    else:
+        top = np.arange(coarse.size)
     poses = np.column_stack((positions[top // len(headings)], headings[top % len(headings)]))
     return poses, pose_scores(field, points, poses)
 
@@ -62,11 +65,12 @@ def search(field: DistanceField, points: np.ndarray, positions: np.ndarray, head
 def best_candidates(poses: np.ndarray, scores: np.ndarray, count: int,
                     separation: float) -> np.ndarray:
     """Up to ``count`` of ``(N, 3)`` poses of lowest score, positions ≥ ``separation`` apart."""
-    out: list[np.ndarray] = []
-    for i in np.argsort(scores, kind="stable"):
-        p = poses[i]
-        if all(np.hypot(*(p[:2] - o[:2])) >= separation for o in out):
-            out.append(p)
-            if len(out) == count:
+    order = poses[np.argsort(scores, kind="stable")]
+    keep = [0]
+    for i in range(1, len(order)):
+        d = np.hypot(*(order[keep, :2] - order[i, :2]).T)
+        if d.min() >= separation:
+            keep.append(i)
+            if len(keep) == count:
                 break
-    return np.array(out).reshape(-1, 3)
+    return order[keep[:count]].reshape(-1, 3)

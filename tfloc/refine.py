@@ -36,6 +36,10 @@ class RefineConfig:
         gate_end: pair distance gate of the last iteration (metres).
         inlier_distance: truncation of the residual used to rank candidates (metres).
         damping: Levenberg–Marquardt damping added to the normal equations.
+        prune_after: after this many iterations only the ``keep`` candidates with the lowest
+            truncated residual go on, duplicates (within 5 cm of a better one) dropped
+            (0: never prune).
+        keep: see ``prune_after``.
     """
 
     iterations: int = 6
@@ -45,6 +49,8 @@ class RefineConfig:
     gate_end: float = 0.05
     inlier_distance: float = 0.05
     damping: float = 1e-6
+    prune_after: int = 3
+    keep: int = 2
 
 
 def _virtual_geometry(ranges: np.ndarray, laser: LaserSpec) -> tuple[np.ndarray, np.ndarray]:
@@ -94,7 +100,10 @@ def truncated_cost(residuals: np.ndarray, inlier_distance: float) -> np.ndarray:
 
 def refine(map_: Map, laser: LaserSpec, points: np.ndarray, poses: np.ndarray,
            config: RefineConfig = RefineConfig()) -> np.ndarray:
-    """Refine ``(K, 3)`` poses so the real ``points`` ``(M, 2)`` (sensor frame) lie on the map."""
+    """Refine ``(K, 3)`` poses so the real ``points`` ``(M, 2)`` (sensor frame) lie on the map.
+
+    Returns the refined poses: all ``K``, or the ``keep`` best if pruning is on (see
+    :class:`RefineConfig`)."""
     poses = np.array(poses, dtype=float).reshape(-1, 3)
     points = np.ascontiguousarray(points, dtype=float)
     cfg = config
@@ -110,4 +119,18 @@ def refine(map_: Map, laser: LaserSpec, points: np.ndarray, poses: np.ndarray,
                 h = h[enough] + cfg.damping * np.eye(3)
                 delta[enough] -= np.linalg.solve(h, g[enough][..., None])[..., 0]
         poses = _compose(poses, delta)
+        if it + 1 == cfg.prune_after and len(poses) > cfg.keep:
+            poses = _prune(poses, truncated_cost(np.abs(r), cfg.inlier_distance), cfg.keep)
     return poses
+
+
+def _prune(poses: np.ndarray, cost: np.ndarray, keep: int, same: float = 0.05) -> np.ndarray:
+    """The ``keep`` lowest-cost poses, counting poses within ``same`` metres of a better one
+    (converged to the same place) once."""
+    kept: list[int] = []
+    for i in np.argsort(cost, kind="stable"):
+        if all(np.hypot(*(poses[i, :2] - poses[j, :2])) >= same for j in kept):
+            kept.append(int(i))
+            if len(kept) == keep:
+                break
+    return poses[np.sort(kept)]

@@ -18,7 +18,9 @@ needs ~1800 cost evaluations per scan). Stages:
    (:mod:`tfloc.refine`), batched, with a shrinking outlier gate: centimetre accuracy once the
    pose is in the basin.
 4. **Selection** of the refined candidate with the lowest truncated point-to-line residual
-   (``select="residual"``), or the lowest turning-function Err (``select="tf"``).
+   (``select="residual"``), or the lowest turning-function Err (``select="tf"``); candidates
+   within ``tie_tolerance`` of the best (the scan sees the same geometry from both places, e.g.
+   a bare corner) are a tie, broken in favour of the one nearest the VP.
 
 Each stage can be switched off (``tf_seed``, ``grid``, ``refine``) for the ablation in
 ``benchmarks/tfplus_ablation.py``. It uses only the :class:`~tfloc.maps.base.Map` protocol and
@@ -70,6 +72,9 @@ class TfPlusConfig:
         candidates: candidates refined.
         separation: minimum distance between candidates.
         min_returns: fewer valid returns than this is a no-answer.
+        tie_tolerance: candidates whose cost is within this fraction of the best are a tie
+            (the scan sees the same geometry from both, e.g. a bare corner), broken by
+            distance to the VP (0: no tie-break).
         refinement: the point-to-line refinement's parameters.
         tf: the turning-function parameters (ShortStraw, polygon closure) of the seed; the
             resampling distance is 5 cm (the paper's S = 1 m gives edges too coarse for
@@ -96,6 +101,7 @@ class TfPlusConfig:
     candidates: int = 4
     separation: float = 0.3
     min_returns: int = 10
+    tie_tolerance: float = 0.1
     refinement: RefineConfig = RefineConfig()
     tf: TfConfig = TfConfig(spacing=0.05)
 
@@ -153,6 +159,17 @@ def tf_errs(problem: Problem, poses: np.ndarray, cfg: TfPlusConfig) -> np.ndarra
     return out
 
 
+def pick(cost: np.ndarray, poses: np.ndarray, vp: Pose, tie_tolerance: float) -> int:
+    """Index of the answer: the lowest ``cost``, or, among the candidates within a factor
+    ``1 + tie_tolerance`` of it (the scan cannot tell them apart), the one nearest the VP."""
+    best = float(np.min(cost))
+    tied = np.flatnonzero(cost <= best * (1.0 + tie_tolerance))
+    if len(tied) == 1:
+        return int(tied[0])
+    near = np.hypot(poses[tied, 0] - vp.x, poses[tied, 1] - vp.y)
+    return int(tied[np.argmin(near)])
+
+
 class TurningFunctionPlusMatcher:
     """``tf-plus``: turning-function heading seed, coarse grid, point-to-line refinement."""
 
@@ -193,7 +210,7 @@ class TurningFunctionPlusMatcher:
             cost = truncated_cost(line_residuals(problem.map, problem.laser, points, cands,
                                                  cfg.refinement.window),
                                   cfg.refinement.inlier_distance)
-        b = int(np.argmin(cost))
+        b = pick(cost, cands, vp, cfg.tie_tolerance)
         pose = Pose.from_array(cands[b])
         info.update({"status": "ok", "candidates": len(cands), "cost": float(cost[b])})
         return Estimate(pose, True, 1, int(evaluations), info)
