@@ -17,9 +17,11 @@ from .distance_field import DistanceField
 from .maps.base import Map
 
 
-def lattice(map_: Map, centre: np.ndarray, radius: float, step: float,
+def lattice(map_: Map, field: DistanceField, centre: np.ndarray, radius: float, step: float,
             clearance: float) -> np.ndarray:
-    """Free lattice positions ``(N, 2)`` (metres) within ``radius`` of ``centre``, centre first."""
+    """Free lattice positions ``(N, 2)`` (metres) within ``radius`` of ``centre``, centre first,
+    at least ``clearance`` from the map's points (by the distance field: a clearance query to
+    the map itself can cost more than the whole search on a map used once)."""
     k = int(np.floor(radius / step))
     g = np.arange(-k, k + 1) * step
     gx, gy = np.meshgrid(g, g)
@@ -27,8 +29,9 @@ def lattice(map_: Map, centre: np.ndarray, radius: float, step: float,
     off = off[np.hypot(off[:, 0], off[:, 1]) <= radius + 1e-9]
     off = off[np.argsort(np.hypot(off[:, 0], off[:, 1]), kind="stable")]
     xy = centre[None, :] + off
-    keep = map_.in_bounds(xy)
-    keep[keep] = map_.is_free(xy[keep], clearance)
+    keep = field(xy) >= clearance
+    keep[keep] = map_.in_bounds(xy[keep])
+    keep[keep] = map_.is_free(xy[keep])
     return xy[keep]
 
 

@@ -17,16 +17,17 @@ from .turning import TurningFunction
 
 
 def edge_histogram(tf: TurningFunction, bins: int, smoothing: float, skip_closure: bool) -> np.ndarray:
-    """Length-weighted histogram ``(bins,)`` of edge directions over [0, 2π), Gaussian-smoothed
-    (``smoothing`` radians, circular)."""
+    """Length-weighted histogram ``(bins,)`` of edge directions over [0, 2π), smoothed by a
+    circular Gaussian of ``smoothing`` radians."""
     lengths = np.diff(tf.breaks)
     angles = np.mod(tf.angles, 2 * np.pi)
     if skip_closure and len(angles) > 3:
         lengths, angles = lengths[1:-1], angles[1:-1]
     width = 2 * np.pi / bins
-    centres = (np.arange(bins) + 0.5) * width
-    d = (centres[None, :] - angles[:, None] + np.pi) % (2 * np.pi) - np.pi
-    return (lengths[:, None] * np.exp(-0.5 * (d / smoothing) ** 2)).sum(axis=0)
+    raw = np.bincount(np.minimum((angles / width).astype(np.int64), bins - 1), lengths, bins)
+    d = (np.arange(bins) + bins // 2) % bins - bins // 2            # circular bin offsets
+    kernel = np.exp(-0.5 * (d * width / smoothing) ** 2)
+    return np.real(np.fft.ifft(np.fft.fft(raw) * np.fft.fft(kernel)))
 
 
 def rotation_candidates(real: TurningFunction, virtual: TurningFunction, max_rotation: float,

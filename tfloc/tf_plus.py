@@ -189,11 +189,12 @@ class TurningFunctionPlusMatcher:
         heads, info = heading_seeds(problem, cfg)
         vp = problem.initial
         if cfg.grid:
-            positions = lattice(problem.map, vp.xy, cfg.search_radius, cfg.grid_step, cfg.clearance)
+            field = _field(problem.map, cfg)
+            positions = lattice(problem.map, field, vp.xy, cfg.search_radius, cfg.grid_step,
+                                cfg.clearance)
             if len(positions) == 0:
                 positions = vp.xy[None, :]
-            poses, scores = search(_field(problem.map, cfg), points, positions, heads,
-                                   cfg.scan_stride, cfg.shortlist)
+            poses, scores = search(field, points, positions, heads, cfg.scan_stride, cfg.shortlist)
             cands = best_candidates(poses, scores, cfg.candidates, cfg.separation)
             evaluations = len(positions) * len(heads) + len(poses)
         else:
