@@ -86,9 +86,15 @@ def line_residuals(map_: Map, laser: LaserSpec, points: np.ndarray, poses: np.nd
     """Point-to-line distances ``(K, M)`` (metres) of the real ``points`` ``(M, 2)`` at ``poses``
     ``(K, 3)`` against their virtual scans; NaN where a point has no virtual neighbour within
     ``gate``."""
-    q, normal = _virtual_geometry(map_.raycast(poses, laser), laser)
-    _, _, r = pairs_kernel(points, np.zeros((len(poses), 3)), q, normal, laser.angle_min,
-                           laser.resolution, window, gate)
+    return residuals_to(map_.raycast(poses, laser), laser, points, window, gate)
+
+
+def residuals_to(virtual: np.ndarray, laser: LaserSpec, points: np.ndarray, window: int = 6,
+                 gate: float = 1.0) -> np.ndarray:
+    """:func:`line_residuals` against given virtual scans ``(K, n_beams)`` (ranges, metres)."""
+    q, normal = _virtual_geometry(virtual, laser)
+    _, _, r = pairs_kernel(np.ascontiguousarray(points, dtype=float), np.zeros((len(virtual), 3)),
+                           q, normal, laser.angle_min, laser.resolution, window, gate)
     return np.abs(r)
 
 

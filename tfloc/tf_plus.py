@@ -17,8 +17,8 @@ needs ~1800 cost evaluations per scan). Stages:
 3. **Point-to-line refinement** of every candidate against its own virtual scan
    (:mod:`tfloc.refine`), batched, with a shrinking outlier gate: centimetre accuracy once the
    pose is in the basin.
-4. **Selection** of the refined candidate with the lowest truncated point-to-line residual
-   (``select="residual"``), or the lowest turning-function Err (``select="tf"``); candidates
+4. **Selection** of the refined candidate with the lowest per-beam cost (truncated point-to-line
+   residual, plus see-through beams, :mod:`tfloc.scan_cost`; ``select="residual"``), or the lowest turning-function Err (``select="tf"``); candidates
    within ``tie_tolerance`` of the best (the scan sees the same geometry from both places, e.g.
    a bare corner) are a tie, broken in favour of the one nearest the VP.
 
@@ -40,7 +40,8 @@ from .heading_histogram import rotation_candidates
 from .maps.base import Map
 from .pose import Pose
 from .problem import Estimate, Problem
-from .refine import RefineConfig, line_residuals, refine, truncated_cost
+from .refine import RefineConfig, refine
+from .scan_cost import scan_cost
 from .tf import TfConfig, scan_turning_function
 from .turning import match
 
@@ -72,6 +73,7 @@ class TfPlusConfig:
         candidates: candidates refined.
         separation: minimum distance between candidates.
         min_returns: fewer valid returns than this is a no-answer.
+        beam_check: count see-through beams in the selection cost (:mod:`tfloc.scan_cost`).
         tie_tolerance: candidates whose cost is within this fraction of the best are a tie
             (the scan sees the same geometry from both, e.g. a bare corner), broken by
             distance to the VP (0: no tie-break).
@@ -102,6 +104,7 @@ class TfPlusConfig:
     separation: float = 0.3
     min_returns: int = 10
     tie_tolerance: float = 0.1
+    beam_check: bool = True
     refinement: RefineConfig = RefineConfig()
     tf: TfConfig = TfConfig(spacing=0.05)
 
@@ -208,17 +211,17 @@ class TurningFunctionPlusMatcher:
         if cfg.select == "tf":
             cost = tf_errs(problem, cands, cfg)
         else:
-            cost = truncated_cost(line_residuals(problem.map, problem.laser, points, cands,
-                                                 cfg.refinement.window),
-                                  cfg.refinement.inlier_distance)
+            cost = scan_cost(problem.map, problem.laser, problem.ranges, cands,
+                             cfg.refinement.window, cfg.refinement.inlier_distance, cfg.beam_check)
         b = pick(cost, cands, vp, cfg.tie_tolerance)
         pose = Pose.from_array(cands[b])
         info.update({"status": "ok", "candidates": len(cands), "cost": float(cost[b])})
         return Estimate(pose, True, 1, int(evaluations), info)
 
     def score(self, problem: Problem, pose: Pose) -> float:
-        """Root of the truncated mean squared point-to-line residual at ``pose`` (metres)."""
-        cfg = self.config.refinement
-        r = line_residuals(problem.map, problem.laser, problem.points, pose.as_array()[None, :],
-                           cfg.window)
-        return float(np.sqrt(truncated_cost(r, cfg.inlier_distance)[0]))
+        """The selection objective at ``pose`` (:func:`tfloc.scan_cost.scan_cost`), as its root
+        (metres): the root mean square of the truncated per-beam residuals."""
+        cfg = self.config
+        cost = scan_cost(problem.map, problem.laser, problem.ranges, pose.as_array()[None, :],
+                         cfg.refinement.window, cfg.refinement.inlier_distance, cfg.beam_check)
+        return float(np.sqrt(cost[0]))
