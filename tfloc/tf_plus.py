@@ -95,10 +95,10 @@ class TfPlusConfig:
     rotation_seeds: int = 3
     max_rotation: float = math.radians(20.0)
     heading_span: float = math.radians(17.0)
-    heading_step: float = math.radians(2.0)
+    heading_step: float = math.radians(3.0)
     field_resolution: float = 0.05
     field_truncation: float = 0.3
-    scan_stride: int = 6
+    scan_stride: int = 9
     shortlist: int = 64
     candidates: int = 4
     separation: float = 0.3
