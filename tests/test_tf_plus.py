@@ -90,10 +90,13 @@ def test_config_overrides_and_bad_parameters():
 def test_ablation_switches_run(test_room, lms200):
     ranges = noisy_scan(test_room, lms200, TRUE)
     init = Pose(TRUE.x + 0.2, TRUE.y - 0.1, TRUE.theta + 0.05)
-    for kw in ({"tf_seed": False}, {"heading_sweep": False}, {"grid": False}, {"refine": False},
-               {"select": "tf"}):
+    for kw in ({"tf_seed": False}, {"heading_sweep": False}, {"grid": False}, {"select": "tf"},
+               {"tie_tolerance": 0.0}, {"beam_check": False}):
         est = TurningFunctionPlusMatcher(**kw).localize(Problem(test_room, lms200, ranges, init))
-        assert est.pose.distance_to(TRUE) < 0.15, kw
+        assert est.pose.distance_to(TRUE) < 0.02, kw
+    # without refinement the answer is a grid pose (0.2 m lattice): near, not exact
+    est = TurningFunctionPlusMatcher(refine=False).localize(Problem(test_room, lms200, ranges, init))
+    assert 0.0 < est.pose.distance_to(TRUE) < 0.5
 
 
 def test_edge_histogram_recovers_a_pure_rotation(test_room, lms200):
