@@ -121,3 +121,15 @@ def test_distance_field_is_zero_on_walls_and_truncated_far(test_room):
     pts, _ = test_room.sample_points(0.5)
     assert np.all(f(pts) <= 0.05)
     assert np.all(f(np.array([[-50.0, -50.0], [5.0, 100.0]])) == pytest.approx(0.3))
+
+
+def test_see_through_beams_cost_in_the_score(lms200):
+    # a room whose far wall the real scan misses entirely: with the beam check those beams count
+    room = VectorMap(outline=box(0, 0, 4, 3))
+    pose = Pose(1.0, 1.5, 0.0)
+    ranges = room.raycast(pose, lms200)
+    ranges[60:120] = np.inf                                   # the beams towards x = 4
+    p = Problem(room, lms200, ranges, pose)
+    with_check = TurningFunctionPlusMatcher().score(p, pose)
+    without = TurningFunctionPlusMatcher(beam_check=False).score(p, pose)
+    assert without < 1e-6 < with_check
