@@ -26,6 +26,46 @@ from numba import njit
 
 
 @njit(cache=True, nogil=True)
+def _resample_into(points: np.ndarray, spacing: float, out: np.ndarray) -> int:
+    """Algorithm 1 written into ``out``; returns the number of points, or -1 if ``out`` is too
+    small (``out`` of shape ``(0, 2)`` just counts)."""
+    n = points.shape[0]
+    cap = out.shape[0]
+    count_only = cap == 0
+    m = 0
+    p1x, p1y = points[0, 0], points[0, 1]
+    if not count_only:
+        out[0, 0], out[0, 1] = p1x, p1y
+    m += 1
+    i = 1
+    surely_inside = spacing * spacing * (1.0 - 1e-9)   # d² below this ⇒ d ≤ spacing, no sqrt
+    while i < n:
+        dx, dy = points[i, 0] - p1x, points[i, 1] - p1y
+        d2 = dx * dx + dy * dy
+        if d2 < surely_inside:
+            i += 1
+            continue
+        d = np.sqrt(d2)
+        if d > spacing:
+            p1x, p1y = p1x + dx / d * spacing, p1y + dy / d * spacing
+            if not count_only:
+                if m >= cap:
+                    return -1
+                out[m, 0], out[m, 1] = p1x, p1y
+            m += 1
+        else:
+            i += 1
+    lx, ly = points[n - 1, 0] - p1x, points[n - 1, 1] - p1y
+    if np.sqrt(lx * lx + ly * ly) > 0.5 * spacing:
+        if not count_only:
+            if m >= cap:
+                return -1
+            out[m, 0], out[m, 1] = points[n - 1, 0], points[n - 1, 1]
+        m += 1
+    return m
+
+
+@njit(cache=True, nogil=True)
 def resample(points: np.ndarray, spacing: float) -> np.ndarray:
     """Algorithm 1: walk along ``points`` ``(N, 2)`` and emit points exactly ``spacing`` metres
     apart (chord length from the last emitted point towards the next input point).
@@ -35,37 +75,21 @@ def resample(points: np.ndarray, spacing: float) -> np.ndarray:
     the walk follows chords, not the input path, so it cuts corners by up to ``spacing``.
     """
     n = points.shape[0]
-    out = np.empty((max(2, n) * 4 + 16, 2))
     if n == 0:
-        return out[:0]
-    m = 0
-    p1x, p1y = points[0, 0], points[0, 1]
-    out[m, 0], out[m, 1] = p1x, p1y
-    m += 1
-    i = 1
-    while i < n:
-        p2x, p2y = points[i, 0], points[i, 1]
-        dx, dy = p2x - p1x, p2y - p1y
-        d = np.sqrt(dx * dx + dy * dy)
-        if d > spacing:
-            p1x, p1y = p1x + dx / d * spacing, p1y + dy / d * spacing
-            if m >= out.shape[0]:
-                grown = np.empty((out.shape[0] * 2, 2))
-                grown[:m] = out[:m]
-                out = grown
-            out[m, 0], out[m, 1] = p1x, p1y
-            m += 1
-        else:
-            i += 1
-    lx, ly = points[n - 1, 0] - p1x, points[n - 1, 1] - p1y
-    if np.sqrt(lx * lx + ly * ly) > 0.5 * spacing:
-        if m >= out.shape[0]:
-            grown = np.empty((out.shape[0] + 1, 2))
-            grown[:m] = out[:m]
-            out = grown
-        out[m, 0], out[m, 1] = points[n - 1, 0], points[n - 1, 1]
-        m += 1
-    return out[:m].copy()
+        return np.empty((0, 2))
+    path = 0.0                 # M ≤ path/spacing + 2 per input point (each emission walks S)
+    for i in range(1, n):
+        dx, dy = points[i, 0] - points[i - 1, 0], points[i, 1] - points[i - 1, 1]
+        path += np.sqrt(dx * dx + dy * dy)
+    cap = 3 * n + 16
+    if np.isfinite(path) and path / spacing < 1e9:
+        cap += int(path / spacing)
+    out = np.empty((cap, 2))
+    m = _resample_into(points, spacing, out)
+    if m < 0:                  # not expected; count exactly and redo
+        out = np.empty((_resample_into(points, spacing, np.empty((0, 2))), 2))
+        m = _resample_into(points, spacing, out)
+    return out[:m]
 
 
 def straws(points: np.ndarray, window: int = 1) -> np.ndarray:
@@ -74,35 +98,95 @@ def straws(points: np.ndarray, window: int = 1) -> np.ndarray:
     return np.einsum("ij,ij->i", d, d)
 
 
+@njit(cache=True, nogil=True)
+def _median(values: np.ndarray) -> float:
+    """``np.median`` of a 1-D array (the mean of the two middle values when the size is even)."""
+    v = np.sort(values)
+    n = v.shape[0]
+    h = n // 2
+    if n % 2 == 1:
+        return v[h]
+    return (v[h - 1] + v[h]) / 2.0
+
+
+@njit(cache=True, nogil=True)
+def _candidates(points: np.ndarray, window: int, t: float) -> np.ndarray:
+    """Algorithm 2 for ``len(points) > 2·window`` (see :func:`corner_candidates`)."""
+    n = points.shape[0]
+    m = n - 2 * window
+    s = np.empty(m)
+    for i in range(m):
+        dx = points[i + 2 * window, 0] - points[i, 0]
+        dy = points[i + 2 * window, 1] - points[i, 1]
+        s[i] = dx * dx + dy * dy
+    cut = _median(s) * t
+    out = np.empty(m + 2, dtype=np.int64)
+    out[0] = 0
+    k = 1
+    for i in range(m):
+        if s[i] < cut:
+            out[k] = i + window
+            k += 1
+    out[k] = n - 1
+    return out[:k + 1].copy()
+
+
 def corner_candidates(points: np.ndarray, window: int = 1, t: float = 0.99) -> np.ndarray:
     """Algorithm 2: indices of the first point, every point whose squared straw is below
     ``median × t``, and the last point (sorted, unique)."""
     n = len(points)
     if n <= 2 * window:
         return np.arange(n) if n < 2 else np.array([0, n - 1])
-    s = straws(points, window)
-    below = np.flatnonzero(s < np.median(s) * t) + window
-    return np.concatenate(([0], below, [n - 1]))
+    return _candidates(np.asarray(points, dtype=float), int(window), float(t))
 
 
 @njit(cache=True, nogil=True)
 def merge_lines(points: np.ndarray, corners: np.ndarray, threshold: float = 0.95) -> np.ndarray:
     """Algorithm 3 applied to consecutive corner triples: drop the middle corner ``c_m``
-    whenever the path from ``c_l`` to ``c_n`` is a line, i.e. chord / path length > threshold."""
-    seg = np.sqrt(((points[1:] - points[:-1]) ** 2).sum(axis=1))
-    cum = np.zeros(points.shape[0])
-    cum[1:] = np.cumsum(seg)
-    keep = list(corners)
-    i = 1
-    while i < len(keep) - 1:
-        a, b = keep[i - 1], keep[i + 1]
+    whenever the path from ``c_l`` to ``c_n`` is a line, i.e. chord / path length > threshold.
+
+    One pass: the last kept corner, the pending middle corner and the next candidate form the
+    triple; a dropped middle is replaced by the next candidate (the same triples, in the same
+    order, as removing it from the list and testing again)."""
+    n = points.shape[0]
+    cum = np.zeros(n)
+    for i in range(1, n):
+        dx, dy = points[i, 0] - points[i - 1, 0], points[i, 1] - points[i - 1, 1]
+        cum[i] = cum[i - 1] + np.sqrt(dx * dx + dy * dy)
+    k = corners.shape[0]
+    if k < 3:
+        return corners.astype(np.int64)
+    keep = np.empty(k, dtype=np.int64)
+    keep[0] = corners[0]
+    m = 1
+    mid = corners[1]
+    for j in range(2, k):
+        a, b = keep[m - 1], corners[j]
         path = cum[b] - cum[a]
         dx, dy = points[b, 0] - points[a, 0], points[b, 1] - points[a, 1]
-        if path > 0.0 and np.sqrt(dx * dx + dy * dy) / path > threshold:
-            keep.pop(i)
-        else:
-            i += 1
-    return np.array(keep, dtype=np.int64)
+        if not (path > 0.0 and np.sqrt(dx * dx + dy * dy) / path > threshold):
+            keep[m] = mid
+            m += 1
+        mid = b
+    keep[m] = mid
+    return keep[:m + 1].copy()
+
+
+@njit(cache=True, nogil=True)
+def _shortstraw(points: np.ndarray, spacing: float, window: int, t: float,
+                line_threshold: float) -> np.ndarray:
+    """Algs. 1–3 in one compiled call (see :func:`shortstraw`)."""
+    res = resample(points, spacing)
+    n = res.shape[0]
+    if n <= 2 * window:
+        cand = np.arange(n) if n < 2 else np.array([0, n - 1], dtype=np.int64)
+    else:
+        cand = _candidates(res, window, t)
+    keep = merge_lines(res, cand, line_threshold)
+    out = np.empty((keep.shape[0], 2))
+    for i in range(keep.shape[0]):
+        out[i, 0], out[i, 1] = res[keep[i], 0], res[keep[i], 1]
+    return out
 
 
 def is_line(points: np.ndarray, a: int, b: int, threshold: float = 0.95) -> bool:
@@ -121,6 +205,4 @@ def shortstraw(points: np.ndarray, spacing: float, window: int = 1, t: float = 0
     pts = np.ascontiguousarray(points, dtype=float)
     if len(pts) < 2:
         return pts.copy()
-    res = resample(pts, float(spacing))
-    cand = corner_candidates(res, window, t)
-    return res[merge_lines(res, cand.astype(np.int64), float(line_threshold))]
+    return _shortstraw(pts, float(spacing), int(window), float(t), float(line_threshold))

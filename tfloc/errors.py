@@ -33,3 +33,7 @@ class MatcherError(TflocError):
 
 class ConfigError(TflocError):
     """A run configuration (TOML) or a command-line option is invalid."""
+
+
+class BagError(TflocError):
+    """A ROS bag cannot be read or imported: unreadable file, missing topic, bad message."""

@@ -7,6 +7,26 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
+from numba import njit
+
+
+@njit(cache=True, nogil=True)
+def _returns_to_points(ranges: np.ndarray, directions: np.ndarray, max_range: float) -> np.ndarray:
+    """Eq. 4 for the beams with a return (finite, > 0, < ``max_range``), in beam order."""
+    n = 0
+    for i in range(ranges.shape[0]):
+        r = ranges[i]
+        if np.isfinite(r) and r > 0.0 and r < max_range:
+            n += 1
+    out = np.empty((n, 2))
+    k = 0
+    for i in range(ranges.shape[0]):
+        r = ranges[i]
+        if np.isfinite(r) and r > 0.0 and r < max_range:
+            out[k, 0] = directions[i, 0] * r
+            out[k, 1] = directions[i, 1] * r
+            k += 1
+    return out
 
 
 @dataclass(frozen=True)
@@ -55,11 +75,17 @@ class LaserSpec:
         a.setflags(write=False)
         return a
 
+    @cached_property
+    def directions(self) -> np.ndarray:
+        """Unit vectors ``(cos φᵢ, sin φᵢ)`` of the beams, shape ``(n_beams, 2)`` (read-only)."""
+        d = np.column_stack((np.cos(self.angles), np.sin(self.angles)))
+        d.setflags(write=False)
+        return d
+
     def valid(self, ranges: np.ndarray) -> np.ndarray:
         """Mask of beams with a return: finite, positive and below ``max_range``."""
         r = np.asarray(ranges, dtype=float)
-        with np.errstate(invalid="ignore"):
-            return np.isfinite(r) & (r > 0.0) & (r < self.max_range)
+        return np.isfinite(r) & (r > 0.0) & (r < self.max_range)
 
     def to_points(self, ranges: np.ndarray, keep_invalid: bool = False) -> np.ndarray:
         """Eq. 4: ranges (metres) → points in the sensor frame, shape ``(k, 2)``.
@@ -67,10 +93,11 @@ class LaserSpec:
         Beams with no return are dropped unless ``keep_invalid``, in which case they are NaN rows.
         """
         r = np.asarray(ranges, dtype=float)
-        with np.errstate(invalid="ignore"):
-            pts = np.column_stack((np.cos(self.angles) * r, np.sin(self.angles) * r))
+        if not keep_invalid and r.shape == (self.n_beams,):
+            return _returns_to_points(r, self.directions, float(self.max_range))
         ok = self.valid(r)
         if keep_invalid:
-            pts[~ok] = np.nan
+            pts = np.full((len(r), 2), np.nan)
+            pts[ok] = self.directions[ok] * r[ok, None]
             return pts
-        return pts[ok]
+        return self.directions[ok] * r[ok, None]

@@ -48,6 +48,8 @@ from .pose import Pose, wrap_angle
 from .problem import Estimate, Problem
 from .turning import TurningFunction, match, turning_function
 
+_ORIGIN = np.zeros((1, 2))
+
 
 @dataclass(frozen=True)
 class TfConfig:
@@ -101,7 +103,7 @@ def scan_corners(ranges: np.ndarray, laser: LaserSpec, config: TfConfig = TfConf
 def scan_polygon(corners: np.ndarray, config: TfConfig = TfConfig()) -> np.ndarray:
     """The closed scan polygon of a scan's corners (through the sensor origin if configured)."""
     if config.close_through_origin:
-        return np.vstack((np.zeros((1, 2)), corners))
+        return np.concatenate((_ORIGIN, corners))
     return corners
 
 
@@ -129,7 +131,11 @@ class _Cost:
         cfg, prob = self.config, self.problem
         errs = np.full(len(poses), cfg.penalty)
         rots = np.zeros(len(poses))
-        free = prob.map.is_free(poses[:, :2])
+        xy = poses[:, :2]
+        if len(poses) > 1 and (xy == xy[0]).all():  # the seven orientations share one position
+            free = np.repeat(prob.map.is_free(xy[:1]), len(poses))
+        else:
+            free = prob.map.is_free(xy)
         if free.any():
             scans = prob.map.raycast(poses[free], prob.laser)
             for j, ranges in zip(np.flatnonzero(free), scans, strict=True):

@@ -2,7 +2,8 @@
 
 ``scans.csv`` columns: ``scan_id,group,true_x,true_y,true_theta,init_x,init_y,init_theta,ranges``
 (metres, radians). ``true_*`` may be empty (truth unknown). ``ranges`` holds space-separated
-floats; ``inf``, ``nan`` or values ≥ max_range mean no return.
+floats; ``inf``, ``nan`` or values ≥ max_range mean no return. Optional columns: ``stamp``
+(the scan's time in seconds, e.g. from a ROS bag; may be empty) and ``ref_ranges``.
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ class Scan:
     true: Pose | None = None
     line: int = 0  # 1-based line in scans.csv, for messages
     ref_ranges: np.ndarray | None = None  # scan-to-scan datasets: the reference scan (see map_for)
+    stamp: float | None = None  # seconds (optional ``stamp`` column), e.g. the ROS header stamp
 
 
 @dataclass(frozen=True, eq=False)
@@ -149,11 +151,20 @@ def iter_scans(scenario: Scenario) -> Iterator[Scan]:
                 raise DatasetError(f"{path}:{line}: duplicate scan_id {sid!r}")
             seen.add(sid)
             ref = row.get("ref_ranges")
+            stamp = (row.get("stamp") or "").strip()
             yield Scan(sid, row["group"].strip(),
                        parse_ranges(row["ranges"], scenario.laser, path, line),
                        _pose(row, "init", path, line, optional=False),
                        _pose(row, "true", path, line, optional=True), line,
-                       parse_ranges(ref, scenario.laser, path, line) if ref else None)
+                       parse_ranges(ref, scenario.laser, path, line) if ref else None,
+                       _stamp(stamp, path, line) if stamp else None)
+
+
+def _stamp(text: str, path: Path, line: int) -> float:
+    t = _float(text, path, line, "stamp")
+    if not math.isfinite(t):
+        raise DatasetError(f"{path}:{line}: stamp is not finite: {text!r}")
+    return t
 
 
 def map_for(scenario: Scenario, scan: Scan, cache: dict | None = None):
@@ -184,7 +195,8 @@ def _fmt(v: float) -> str:
 def write_scenario(root: str | Path, name: str, map_path: str | Path, laser: LaserSpec,
                    scans: Iterable[Scan], description: str = "", **extra) -> Path:
     """Write a dataset directory (``scenario.json`` + ``scans.csv``); ``map_path`` is stored
-    relative to ``root``. Ranges are written with 0.1 mm precision."""
+    relative to ``root``. Ranges are written with 0.1 mm precision; a ``stamp`` column (µs) is
+    written only if some scan has a stamp."""
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
     rel = Path(os.path.relpath(Path(map_path).resolve(), root.resolve()))
@@ -195,13 +207,15 @@ def write_scenario(root: str | Path, name: str, map_path: str | Path, laser: Las
     (root / "scenario.json").write_text(json.dumps(doc, indent=2) + "\n")
     scans = list(scans)
     with_ref = any(s.ref_ranges is not None for s in scans)
+    with_stamp = any(s.stamp is not None for s in scans)
     with (root / "scans.csv").open("w", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow(COLUMNS + (["ref_ranges"] if with_ref else []))
+        w.writerow(COLUMNS + (["stamp"] if with_stamp else []) + (["ref_ranges"] if with_ref else []))
         for s in scans:
             t = ["", "", ""] if s.true is None else [f"{s.true.x:.6f}", f"{s.true.y:.6f}", f"{s.true.theta:.7f}"]
             ref = [] if not with_ref else [" ".join(_fmt(v) for v in s.ref_ranges)
                                            if s.ref_ranges is not None else ""]
+            stamp = [] if not with_stamp else ["" if s.stamp is None else f"{s.stamp:.6f}"]
             w.writerow([s.scan_id, s.group, *t, f"{s.initial.x:.6f}", f"{s.initial.y:.6f}",
-                        f"{s.initial.theta:.7f}", " ".join(_fmt(v) for v in s.ranges), *ref])
+                        f"{s.initial.theta:.7f}", " ".join(_fmt(v) for v in s.ranges), *stamp, *ref])
     return root

@@ -1,0 +1,43 @@
+"""The accuracy regression guard: rerun the fixed-seed subset and compare with the reference.
+
+Fails with a readable table of every metric that got worse than its tolerance allows (see
+tfloc/harness/guard.py for the tolerances and why). Update the reference deliberately with
+`tfloc guard --update`.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+from tfloc.harness import guard
+from tfloc.harness.config import load_config
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def config(tmp_path_factory):
+    os.chdir(ROOT)  # the run configuration's paths are relative to the project root
+    cfg = load_config(ROOT / guard.CONFIG)
+    return cfg.with_overrides(out=tmp_path_factory.mktemp("guard") / "run")
+
+
+@pytest.fixture(scope="module")
+def reference():
+    return guard.read_reference(ROOT / guard.REFERENCE)
+
+
+def test_reference_covers_every_guarded_matcher(config, reference):
+    assert {m.label for m in config.matchers} <= set(reference.matcher)
+    assert set(reference.group) == {f"d{i}-a{j}" for i in (1, 2, 3) for j in (1, 2, 3)} | {"all"}
+    assert (reference[reference.group != "all"].n == config.limit_per_group).all()
+
+
+def test_no_accuracy_regression(config, reference):
+    current = guard.run_subset(config, progress=False)
+    diff = guard.compare(current, reference)
+    assert len(diff) == len(reference) * len(guard.RULES)
+    assert not diff.worse.any(), "accuracy regression:\n" + guard.format_table(diff)

@@ -1,0 +1,126 @@
+"""The runner: error and timeout rows, resume after SIGKILL, outcome classification, bad data."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from tfloc.errors import DatasetError
+from tfloc.harness.config import MatcherSpec, RunConfig
+from tfloc.harness.dataset import Scan, write_scenario
+from tfloc.harness.results import read_estimates
+from tfloc.harness.runner import run
+from tfloc.pose import Pose
+
+ROOT = Path(__file__).resolve().parents[1]
+ROOM = ROOT / "data" / "maps" / "test-room.geojson"
+TESTS = Path(__file__).resolve().parent
+
+
+def make_dataset(root: Path, m, laser, n: int = 6, offset=(0.2, -0.1)) -> Path:
+    """``n`` scans in the test room; initial = true − offset (so true = initial + offset)."""
+    scans = []
+    for i in range(n):
+        true = Pose(3.0 + 0.3 * (i % 3), 3.5 + 0.4 * (i // 3), 0.1 * i)
+        init = Pose(true.x - offset[0], true.y - offset[1], true.theta)
+        scans.append(Scan(f"s{i}", f"g{i % 2}", m.raycast(true, laser), init, true))
+    return write_scenario(root, root.name, ROOM, laser, scans)
+
+
+def cfg(ds: Path, out: Path, *specs: MatcherSpec, **kw) -> RunConfig:
+    return RunConfig(name="t", out=out, datasets=(ds,), matchers=specs, **kw)
+
+
+def test_raising_and_hanging_matchers_leave_a_complete_run(tmp_path, test_room, lms200):
+    ds = make_dataset(tmp_path / "ds", test_room, lms200)
+    out = run(cfg(ds, tmp_path / "run", MatcherSpec.make("toy_matchers:Raises", label="raises"),
+                  MatcherSpec.make("toy_matchers:Hangs", {"hang_every": 3}, label="hangs"),
+                  MatcherSpec.make("toy_matchers:Stay", label="stay"),
+                  jobs=2, timeout_s=3.0), progress=False)
+    df = read_estimates(out)
+    assert len(df) == 18 and not df.duplicated(["dataset", "scan_id", "matcher"]).any()
+    assert df[df.matcher == "raises"].status.str.startswith("error:ValueError: toy failure").any()
+    assert (df[df.matcher == "hangs"].status == "timeout").any()
+    assert (df[df.matcher == "stay"].status == "ok").all()
+    bad = df[df.status != "ok"]
+    assert (bad.outcome == "no-answer").all() and bad.status.str.contains("\n").sum() == 0
+
+
+@pytest.mark.parametrize("false_value, outcome", [(0.5, "local-optimum"), (-0.1, "ambiguous")])
+def test_outcome_is_decided_by_the_matchers_own_objective(tmp_path, test_room, lms200,
+                                                           false_value, outcome):
+    ds = make_dataset(tmp_path / "ds", test_room, lms200, n=2)
+    spec = MatcherSpec.make("toy_matchers:TwoMinima", {"to_true": [0.2, -0.1], "to_false": [1.0, 0.5],
+                                                       "false_value": false_value}, label="toy")
+    df = read_estimates(run(cfg(ds, tmp_path / "run", spec, jobs=1), progress=False))
+    assert (df.outcome == outcome).all()
+    assert (df.score_true < df.score_est).all() == (outcome == "local-optimum")
+
+
+def test_success_outcome(tmp_path, test_room, lms200):
+    ds = make_dataset(tmp_path / "ds", test_room, lms200, n=2, offset=(0.05, 0.0))
+    df = read_estimates(run(cfg(ds, tmp_path / "run", MatcherSpec.make("toy_matchers:Stay", label="stay"),
+                                jobs=1), progress=False))
+    assert (df.outcome == "success").all() and df.dist_err_m.round(6).eq(0.05).all()
+
+
+def test_resume_after_sigkill_has_every_task_exactly_once(tmp_path, test_room, lms200):
+    ds = make_dataset(tmp_path / "ds", test_room, lms200, n=12)
+    out = tmp_path / "run"
+    cmd = [sys.executable, "-m", "tfloc.cli", "bench", str(ds), "--out", str(out), "--jobs", "2",
+           "--matchers", "toy_matchers:Stay,toy_matchers:TwoMinima", "--no-progress", "--timeout", "30"]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(TESTS), str(ROOT)])}
+    proc = subprocess.Popen(cmd, env=env, start_new_session=True, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE)
+    est = out / "estimates.csv"
+    deadline = time.time() + 120
+    while time.time() < deadline:
+        if est.exists() and est.read_text().count("\n") >= 4:
+            break
+        time.sleep(0.05)
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    n_before = est.read_text().count("\n") - 1
+    # a torn last line, as a kill in the middle of a write leaves it
+    with est.open("a") as fh:
+        fh.write("ds,s99,g0,toy_matchers:Stay,3.0,3.5")
+    r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    df = read_estimates(out)
+    keys = df[["dataset", "scan_id", "matcher"]]
+    assert len(df) == 24 and not keys.duplicated().any()
+    assert set(df.scan_id) == {f"s{i}" for i in range(12)}
+    assert n_before < 24
+    run_json = json.loads((out / "run.json").read_text())
+    assert len(run_json["sessions"]) == 2 and run_json["sessions"][1]["already_done"] >= n_before
+
+
+def test_malformed_row_is_rejected_with_file_and_line(tmp_path, test_room, lms200):
+    ds = make_dataset(tmp_path / "ds", test_room, lms200, n=3)
+    lines = (ds / "scans.csv").read_text().splitlines()
+    lines[2] = lines[2].rsplit(" ", 3)[0]
+    (ds / "scans.csv").write_text("\n".join(lines) + "\n")
+    with pytest.raises(DatasetError, match=r"scans\.csv:3: 178 ranges, expected 181"):
+        run(cfg(ds, tmp_path / "run", MatcherSpec.make("toy_matchers:Stay")), progress=False)
+    r = subprocess.run([sys.executable, "-m", "tfloc.cli", "bench", str(ds), "--out",
+                        str(tmp_path / "r2"), "--matchers", "tf"], capture_output=True, text=True)
+    assert r.returncode == 2 and "scans.csv:3:" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_run_json_records_config_versions_and_machine(tmp_path, test_room, lms200):
+    ds = make_dataset(tmp_path / "ds", test_room, lms200, n=1)
+    out = run(cfg(ds, tmp_path / "run", MatcherSpec.make("toy_matchers:Stay", label="stay"), jobs=1),
+              progress=False)
+    doc = json.loads((out / "run.json").read_text())
+    assert doc["config"]["matchers"][0]["label"] == "stay"
+    assert doc["versions"]["numpy"] and doc["machine"]["cpu_count"] >= 1
+    assert doc["datasets"] == {"ds": str(ds)}
+    assert isinstance(pd.read_csv(out / "estimates.csv"), pd.DataFrame)

@@ -1,0 +1,140 @@
+"""The beam-interval raycast kernel against the brute-force oracle and an analytic room."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from tfloc.laser import LaserSpec
+from tfloc.maps._raycast import raycast_segments, raycast_segments_bruteforce
+from tfloc.maps.vector import VectorMap
+from tfloc.pose import Pose
+
+LASERS = [
+    LaserSpec.lms200(),
+    LaserSpec.from_degrees(30.0, 360.0, 1.0, -180.0),          # full circle, first = last beam
+    LaserSpec.from_degrees(8.0, 359.0, 1.0, 0.0),              # wraps through the heading
+    LaserSpec.from_degrees(5.6, 240.0, 0.36),                  # URG-like, 667 beams
+    LaserSpec.from_degrees(10.0, 270.0, 0.25, -135.0),
+]
+
+
+def _same(fast: np.ndarray, brute: np.ndarray) -> None:
+    assert fast.shape == brute.shape
+    np.testing.assert_array_equal(np.isinf(fast), np.isinf(brute))
+    np.testing.assert_allclose(fast, brute, rtol=0.0, atol=1e-9)
+
+
+def _both(poses, laser, segs):
+    poses = np.ascontiguousarray(np.asarray(poses, dtype=float).reshape(-1, 3))
+    segs = np.ascontiguousarray(np.asarray(segs, dtype=float).reshape(-1, 4))
+    a = np.asarray(laser.angles, dtype=float)
+    return (raycast_segments(poses, a, segs, laser.max_range),
+            raycast_segments_bruteforce(poses, a, segs, laser.max_range))
+
+
+@pytest.mark.parametrize("laser", LASERS, ids=lambda s: f"{math.degrees(s.fov):.0f}deg")
+@pytest.mark.parametrize("seed", range(8))
+def test_random_maps_match_bruteforce(laser, seed):
+    rng = np.random.default_rng(seed)
+    n = rng.integers(1, 150)
+    a = rng.uniform(-10, 10, (n, 2))
+    length = rng.choice([0.05, 0.5, 3.0, 15.0], n) * rng.uniform(0.1, 1.0, n)
+    phi = rng.uniform(-np.pi, np.pi, n)
+    segs = np.column_stack((a, a + length[:, None] * np.column_stack((np.cos(phi), np.sin(phi)))))
+    poses = np.column_stack((rng.uniform(-10, 10, (40, 2)), rng.uniform(-4, 4, 40)))
+    fast, brute = _both(poses, laser, segs)
+    assert np.isfinite(brute).any()
+    _same(fast, brute)
+
+
+@pytest.mark.parametrize("laser", LASERS[:3], ids=lambda s: f"{math.degrees(s.fov):.0f}deg")
+def test_endpoints_on_beams_and_collinear_segments(laser):
+    """Segment ends exactly on beam directions, segments along beams, poses on segments/ends."""
+    rng = np.random.default_rng(3)
+    pose = np.array([0.3, -0.2, 0.4])
+    ang = pose[2] + laser.angles
+    segs = []
+    for i in range(0, laser.n_beams, 7):
+        r1, r2 = rng.uniform(0.5, 9.0, 2)
+        j = min(i + int(rng.integers(0, 4)), laser.n_beams - 1)
+        p1 = pose[:2] + r1 * np.array([np.cos(ang[i]), np.sin(ang[i])])
+        p2 = pose[:2] + r2 * np.array([np.cos(ang[j]), np.sin(ang[j])])
+        segs.append(np.concatenate((p1, p2)))                     # ends on beams i and j
+        p3 = pose[:2] + (r1 + 0.5) * np.array([np.cos(ang[i]), np.sin(ang[i])])
+        segs.append(np.concatenate((p1, p3)))                     # collinear with beam i
+    segs = np.array(segs)
+    poses = [pose, np.r_[segs[0, :2], 0.1], np.r_[0.5 * (segs[2, :2] + segs[2, 2:]), -1.0],
+             np.r_[segs[5, 2:], 2.0]]
+    fast, brute = _both(poses, laser, segs)
+    assert np.isfinite(brute).sum() > 20
+    _same(fast, brute)
+
+
+def test_axis_aligned_grid_of_walls_with_poses_on_grid_lines():
+    """Many exact ties: walls on integer lines, poses and beam angles hitting corners exactly."""
+    laser = LaserSpec.from_degrees(12.0, 360.0, 0.5, -180.0)
+    segs = [[x, 0, x, 10] for x in range(0, 11, 2)] + [[0, y, 10, y] for y in range(0, 11, 2)]
+    segs += [[1, 1, 3, 3], [3, 3, 5, 5], [5, 1, 7, 3]]            # diagonals through grid points
+    poses = [[1, 1, 0.0], [2, 3, math.pi / 4], [5, 5, math.pi / 2], [4, 4, 0.0], [3, 1, -math.pi]]
+    fast, brute = _both(poses, laser, segs)
+    _same(fast, brute)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(*[st.integers(-8, 8)] * 4), min_size=1, max_size=30),
+       st.tuples(st.integers(-8, 8), st.integers(-8, 8), st.integers(-8, 8)),
+       st.sampled_from(LASERS[:3]))
+def test_integer_maps_match_bruteforce(segs, pose, laser):
+    """Integer coordinates give exact collinearities, endpoint hits and poses on segments."""
+    segs = np.array(segs, dtype=float) / 2.0
+    segs = segs[np.hypot(segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1]) > 0]
+    if len(segs) == 0:
+        return
+    p = np.array([pose[0] / 2.0, pose[1] / 2.0, pose[2] * math.pi / 8])
+    fast, brute = _both(p, laser, segs)
+    _same(fast, brute)
+
+
+def test_square_room_is_analytic():
+    laser = LaserSpec.from_degrees(20.0, 360.0, 1.0, -180.0)
+    half = 2.5
+    room = VectorMap.from_segments(np.array([[-half, -half, half, -half], [half, -half, half, half],
+                                             [half, half, -half, half], [-half, half, -half, -half]]))
+    for theta in (0.0, 0.3, -2.0):
+        r = room.raycast(Pose(0.0, 0.0, theta), laser)
+        phi = theta + laser.angles
+        expected = half / np.maximum(np.abs(np.cos(phi)), np.abs(np.sin(phi)))
+        np.testing.assert_allclose(r, expected, rtol=0.0, atol=1e-9)
+
+
+def test_out_of_range_and_no_segments():
+    laser = LaserSpec.lms200()
+    fast, brute = _both([0, 0, 0], laser, [[20, -1, 20, 1]])
+    assert np.isinf(fast).all() and np.isinf(brute).all()
+    fast, brute = _both([0, 0, 0], laser, np.empty((0, 4)))
+    assert np.isinf(fast).all() and fast.shape == (1, laser.n_beams)
+
+
+def test_non_uniform_angles_fall_back_to_bruteforce():
+    rng = np.random.default_rng(0)
+    angles = np.sort(rng.uniform(-np.pi, np.pi, 50))
+    segs = np.ascontiguousarray(rng.uniform(-5, 5, (30, 4)))
+    poses = np.ascontiguousarray(np.column_stack((rng.uniform(-5, 5, (5, 2)), np.zeros(5))))
+    np.testing.assert_array_equal(raycast_segments(poses, angles, segs, 10.0),
+                                  raycast_segments_bruteforce(poses, angles, segs, 10.0))
+
+
+def test_fast_atan2_error_bound():
+    """The arc computation's atan2 approximation stays far inside the kernel's angle margin."""
+    from tfloc.maps._raycast import _ANGLE_MARGIN, _atan2
+
+    rng = np.random.default_rng(0)
+    pts = np.vstack((rng.normal(size=(20000, 2)) * 10.0 ** rng.uniform(-6, 3, (20000, 1)),
+                     [[1, 0], [0, 1], [-1, 0], [0, -1], [1, 1], [-1, -1], [-1, 1e-300], [-1, -1e-300]]))
+    err = [abs(math.remainder(_atan2(y, x) - math.atan2(y, x), 2 * math.pi)) for x, y in pts]
+    assert max(err) < 1e-5 < _ANGLE_MARGIN / 5

@@ -1,0 +1,78 @@
+"""Toy matchers for harness tests (imported by spawned workers as ``toy_matchers:Class``)."""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from tfloc.pose import Pose
+from tfloc.problem import Estimate, Problem
+
+
+class Stay:
+    """Returns the initial pose; objective = distance to the initial pose."""
+
+    name = "stay"
+
+    def __init__(self, sleep_s: float = 0.0) -> None:
+        self.sleep_s = sleep_s
+
+    def localize(self, problem: Problem) -> Estimate:
+        time.sleep(self.sleep_s)
+        return Estimate(problem.initial, True, 1, 1)
+
+    def score(self, problem: Problem, pose: Pose) -> float:
+        return pose.distance_to(problem.initial)
+
+
+class Raises(Stay):
+    """Raises on every ``fail_every``-th call in a worker (a data-dependent crash)."""
+
+    def __init__(self, fail_every: int = 2) -> None:
+        super().__init__()
+        self.fail_every, self.calls = fail_every, 0
+
+    def localize(self, problem: Problem) -> Estimate:
+        self.calls += 1
+        if self.calls % self.fail_every == 0:
+            raise ValueError("toy failure\nwith a second line")
+        return super().localize(problem)
+
+
+class Hangs(Stay):
+    """Hangs (sleeps far past any time limit) on every ``hang_every``-th call in a worker."""
+
+    def __init__(self, hang_every: int = 2) -> None:
+        super().__init__()
+        self.hang_every, self.calls = hang_every, 0
+
+    def localize(self, problem: Problem) -> Estimate:
+        self.calls += 1
+        if self.calls % self.hang_every == 0:
+            time.sleep(3600)
+        return super().localize(problem)
+
+
+class TwoMinima:
+    """An objective with a global minimum 0 at ``init + to_true`` (the truth, by construction of
+    the test dataset) and a second minimum of value ``false_value`` at ``init + to_false``.
+    ``localize`` returns the second one, so the outcome is known: a ``local-optimum`` when
+    ``false_value`` > 0, ``ambiguous`` when it is ≤ 0."""
+
+    name = "two-minima"
+
+    def __init__(self, to_true=(0.0, 0.0), to_false=(1.0, 0.0), false_value: float = 0.5) -> None:
+        self.to_true, self.to_false, self.false_value = np.array(to_true), np.array(to_false), false_value
+
+    def _at(self, problem: Problem, d) -> Pose:
+        return Pose(problem.initial.x + d[0], problem.initial.y + d[1], problem.initial.theta)
+
+    def localize(self, problem: Problem) -> Estimate:
+        return Estimate(self._at(problem, self.to_false), True, 3, 10)
+
+    def score(self, problem: Problem, pose: Pose) -> float:
+        t, f = self._at(problem, self.to_true), self._at(problem, self.to_false)
+        return min(pose.distance_to(t) + abs(math.remainder(pose.theta - t.theta, math.tau)),
+                   pose.distance_to(f) + self.false_value)

@@ -1,0 +1,62 @@
+"""Accuracy regression guard: rerun the fixed-seed subset (benchmarks/regression.toml) and compare
+its metrics with the committed reference (results/reference/summary.csv).
+
+Exits 1 and prints a table of every metric that got worse than its tolerance allows
+(tolerances and their justification: tfloc/harness/guard.py). With --update, rewrites the
+reference deliberately and prints what changed.
+
+Examples:
+  tfloc guard              # check
+  tfloc guard --update     # accept the current results as the new reference
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from ..errors import ConfigError
+
+HELP = "accuracy regression guard: rerun a fixed subset and compare with the reference"
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    from ..harness.guard import CONFIG, REFERENCE
+
+    p.add_argument("--config", type=Path, default=CONFIG, help=f"subset run configuration ({CONFIG})")
+    p.add_argument("--reference", type=Path, default=REFERENCE, help=f"reference metrics ({REFERENCE})")
+    p.add_argument("--update", action="store_true", help="rewrite the reference with this run's metrics")
+    p.add_argument("--matchers", help="only these matchers (comma-separated)")
+    p.add_argument("--jobs", type=int, help="worker processes (default from the config)")
+    p.add_argument("--resume", action="store_true", help="reuse a previous guard run's finished rows")
+    p.add_argument("--all", action="store_true", help="print every compared metric, not only regressions")
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..harness import guard
+    from ..harness.config import load_config, parse_matchers
+
+    cfg = load_config(args.config)
+    if args.matchers:
+        cfg = cfg.with_overrides(matchers=parse_matchers(args.matchers.split(","), {}, "--matchers"))
+    cfg = cfg.with_overrides(jobs=args.jobs)
+    current = guard.run_subset(cfg, fresh=not args.resume)
+    if args.update:
+        old = guard.read_reference(args.reference) if args.reference.exists() else current.iloc[:0]
+        if args.matchers and args.reference.exists():  # keep the other matchers' reference rows
+            keep = old[~old.matcher.isin(current.matcher.unique())]
+            current = guard.pd.concat([keep, current]).sort_values(list(guard.KEY), ignore_index=True)
+        guard.write_reference(current, args.reference)
+        print(f"updated {args.reference}:\n{guard.format_changes(old, current)}")
+        return 0
+    if not args.reference.exists():
+        raise ConfigError(f"{args.reference}: no reference yet; create it with 'tfloc guard --update'")
+    diff = guard.compare(current, guard.read_reference(args.reference))
+    print(guard.format_table(diff, only_worse=not args.all))
+    n = int(diff.worse.sum())
+    if n:
+        print(f"\n{n} metric(s) worse than the reference allows", file=sys.stderr)
+        return 1
+    print(f"\nall {len(diff)} guarded metrics within tolerance", file=sys.stderr)
+    return 0

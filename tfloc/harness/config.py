@@ -1,0 +1,129 @@
+"""Run configurations: which matchers on which datasets, with which limits (TOML ↔ RunConfig).
+
+A run configuration file looks like::
+
+    name = "paper-protocol"
+    out = "results/paper-protocol"          # relative paths are relative to where tfloc runs
+    datasets = ["data/scenarios/office-pool", "data/scenarios/detail-1"]
+    matchers = ["tf", "csm-corr", { label = "tf-S0.5", name = "tf", params = { spacing = 0.5 } }]
+    jobs = 2                 # worker processes
+    timeout_s = 60           # per (scan, matcher) task
+    limit_per_group = 0      # 0 = all scans; N = the first N scans of each group (smoke runs)
+    [success]
+    dist_m = 0.10
+    orient_deg = 2.0
+    [params.tf]              # parameters for every matcher entry named "tf" without its own
+    spacing = 1.0
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tomllib
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from ..errors import ConfigError
+
+
+@dataclass(frozen=True)
+class MatcherSpec:
+    """One matcher column of a run: its ``label`` in the results, registered ``name``, ``params``."""
+
+    label: str
+    name: str
+    params_json: str = "{}"
+
+    @property
+    def params(self) -> dict[str, Any]:
+        return json.loads(self.params_json)
+
+    @classmethod
+    def make(cls, name: str, params: dict | None = None, label: str | None = None) -> MatcherSpec:
+        return cls(label or name, name, json.dumps(params or {}, sort_keys=True))
+
+
+@dataclass(frozen=True)
+class RunConfig:
+    """A benchmark run. Distances in metres, angles in radians, times in seconds."""
+
+    name: str
+    out: Path
+    datasets: tuple[Path, ...]
+    matchers: tuple[MatcherSpec, ...]
+    jobs: int = 2
+    timeout_s: float = 60.0
+    limit_per_group: int = 0
+    success_dist_m: float = 0.10
+    success_orient_rad: float = math.radians(2.0)
+    extra: dict = field(default_factory=dict, compare=False)
+
+    def __post_init__(self) -> None:
+        if not self.datasets:
+            raise ConfigError(f"run {self.name!r}: no datasets given")
+        if not self.matchers:
+            raise ConfigError(f"run {self.name!r}: no matchers given")
+        labels = [m.label for m in self.matchers]
+        if len(set(labels)) != len(labels):
+            raise ConfigError(f"run {self.name!r}: duplicate matcher labels {labels}")
+        if self.jobs < 1 or self.timeout_s <= 0 or self.limit_per_group < 0:
+            raise ConfigError(f"run {self.name!r}: jobs ≥ 1, timeout_s > 0 and limit_per_group ≥ 0 required")
+
+    def with_overrides(self, **kw: Any) -> RunConfig:
+        return replace(self, **{k: v for k, v in kw.items() if v is not None})
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"name": self.name, "out": str(self.out), "datasets": [str(d) for d in self.datasets],
+                "matchers": [{"label": m.label, "name": m.name, "params": m.params} for m in self.matchers],
+                "jobs": self.jobs, "timeout_s": self.timeout_s, "limit_per_group": self.limit_per_group,
+                "success": {"dist_m": self.success_dist_m,
+                            "orient_deg": math.degrees(self.success_orient_rad)}, **self.extra}
+
+
+def parse_matchers(entries: list, defaults: dict[str, dict], where: str) -> tuple[MatcherSpec, ...]:
+    """Matcher entries: a registered name, or a table ``{label, name, params}``."""
+    specs = []
+    for i, e in enumerate(entries):
+        if isinstance(e, str):
+            specs.append(MatcherSpec.make(e, defaults.get(e)))
+        elif isinstance(e, dict) and isinstance(e.get("name"), str):
+            params = {**defaults.get(e["name"], {}), **e.get("params", {})}
+            specs.append(MatcherSpec.make(e["name"], params, e.get("label")))
+        else:
+            raise ConfigError(f"{where}: matchers[{i}] must be a name or a table with 'name'")
+    return tuple(specs)
+
+
+def load_config(path: str | Path) -> RunConfig:
+    """Read a run configuration TOML file; errors name the file and the key."""
+    path = Path(path)
+    try:
+        doc = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise ConfigError(f"{path}: no such run configuration") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{path}: not valid TOML ({exc})") from None
+    known = {"name", "out", "datasets", "matchers", "jobs", "timeout_s", "limit_per_group",
+             "success", "params", "description", "sweep"}
+    unknown = sorted(set(doc) - known)
+    if unknown:
+        raise ConfigError(f"{path}: unknown key(s) {', '.join(unknown)}")
+    for key in ("datasets", "matchers"):
+        if not isinstance(doc.get(key), list):
+            raise ConfigError(f"{path}: '{key}' must be a list")
+    success = doc.get("success", {})
+    try:
+        return RunConfig(
+            name=str(doc.get("name", path.stem)),
+            out=Path(doc.get("out", f"results/{doc.get('name', path.stem)}")),
+            datasets=tuple(Path(d) for d in doc["datasets"]),
+            matchers=parse_matchers(doc["matchers"], doc.get("params", {}), str(path)),
+            jobs=int(doc.get("jobs", 2)), timeout_s=float(doc.get("timeout_s", 60.0)),
+            limit_per_group=int(doc.get("limit_per_group", 0)),
+            success_dist_m=float(success.get("dist_m", 0.10)),
+            success_orient_rad=math.radians(float(success.get("orient_deg", 2.0))),
+            extra={k: doc[k] for k in ("description", "sweep") if k in doc})
+    except (TypeError, ValueError) as exc:
+        raise ConfigError(f"{path}: {exc}") from None

@@ -1,0 +1,161 @@
+"""Run matchers over scenario datasets: a process pool, per-task time limits, results streamed
+to ``estimates.csv`` as tasks finish, and resume by skipping what is already there.
+
+The pool is :class:`pebble.ProcessPool` (spawned workers; a task past its time limit is killed
+with its worker, which is replaced). Each worker is started with its thread pools (OpenMP,
+BLAS, numba) limited to ``max(1, cores // jobs)`` threads, so that together the workers use the
+2 cores the benchmark is specified for, and a matcher never gets more than 2.
+"""
+
+from __future__ import annotations
+
+import json
+import multiprocessing
+import os
+import platform
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from concurrent.futures import TimeoutError as FutureTimeout
+from concurrent.futures import as_completed
+from importlib import metadata
+from pathlib import Path
+
+from pebble import ProcessExpired, ProcessPool
+from tqdm import tqdm
+
+from .config import RunConfig
+from .dataset import iter_scans, read_scenario
+from .results import ResultWriter, done_keys
+from .task import Task, failure_row, run_task, warm_up
+
+THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS",
+               "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")
+PACKAGES = ("tfloc", "numpy", "scipy", "shapely", "numba", "pandas", "open3d", "kiss-icp",
+            "opencv-python-headless", "pebble", "matplotlib")
+
+
+def make_tasks(config: RunConfig) -> list[Task]:
+    """Every (dataset, scan, matcher) task of a run, in dataset/scan order (validates datasets)."""
+    tasks = []
+    for d in config.datasets:
+        scenario = read_scenario(d)
+        per_group: dict[str, int] = {}
+        for scan in iter_scans(scenario):
+            n = per_group[scan.group] = per_group.get(scan.group, 0) + 1
+            if config.limit_per_group and n > config.limit_per_group:
+                continue
+            for m in config.matchers:
+                tasks.append(Task(str(d), scenario.name, scan.scan_id, m.label, m.name, m.params_json,
+                                  config.success_dist_m, config.success_orient_rad))
+    return tasks
+
+
+def threads_per_job(jobs: int) -> int:
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    return max(1, min(2, cores // jobs))
+
+
+def _init_worker(threads: int) -> None:
+    for var in THREAD_VARS:
+        os.environ[var] = str(threads)
+    try:
+        from threadpoolctl import threadpool_limits
+
+        threadpool_limits(threads)
+    except ImportError:
+        pass
+
+
+def environment() -> dict:
+    """Package versions, git commit and machine, for ``run.json``."""
+    versions = {}
+    for pkg in PACKAGES:
+        try:
+            versions[pkg] = metadata.version(pkg)
+        except metadata.PackageNotFoundError:
+            versions[pkg] = None
+    try:
+        commit = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
+                                timeout=10).stdout.strip() or None
+        dirty = bool(subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
+                                    capture_output=True, text=True, timeout=10).stdout.strip())
+    except (OSError, subprocess.SubprocessError):
+        commit, dirty = None, None
+    return {"versions": versions, "git": {"commit": commit, "dirty": dirty},
+            "machine": {"platform": platform.platform(), "processor": platform.processor(),
+                        "cpu_count": os.cpu_count(), "python": sys.version.split()[0],
+                        "node": platform.node()}}
+
+
+def write_run_json(config: RunConfig, out: Path, n_tasks: int, n_done: int) -> None:
+    path = out / "run.json"
+    previous = json.loads(path.read_text()) if path.exists() else {}
+    starts = previous.get("sessions", []) + [{"started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+                                              "tasks": n_tasks, "already_done": n_done}]
+    doc = {"config": config.to_dict(), **environment(), "threads_per_job": threads_per_job(config.jobs),
+           "datasets": {read_scenario(d).name: str(d) for d in config.datasets}, "sessions": starts}
+    path.write_text(json.dumps(doc, indent=2) + "\n")
+
+
+def execute_local(tasks: list[Task], jobs: int, timeout_s: float,
+                  on_row: Callable[[dict], None]) -> None:
+    """Run ``tasks`` on a local process pool; every task ends in exactly one ``on_row`` call."""
+    ctx = multiprocessing.get_context("spawn")
+    with ProcessPool(max_workers=jobs, context=ctx, initializer=_init_worker,
+                     initargs=(threads_per_job(jobs),)) as pool:
+        warm = {}
+        for t in tasks:  # compile kernels and load data outside the timed, time-limited tasks
+            warm.setdefault((t.dataset, t.matcher, t.params_json), t)
+        for f in [pool.schedule(warm_up, args=(t,)) for t in warm.values()]:
+            try:
+                f.result()
+            except Exception:  # noqa: BLE001 - the task itself will report the failure
+                pass
+        futures = {pool.schedule(run_task, args=(t,), timeout=timeout_s): t for t in tasks}
+        for fut in as_completed(futures):
+            t = futures[fut]
+            try:
+                row = fut.result()
+            except (TimeoutError, FutureTimeout):
+                row = failure_row(t, "timeout")
+            except ProcessExpired as exc:
+                row = failure_row(t, f"error:worker died ({exc})")
+            except Exception as exc:  # noqa: BLE001
+                row = failure_row(t, f"error:{type(exc).__name__}: {exc}")
+            on_row(row)
+
+
+Executor = Callable[[list[Task], int, float, Callable[[dict], None]], None]
+
+
+def run(config: RunConfig, progress: bool | None = None, executor: Executor = execute_local) -> Path:
+    """Run (or resume) a benchmark; returns the run directory holding ``estimates.csv``."""
+    out = Path(config.out)
+    out.mkdir(parents=True, exist_ok=True)
+    tasks = make_tasks(config)
+    done = done_keys(out / "estimates.csv")
+    todo = [t for t in tasks if t.key not in done]
+    write_run_json(config, out, len(tasks), len(tasks) - len(todo))
+    if not todo:
+        return out
+    bar = tqdm(total=len(tasks), initial=len(tasks) - len(todo), unit="task", desc=config.name,
+               disable=None if progress is None else not progress, smoothing=0.05, mininterval=1.0)
+    failures = 0
+    with ResultWriter(out / "estimates.csv") as writer:
+        def on_row(row: dict) -> None:
+            nonlocal failures
+            writer.write(row)
+            failures += row.get("status", "ok") not in ("ok", "failed")
+            bar.update(1)
+            if failures:
+                bar.set_postfix(errors=failures, refresh=False)
+
+        try:
+            executor(todo, config.jobs, config.timeout_s, on_row)
+        finally:
+            bar.close()
+    return out
+
+

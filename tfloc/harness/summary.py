@@ -1,0 +1,89 @@
+"""The paper's scenarios and the run summary (``summary.csv``): metrics per matcher × grouping.
+
+Scenario I = datasets ``detail-1``, ``detail-2``, ``detail-3`` (one sample each); Scenario II =
+dataset ``office-pool`` binned by initial angle offset; Scenario III = ``office-pool`` binned
+by initial distance offset. Other datasets get per-dataset rows, binned by distance and angle
+offset when they are scan-to-map (a scan-to-scan dataset's offsets are odometry, not bins).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from pathlib import Path
+
+import pandas as pd
+
+from .metrics import METRIC_COLUMNS, summarize
+
+SCENARIO_I = ("detail-1", "detail-2", "detail-3")
+POOL = "office-pool"
+SUMMARY_KEYS = ["grouping", "dataset", "bin", "matcher"]
+
+
+def scenario_rows(p: pd.DataFrame) -> pd.DataFrame:
+    """Prepared rows labelled by paper scenario (``scenario``: I/II/III) and ``sample``.
+
+    Office-pool rows appear twice (in II by angle bin, in III by distance bin).
+    """
+    parts = []
+    one = p[p["dataset"].isin(SCENARIO_I)]
+    if len(one):
+        parts.append(one.assign(scenario="I", sample=one["dataset"]))
+    pool = p[p["dataset"] == POOL]
+    if len(pool):
+        parts.append(pool.assign(scenario="II", sample=pool["angle_bin"].astype(object)))
+        parts.append(pool.assign(scenario="III", sample=pool["dist_bin"].astype(object)))
+    if not parts:
+        return p.iloc[:0].assign(scenario=pd.Series(dtype=object), sample=pd.Series(dtype=object))
+    return pd.concat(parts, ignore_index=True)
+
+
+def scenario_summary(p: pd.DataFrame) -> pd.DataFrame:
+    """Metrics per (scenario, sample, matcher), samples in table order, missing bins dropped."""
+    s = scenario_rows(p)
+    if s.empty:
+        return pd.DataFrame(columns=["scenario", "sample", "matcher", *METRIC_COLUMNS])
+    s = s[s["sample"].notna()]
+    out = summarize(s, ["scenario", "sample", "matcher"])
+    order = {k: i for i, k in enumerate([*SCENARIO_I, *p["angle_bin"].cat.categories,
+                                         *p["dist_bin"].cat.categories])}
+    out["_o"] = out["sample"].map(order)
+    return out.sort_values(["scenario", "_o", "matcher"]).drop(columns="_o").reset_index(drop=True)
+
+
+def summary_table(p: pd.DataFrame, scan_to_scan: Iterable[str] = ()) -> pd.DataFrame:
+    """Every grouping of the report in one long table (columns :data:`SUMMARY_KEYS` + metrics).
+
+    groupings: ``scenario-I`` (bin = all), ``scenario-II`` (bin = angle bin), ``scenario-III``
+    (bin = distance bin), ``dataset`` (bin = all), ``dataset-dist_bin``, ``dataset-angle_bin``
+    (scan-to-map datasets with truth), ``dataset-group`` (scan-to-scan datasets: their groups),
+    ``overall`` (dataset = bin = all).
+    """
+    s2s = set(scan_to_scan)
+    parts = []
+    sc = scenario_summary(p)
+    for name, g in sc.groupby("scenario", sort=True):
+        one = name == "I"
+        parts.append(g.assign(grouping=f"scenario-{name}", bin="all" if one else g["sample"],
+                              dataset=g["sample"] if one else POOL))
+    parts.append(summarize(p, ["dataset", "matcher"]).assign(grouping="dataset", bin="all"))
+    truth = p[p["truth"]]
+    s2m = truth[~truth["dataset"].isin(s2s)]
+    for col in ("dist_bin", "angle_bin"):
+        if len(s2m):
+            t = summarize(s2m, ["dataset", col, "matcher"])
+            parts.append(t.rename(columns={col: "bin"}).assign(grouping=f"dataset-{col}"))
+    s2s_rows = p[p["dataset"].isin(s2s)]
+    if len(s2s_rows):
+        t = summarize(s2s_rows, ["dataset", "group", "matcher"])
+        parts.append(t.rename(columns={"group": "bin"}).assign(grouping="dataset-group"))
+    parts.append(summarize(p, ["matcher"]).assign(grouping="overall", dataset="all", bin="all"))
+    out = pd.concat([x.astype({"bin": object}) for x in parts if len(x)], ignore_index=True)
+    return out[SUMMARY_KEYS + list(METRIC_COLUMNS)]
+
+
+def write_summary(table: pd.DataFrame, path: str | Path) -> Path:
+    """Write the summary table as CSV (floats with 6 significant digits)."""
+    path = Path(path)
+    table.to_csv(path, index=False, float_format="%.6g")
+    return path
