@@ -5,24 +5,29 @@ It keeps what the paper's turning function is good at and replaces what holds th
 changes discretely as the virtual pose moves, so its simplex stalls in local optima, and it
 needs ~1800 cost evaluations per scan). Stages:
 
-1. **Turning-function heading seed.** The real scan's turning function is matched against the
-   virtual scan's at the initial guess (VP) (:func:`tfloc.turning.match`); its rotation offset is
-   an estimate of the heading error that needs no position: ``θ = θ_VP − rotation``. The coarse
-   search then only needs a few headings around this seed (and around θ_VP, in case the
-   turning functions are matched wrongly).
+1. **Headings.** A sweep θ_VP ± ``heading_span`` (``heading_sweep``) plus turning-function
+   seeds (``tf_seed``): the real and virtual (at the VP) scans' turning functions are compared
+   as edge-direction histograms (:mod:`tfloc.heading_histogram`), which gives rotation offsets
+   that need no position and no common starting vertex: ``θ = θ_VP − rotation``. (The rotation
+   of Sec. 4.3's ``match`` was measured to be too unreliable for a seed.) Measured: the seeds
+   alone are as good as the sweep alone within 0–15°, and add nothing on top of it (see
+   ``docs/tf-plus.md``).
 2. **Coarse grid over position.** Every free lattice position within ``search_radius`` of the
    VP × those headings is scored on a truncated distance field of the map
    (:mod:`tfloc.coarse`, :mod:`tfloc.distance_field`): smooth, cheap and free of the corner
-   set's discreteness. The best ``candidates`` (at least ``separation`` apart) go on.
+   set's discreteness. Two levels: every ``scan_stride``-th point for all candidates, all points
+   for the best ``shortlist``; the best ``candidates`` (at least ``separation`` apart) go on.
 3. **Point-to-line refinement** of every candidate against its own virtual scan
    (:mod:`tfloc.refine`), batched, with a shrinking outlier gate: centimetre accuracy once the
    pose is in the basin.
 4. **Selection** of the refined candidate with the lowest per-beam cost (truncated point-to-line
-   residual, plus see-through beams, :mod:`tfloc.scan_cost`; ``select="residual"``), or the lowest turning-function Err (``select="tf"``); candidates
+   residual, plus see-through beams, :mod:`tfloc.scan_cost`; ``select="residual"``), or the
+   lowest turning-function Err (``select="tf"``); candidates
    within ``tie_tolerance`` of the best (the scan sees the same geometry from both places, e.g.
    a bare corner) are a tie, broken in favour of the one nearest the VP.
 
-Each stage can be switched off (``tf_seed``, ``grid``, ``refine``) for the ablation in
+Each stage can be switched off (``tf_seed``, ``heading_sweep``, ``grid``, ``refine``,
+``beam_check``, ``tie_tolerance=0``) for the ablation in
 ``benchmarks/tfplus_ablation.py``. It uses only the :class:`~tfloc.maps.base.Map` protocol and
 never the true pose.
 """
