@@ -1,11 +1,12 @@
 """Fair corner correspondences without the truth: rigid hypotheses from corner pairs whose lengths
-agree, scored by one-to-one (mutual nearest neighbour) inliers. Pure, vectorised numpy."""
+agree, scored by one-to-one (mutual nearest neighbour) inliers. Pure functions (numpy, scipy k-d trees)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 
 @dataclass(frozen=True)
@@ -63,25 +64,32 @@ def pair_hypotheses(a: np.ndarray, b: np.ndarray, length_tol: float, min_length:
     return Hypotheses(theta[ok], t[ok])
 
 
-def transform(theta: np.ndarray, t: np.ndarray, a: np.ndarray) -> np.ndarray:
-    """Apply ``(H,)`` rotations and ``(H, 2)`` translations to points ``(N, 2)`` → ``(H, N, 2)``."""
+def transform(theta: np.ndarray, t: np.ndarray, a: np.ndarray, batched: bool = False) -> np.ndarray:
+    """Apply ``(H,)`` rotations and ``(H, 2)`` translations to points ``(N, 2)`` (or, if
+    ``batched``, to per-hypothesis points ``(H, N, 2)``) → ``(H, N, 2)``."""
     c, s = np.cos(theta)[:, None], np.sin(theta)[:, None]
-    x = c * a[None, :, 0] - s * a[None, :, 1] + t[:, None, 0]
-    y = s * a[None, :, 0] + c * a[None, :, 1] + t[:, None, 1]
+    ax, ay = (a[..., 0], a[..., 1]) if batched else (a[None, :, 0], a[None, :, 1])
+    x = c * ax - s * ay + t[:, None, 0]
+    y = s * ax + c * ay + t[:, None, 1]
     return np.stack((x, y), axis=-1)
 
 
-def mutual_inliers(moved: np.ndarray, b: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
-    """One-to-one inliers of ``(H, N, 2)`` moved corners against ``(M, 2)`` corners.
+def mutual_inliers(theta: np.ndarray, t: np.ndarray, a: np.ndarray, b: np.ndarray,
+                   tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """One-to-one inliers of corners ``a`` moved by each of ``(H,)`` rigid transforms against ``b``.
 
     A pair (i, k) is an inlier when k is i's nearest corner, i is k's nearest, and they lie within
-    ``tol`` metres. Returns ``(H, N)`` partner index (−1 = none) and ``(H, N)`` distances.
+    ``tol`` metres. Nearest neighbours come from k-d trees (scipy) on the fixed sets: ``b`` for the
+    moved ``a``, and ``a`` for ``b`` moved back by the inverse transform (distances are
+    preserved), so the cost is O(H·(N + M)·log) instead of an (H, N, M) distance array.
+    Returns ``(H, N)`` partner index (−1 = none) and ``(H, N)`` distances.
     """
-    d = np.linalg.norm(moved[:, :, None, :] - b[None, None, :, :], axis=-1)  # (H, N, M)
-    nn_b = d.argmin(axis=2)  # (H, N)
-    nn_a = d.argmin(axis=1)  # (H, M)
-    dist = np.take_along_axis(d, nn_b[..., None], axis=2)[..., 0]
-    mutual = np.take_along_axis(nn_a, nn_b, axis=1) == np.arange(moved.shape[1])[None, :]
+    moved = transform(theta, t, a)                                         # (H, N, 2)
+    dist, nn_b = cKDTree(b).query(moved.reshape(-1, 2))
+    dist, nn_b = dist.reshape(moved.shape[:2]), nn_b.reshape(moved.shape[:2])
+    back = transform(-theta, np.zeros_like(t), b[None, :, :] - t[:, None, :], batched=True)
+    nn_a = cKDTree(a).query(back.reshape(-1, 2))[1].reshape(back.shape[:2])  # (H, M)
+    mutual = np.take_along_axis(nn_a, nn_b, axis=1) == np.arange(a.shape[0])[None, :]
     partner = np.where(mutual & (dist <= tol), nn_b, -1)
     return partner, dist
 
@@ -91,11 +99,7 @@ def best_hypothesis(a: np.ndarray, b: np.ndarray, hyp: Hypotheses, tol: float) -
 
     Returns its index, the ``(N,)`` partner indices (−1 = none) and the ``(N,)`` distances.
     """
-    chunk = max(1, int(2e7 // max(1, len(a) * len(b))))  # ≤ 2·10⁷ distances (160 MB) at a time
-    parts = [mutual_inliers(transform(hyp.theta[k:k + chunk], hyp.t[k:k + chunk], a), b, tol)
-             for k in range(0, len(hyp.theta), chunk)]
-    partner = np.concatenate([p for p, _ in parts])
-    dist = np.concatenate([d for _, d in parts])
+    partner, dist = mutual_inliers(hyp.theta, hyp.t, a, b, tol)
     inl = partner >= 0
     count = inl.sum(axis=1)
     resid = np.where(inl, dist, 0.0).sum(axis=1)

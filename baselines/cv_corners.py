@@ -21,7 +21,10 @@ Configuration choices and why:
   protocol's initial guess is known to lie in (``max_angle_deg`` = 25°, ``max_shift`` = 4 m per
   step, the same prior as ``csm-corr``'s ±3.5 m / ±20° plus a margin). Each is scored by its one-to-one
   (mutual nearest neighbour) inliers within ``inlier_tol`` = 20 cm, ties broken by the summed
-  inlier distance. The truth is never used.
+  inlier distance. The truth is never used. Real scans can have 100+ corners (10⁴ ordered pairs
+  a side); at most ``max_hypotheses`` = 5000 hypotheses, an evenly strided subset, are scored
+  (the bundled office scans need at most ~6700, so 9 of 3240 are affected; a CSAIL relation
+  took 40 s and tens of GB with no cap).
 * **Refinement by OpenCV**: the best hypothesis's inlier pairs go to
   ``cv2.estimateAffinePartial2D`` with RANSAC (reprojection threshold ``inlier_tol`` on the first
   step, when the two viewpoints still differ, then ``fine_tol`` = 3 cm; OpenCV's default
@@ -73,6 +76,7 @@ class Config:
     min_pair_length: float = 0.5
     max_angle_deg: float = 25.0
     max_shift: float = 4.0
+    max_hypotheses: int = 5000
     inlier_tol: float = 0.20
     fine_tol: float = 0.03
     ransac_max_iters: int = 2000
@@ -113,7 +117,7 @@ class CvCornersMatcher:
             raise _NoAnswer(f"too few corners (real {len(real)}, virtual {len(virtual)})")
         # The window bounds the correction of this step, relative to ``pose``.
         hyp = pair_hypotheses(real, virtual, c.length_tol, c.min_pair_length,
-                              math.radians(c.max_angle_deg), c.max_shift)
+                              math.radians(c.max_angle_deg), c.max_shift, c.max_hypotheses)
         if hyp.theta.size == 0:
             raise _NoAnswer("no corner pairs of agreeing length")
         _, partner, _ = best_hypothesis(real, virtual, hyp, c.inlier_tol)
@@ -165,7 +169,7 @@ class CvCornersMatcher:
         virtual = self._corners(problem.map.raycast(pose, problem.laser), problem)
         if len(real) == 0 or len(virtual) == 0:
             return 0.0
-        partner, dist = mutual_inliers(real[None], virtual, self.config.inlier_tol)
+        partner, dist = mutual_inliers(np.zeros(1), np.zeros((1, 2)), real, virtual, self.config.inlier_tol)
         inl = partner[0] >= 0
         n = int(inl.sum())
         return float(-n + (dist[0, inl].mean() / self.config.inlier_tol if n else 0.0))
