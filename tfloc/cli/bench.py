@@ -38,6 +38,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="only the first N scans of each group (smoke runs; default: all)")
     p.add_argument("--success-cm", type=float, help="success threshold on distance error, cm (default 10)")
     p.add_argument("--success-deg", type=float, help="success threshold on orientation error, degrees (default 2)")
+    p.add_argument("--regenerate", action="store_true",
+                   help="if OUT holds a complete run, discard it and run again (an interrupted run "
+                        "is still resumed); make bench uses this to reproduce the committed results")
     prog = p.add_mutually_exclusive_group()
     prog.add_argument("--progress", dest="progress", action="store_true", default=None,
                       help="always show the progress bar (default: only on a terminal)")
@@ -69,6 +72,6 @@ def run(args: argparse.Namespace) -> int:
     from ..harness.runner import run as run_benchmark
 
     cfg = config_from_args(args)
-    out = run_benchmark(cfg, progress=args.progress)
+    out = run_benchmark(cfg, progress=args.progress, regenerate=args.regenerate)
     print(f"results: {out / 'estimates.csv'}  (report: tfloc report {out})", file=sys.stderr)
     return 0
