@@ -71,6 +71,8 @@ def write_note(results: Path, dataset: Path, max_dist_m: float = 0.10, max_angle
         need = {"scan_id", "matcher", "dist_err_m", "orient_err_rad", "runtime_s", "status"}
         if not need <= set(est.columns):
             raise DatasetError(f"{est_path}: lacks column(s) {', '.join(sorted(need - set(est.columns)))}")
+    all_ids = np.array([s.scan_id for s in scans])
+    in_run = np.isin(all_ids, est["scan_id"].astype(str).unique()) if est is not None else np.ones(len(scans), bool)
     head = ("| method | relations | trans. error m (mean ± std) | max m | squared m² | rot. error ° (mean ± std) "
             "| max ° | success | runtime ms (median / mean) |\n|---|---|---|---|---|---|---|---|---|")
     lines = [
@@ -82,16 +84,22 @@ def write_note(results: Path, dataset: Path, max_dist_m: float = 0.10, max_angle
         "odometry between the two scans, and is scored against the relation. Errors as Kümmerle et al.: "
         "translational ‖trans(δ ⊖ δ*)‖ and rotational |rot(δ ⊖ δ*)|, mean ± std and max over relations "
         f"(absolute and squared). Success: ≤ {100 * max_dist_m:g} cm and ≤ {max_angle_deg:g}°. A scan a "
-        "matcher failed on (error, timeout) counts with its initial guess, so every row covers all relations.",
+        "matcher failed on (error, timeout) counts with its initial guess, so every row covers all relations "
+        "of the run.",
+        "",
+        f"**Relations in this run: {int(in_run.sum())} of {len(scans)}** "
+        f"(local {int((in_run & (groups == 'local')).sum())}, loop {int((in_run & (groups == 'loop')).sum())}; "
+        "the run configuration may take a subset, see its `limit_per_group`). Every table below, the "
+        "odometry row included, is over these relations only.",
         "",
     ]
-    for gname, mask in (("all relations", np.ones(len(scans), bool)),
-                        ("local relations (t2 − t1 ≤ 5 s)", groups == "local"),
-                        ("loop relations (revisits, odometry drifted)", groups == "loop")):
+    for gname, mask in (("all relations", in_run),
+                        ("local relations (t2 − t1 ≤ 5 s)", in_run & (groups == "local")),
+                        ("loop relations (revisits, odometry drifted)", in_run & (groups == "loop"))):
         lines += [f"## {gname}", "", head,
                   _row("odometry (the initial guess)", relation_stats(odo_t[mask], odo_r[mask], odo_ok[mask]))]
         if est is not None:
-            ids = np.array([s.scan_id for s in scans])[mask]
+            ids = all_ids[mask]
             for name, df in est.groupby("matcher", sort=True):
                 df = df.set_index("scan_id").reindex(ids)
                 bad = df["status"].ne("ok") | df["dist_err_m"].isna()
