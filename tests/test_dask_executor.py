@@ -47,7 +47,7 @@ def sorted_rows(df: pd.DataFrame) -> pd.DataFrame:
 def test_local_cluster_gives_the_local_runners_estimates(tmp_path):
     """CLI --scheduler local:2 vs the local process pool: identical rows but for runtime_s."""
     args = ["data/scenarios/detail-1", "--limit-per-group", "1", "--no-progress",
-            "--matchers", "csm-corr,toy_matchers:Stay,toy_matchers:TwoMinima"]
+            "--matchers", "csm-corr,toy_matchers:ThreadsInfo,toy_matchers:TwoMinima"]
     for out, extra in ((tmp_path / "local", []), (tmp_path / "dask", ["--scheduler", "local:2"])):
         r = subprocess.run([sys.executable, "-m", "tfloc.cli", "bench", *args, "--out", str(out),
                             *extra], cwd=ROOT, env=ENV, capture_output=True, text=True, timeout=300)
@@ -56,6 +56,7 @@ def test_local_cluster_gives_the_local_runners_estimates(tmp_path):
     assert len(dask_) == 27 and not dask_.duplicated(KEY).any()
     assert (dask_.status == "ok").all() and set(dask_.outcome) >= {"success"}
     pd.testing.assert_frame_equal(sorted_rows(dask_), sorted_rows(local))
+    assert dask_[dask_.matcher == "toy_matchers:ThreadsInfo"]["info"].str.contains('"omp_threads":"').all()
 
 
 def test_failing_and_hanging_tasks_are_rows_not_crashes(tmp_path, test_room, lms200, cluster):
