@@ -18,12 +18,12 @@ install: $(STAMP)
 
 ## The main job: every registered matcher on the bundled scenarios, with a report.
 bench: $(STAMP)
-	$(BIN)/tfloc bench benchmarks/paper-protocol.toml --jobs $(JOBS)
+	$(BIN)/tfloc bench benchmarks/paper-protocol.toml --jobs $(JOBS) --regenerate
 	$(BIN)/tfloc report results/paper-protocol
-	$(BIN)/tfloc bench benchmarks/real-csail-relations.toml --jobs $(JOBS)
+	$(BIN)/tfloc bench benchmarks/real-csail-relations.toml --jobs $(JOBS) --regenerate
 	$(BIN)/tfloc report results/real-csail-relations
 	$(BIN)/tfloc real-note results/real-csail-relations
-	$(BIN)/tfloc bench benchmarks/real-scan-to-map.toml --jobs $(JOBS)
+	$(BIN)/tfloc bench benchmarks/real-scan-to-map.toml --jobs $(JOBS) --regenerate
 	$(BIN)/tfloc report results/real-scan-to-map
 
 ## Rebuild the real-log datasets and grid maps from data/real/ (deterministic).

@@ -124,3 +124,19 @@ def test_run_json_records_config_versions_and_machine(tmp_path, test_room, lms20
     assert doc["versions"]["numpy"] and doc["machine"]["cpu_count"] >= 1
     assert doc["datasets"] == {"ds": str(ds)}
     assert isinstance(pd.read_csv(out / "estimates.csv"), pd.DataFrame)
+
+
+def test_regenerate_reruns_a_complete_run_and_resumes_an_incomplete_one(tmp_path, test_room, lms200):
+    ds = make_dataset(tmp_path / "ds", test_room, lms200, n=2)
+    c = cfg(ds, tmp_path / "run", MatcherSpec.make("toy_matchers:Stay", label="stay"), jobs=1)
+    est = run(c, progress=False) / "estimates.csv"
+    lines = est.read_text().splitlines()
+    est.write_text("\n".join(lines[:-1]) + "\n")                 # interrupted: one row missing
+    run(c, progress=False, regenerate=True)
+    df = read_estimates(tmp_path / "run")
+    assert len(df) == 2
+    first = json.loads((tmp_path / "run" / "run.json").read_text())["sessions"]
+    assert len(first) == 2                                       # resumed, not restarted
+    run(c, progress=False, regenerate=True)                      # complete: start over
+    assert len(json.loads((tmp_path / "run" / "run.json").read_text())["sessions"]) == 1
+    assert len(read_estimates(tmp_path / "run")) == 2

@@ -44,6 +44,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="run the tasks on a Dask cluster: a running scheduler, or local:N for a "
                    "LocalCluster of N workers (needs: pip install tfloc[dask]; default: a local "
                    "process pool of --jobs workers)")
+    p.add_argument("--regenerate", action="store_true",
+                   help="if OUT holds a complete run, discard it and run again (an interrupted run "
+                        "is still resumed); make bench uses this to reproduce the committed results")
     prog = p.add_mutually_exclusive_group()
     prog.add_argument("--progress", dest="progress", action="store_true", default=None,
                       help="always show the progress bar (default: only on a terminal)")
@@ -81,6 +84,6 @@ def run(args: argparse.Namespace) -> int:
         from ..harness.dask_executor import execute_dask
 
         executor = execute_dask(args.scheduler)
-    out = run_benchmark(cfg, progress=args.progress, executor=executor)
+    out = run_benchmark(cfg, progress=args.progress, executor=executor, regenerate=args.regenerate)
     print(f"results: {out / 'estimates.csv'}  (report: tfloc report {out})", file=sys.stderr)
     return 0

@@ -133,13 +133,23 @@ def collect(fut, task: Task) -> dict:
 Executor = Callable[[list[Task], int, float, Callable[[dict], None]], None]
 
 
-def run(config: RunConfig, progress: bool | None = None, executor: Executor = execute_local) -> Path:
-    """Run (or resume) a benchmark; returns the run directory holding ``estimates.csv``."""
+def run(config: RunConfig, progress: bool | None = None, executor: Executor = execute_local,
+        regenerate: bool = False) -> Path:
+    """Run (or resume) a benchmark; returns the run directory holding ``estimates.csv``.
+
+    An existing ``estimates.csv`` is resumed: finished tasks are skipped. With ``regenerate``, a
+    *complete* previous run is discarded and run again (an interrupted one is still resumed), so
+    one command both reproduces a committed reference run and survives interruptions.
+    """
     out = Path(config.out)
     out.mkdir(parents=True, exist_ok=True)
     tasks = make_tasks(config)
     done = done_keys(out / "estimates.csv")
     todo = [t for t in tasks if t.key not in done]
+    if regenerate and not todo and tasks:
+        (out / "estimates.csv").unlink()
+        (out / "run.json").unlink(missing_ok=True)
+        todo = tasks
     write_run_json(config, out, len(tasks), len(tasks) - len(todo))
     if not todo:
         return out

@@ -33,8 +33,11 @@ class VectorMap:
     Attributes:
         walls: wall geometries (LineStrings) that reflect beams.
         obstacles: polygons that reflect beams and are not free space inside.
-        outline: the mapped area (free space = outline − obstacles − walls); if ``None``, the
-            convex hull of all geometry.
+        outline: the mapped area (free space = outline − obstacles − walls); its boundary
+            reflects beams.
+        region: a mapped area that does not reflect beams, used when there is no outline (e.g.
+            the surroundings of a reference scan); if both are ``None``, the convex hull of all
+            geometry.
         name: a label for reports.
     """
 
@@ -42,13 +45,15 @@ class VectorMap:
     obstacles: tuple[BaseGeometry, ...] = ()
     outline: BaseGeometry | None = None
     name: str = "map"
+    region: BaseGeometry | None = None
     _free_cache: dict = field(default_factory=dict, repr=False)
 
     @classmethod
-    def from_segments(cls, segments: np.ndarray, name: str = "segments") -> VectorMap:
+    def from_segments(cls, segments: np.ndarray, name: str = "segments",
+                      region: BaseGeometry | None = None) -> VectorMap:
         """A map of bare wall segments ``(M, 4)`` = (ax, ay, bx, by), e.g. a reference scan polyline."""
         s = np.asarray(segments, dtype=float).reshape(-1, 4)
-        return cls(walls=tuple(shapely.linestrings(s.reshape(-1, 2, 2))), name=name)
+        return cls(walls=tuple(shapely.linestrings(s.reshape(-1, 2, 2))), name=name, region=region)
 
     @cached_property
     def segments(self) -> np.ndarray:
@@ -62,9 +67,11 @@ class VectorMap:
 
     @cached_property
     def area(self) -> BaseGeometry:
-        """The mapped area: ``outline`` or the convex hull of all geometry."""
+        """The mapped area: ``outline``, else ``region``, else the convex hull of all geometry."""
         if self.outline is not None:
             return self.outline
+        if self.region is not None:
+            return self.region
         return shapely.convex_hull(shapely.GeometryCollection([*self.walls, *self.obstacles]))
 
     @property

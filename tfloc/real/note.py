@@ -18,14 +18,15 @@ from ..harness.dataset import read_scans, read_scenario
 from ..pose import angdiff
 
 #: Kümmerle et al. 2009 (Auton. Robots 27:387-407), MIT CSAIL: errors on its 1172 relations of the
-#: trajectories of three SLAM systems: (method, trans. mean m, std m, max m or None, rot. mean °, std °).
-#: No copy of the paper was at hand. The translational figures (and the 3.570 m maximum of scan
+#: trajectories of three SLAM systems: (method, trans. mean m, std m, max m or None).
+#: No copy of the paper was at hand. These translational figures (and the 3.570 m maximum of scan
 #: matching) agree with a secondary transcription of the paper's table found in a public
-#: repository; the rotational ones are from memory and unconfirmed. Verify before quoting.
+#: repository. The rotational figures could not be confirmed from any source at hand and are
+#: left out rather than quoted from memory. Verify before quoting.
 PUBLISHED_CSAIL = (
-    ("Scan matching (sequential, Kümmerle et al. 2009)", 0.106, 0.325, 3.570, 1.4, 4.5),
-    ("RBPF / GMapping, 50 particles (Kümmerle et al. 2009)", 0.049, 0.049, None, 0.6, 1.2),
-    ("Graph mapping (Kümmerle et al. 2009)", 0.004, 0.009, None, 0.05, 0.08),
+    ("Scan matching (sequential, Kümmerle et al. 2009)", 0.106, 0.325, 3.570),
+    ("RBPF / GMapping, 50 particles (Kümmerle et al. 2009)", 0.049, 0.049, None),
+    ("Graph mapping (Kümmerle et al. 2009)", 0.004, 0.009, None),
 )
 
 def relation_stats(trans_m: np.ndarray, rot_rad: np.ndarray, success: np.ndarray | None = None,
@@ -106,14 +107,14 @@ def write_note(results: Path, dataset: Path, max_dist_m: float = 0.10, max_angle
     lines += [
         "## Published figures on the same relations",
         "",
-        "| method (Kümmerle et al. 2009, MIT CSAIL) | trans. error m (mean ± std) | max m | rot. error ° (mean ± std) |",
-        "|---|---|---|---|",
-        *[f"| {m} | {a:.3f} ± {b:.3f} | {'–' if mx is None else f'{mx:.3f}'} | {c:g} ± {d:g} (unconfirmed) |"
-          for m, a, b, mx, c, d in PUBLISHED_CSAIL],
+        "| method (Kümmerle et al. 2009, MIT CSAIL) | trans. error m (mean ± std) | max m |",
+        "|---|---|---|",
+        *[f"| {m} | {a:.3f} ± {b:.3f} | {'–' if mx is None else f'{mx:.3f}'} |"
+          for m, a, b, mx in PUBLISHED_CSAIL],
         "",
         "No copy of the paper was at hand when this note was written. The translational figures agree with a "
-        "secondary transcription of the paper's table; the rotational ones are unconfirmed. **Check all of them "
-        "against the paper's results tables before quoting them.**",
+        "secondary transcription of the paper's table; the published rotational errors could not be confirmed "
+        "and are not quoted. **Check these figures against the paper's results tables before quoting them.**",
         "",
         "## What can be compared, and what cannot",
         "",
