@@ -6,14 +6,13 @@ import json
 from pathlib import Path
 
 import pytest
+from test_harness_runner import make_dataset
 
 from tfloc.errors import ConfigError
 from tfloc.harness.config import load_config
 from tfloc.harness.report import write_report
 from tfloc.harness.results import read_estimates
 from tfloc.harness.runner import run
-
-from test_harness_runner import make_dataset
 
 
 def write(tmp_path: Path, body: str) -> Path:
