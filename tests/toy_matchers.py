@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 import time
 
 import numpy as np
@@ -34,6 +35,14 @@ class SlowStay(Stay):
 
     def __init__(self, sleep_s: float = 0.25) -> None:
         super().__init__(sleep_s)
+
+
+class ThreadsInfo(Stay):
+    """:class:`Stay` reporting the thread limits its worker process was started with."""
+
+    def localize(self, problem: Problem) -> Estimate:
+        return Estimate(problem.initial, True, 1, 1, {"omp_threads": os.environ.get("OMP_NUM_THREADS"),
+                                                      "numba_threads": os.environ.get("NUMBA_NUM_THREADS")})
 
 
 class Raises(Stay):

@@ -9,6 +9,8 @@ hangs gets an `error:`/`timeout` row and the run goes on.
 Examples:
   tfloc bench benchmarks/paper-protocol.toml
   tfloc bench data/scenarios/detail-1 --matchers tf,csm-corr --out results/try --jobs 2
+  tfloc bench benchmarks/paper-protocol.toml --scheduler tcp://HOST:8786   # on a Dask cluster
+  tfloc bench benchmarks/paper-protocol.toml --scheduler local:2           # a local Dask cluster
 """
 
 from __future__ import annotations
@@ -38,6 +40,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="only the first N scans of each group (smoke runs; default: all)")
     p.add_argument("--success-cm", type=float, help="success threshold on distance error, cm (default 10)")
     p.add_argument("--success-deg", type=float, help="success threshold on orientation error, degrees (default 2)")
+    p.add_argument("--scheduler", metavar="tcp://HOST:PORT | local:N",
+                   help="run the tasks on a Dask cluster: a running scheduler, or local:N for a "
+                   "LocalCluster of N workers (needs: pip install tfloc[dask]; default: a local "
+                   "process pool of --jobs workers)")
     p.add_argument("--regenerate", action="store_true",
                    help="if OUT holds a complete run, discard it and run again (an interrupted run "
                         "is still resumed); make bench uses this to reproduce the committed results")
@@ -69,9 +75,15 @@ def config_from_args(args: argparse.Namespace) -> RunConfig:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..harness.runner import execute_local
     from ..harness.runner import run as run_benchmark
 
     cfg = config_from_args(args)
-    out = run_benchmark(cfg, progress=args.progress, regenerate=args.regenerate)
+    executor = execute_local
+    if args.scheduler:
+        from ..harness.dask_executor import execute_dask
+
+        executor = execute_dask(args.scheduler)
+    out = run_benchmark(cfg, progress=args.progress, executor=executor, regenerate=args.regenerate)
     print(f"results: {out / 'estimates.csv'}  (report: tfloc report {out})", file=sys.stderr)
     return 0

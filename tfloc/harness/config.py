@@ -14,10 +14,19 @@ A run configuration file looks like::
     orient_deg = 2.0
     [params.tf]              # parameters for every matcher entry named "tf" without its own
     spacing = 1.0
+    [[sweep]]                # a parameter grid: one matcher label per grid point
+    name = "tf"              # registered matcher name
+    grid = { spacing = [0.5, 1.0], straw_t = [0.95, 0.99] }
+    params = { }             # optional fixed parameters (over [params.tf])
+    label = "tf"             # optional label prefix (default: name)
+
+A sweep adds the cartesian product of its grid, in the order the keys and values are written,
+as matchers labelled ``tf[spacing=0.5,straw_t=0.95]``, ``tf[spacing=0.5,straw_t=0.99]``, ...
 """
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import tomllib
@@ -96,6 +105,41 @@ def parse_matchers(entries: list, defaults: dict[str, dict], where: str) -> tupl
     return tuple(specs)
 
 
+def _value_text(v: Any) -> str:
+    return v if isinstance(v, str) else json.dumps(v)
+
+
+def expand_sweeps(sweeps: Any, defaults: dict[str, dict], where: str) -> tuple[MatcherSpec, ...]:
+    """Matcher specs of ``[[sweep]]`` tables: one per point of each grid (cartesian product)."""
+    if not isinstance(sweeps, list):
+        raise ConfigError(f"{where}: 'sweep' must be an array of tables ([[sweep]])")
+    specs = []
+    for i, sw in enumerate(sweeps):
+        at = f"{where}: sweep[{i}]"
+        if not isinstance(sw, dict) or not isinstance(sw.get("name"), str):
+            raise ConfigError(f"{at} must be a table with a matcher 'name'")
+        unknown = sorted(set(sw) - {"name", "grid", "params", "label"})
+        if unknown:
+            raise ConfigError(f"{at}: unknown key(s) {', '.join(unknown)}")
+        grid, fixed = sw.get("grid"), sw.get("params", {})
+        if not isinstance(grid, dict) or not grid:
+            raise ConfigError(f"{at}: 'grid' must be a non-empty table of parameter lists")
+        if not isinstance(fixed, dict):
+            raise ConfigError(f"{at}: 'params' must be a table")
+        for k, values in grid.items():
+            if not isinstance(values, list) or not values:
+                raise ConfigError(f"{at}: grid.{k} must be a non-empty list of values")
+            if len({json.dumps(v) for v in values}) != len(values):
+                raise ConfigError(f"{at}: grid.{k} lists a value twice")
+        prefix = str(sw.get("label", sw["name"]))
+        for point in itertools.product(*grid.values()):
+            chosen = dict(zip(grid, point, strict=True))
+            label = f"{prefix}[{','.join(f'{k}={_value_text(v)}' for k, v in chosen.items())}]"
+            specs.append(MatcherSpec.make(sw["name"], {**defaults.get(sw["name"], {}), **fixed,
+                                                       **chosen}, label))
+    return tuple(specs)
+
+
 def load_config(path: str | Path) -> RunConfig:
     """Read a run configuration TOML file; errors name the file and the key."""
     path = Path(path)
@@ -110,6 +154,8 @@ def load_config(path: str | Path) -> RunConfig:
     unknown = sorted(set(doc) - known)
     if unknown:
         raise ConfigError(f"{path}: unknown key(s) {', '.join(unknown)}")
+    if "sweep" in doc:  # a run may consist of sweeps only
+        doc.setdefault("matchers", [])
     for key in ("datasets", "matchers"):
         if not isinstance(doc.get(key), list):
             raise ConfigError(f"{path}: '{key}' must be a list")
@@ -119,11 +165,14 @@ def load_config(path: str | Path) -> RunConfig:
             name=str(doc.get("name", path.stem)),
             out=Path(doc.get("out", f"results/{doc.get('name', path.stem)}")),
             datasets=tuple(Path(d) for d in doc["datasets"]),
-            matchers=parse_matchers(doc["matchers"], doc.get("params", {}), str(path)),
+            matchers=parse_matchers(doc["matchers"], doc.get("params", {}), str(path))
+            + expand_sweeps(doc.get("sweep", []), doc.get("params", {}), str(path)),
             jobs=int(doc.get("jobs", 2)), timeout_s=float(doc.get("timeout_s", 60.0)),
             limit_per_group=int(doc.get("limit_per_group", 0)),
             success_dist_m=float(success.get("dist_m", 0.10)),
             success_orient_rad=math.radians(float(success.get("orient_deg", 2.0))),
-            extra={k: doc[k] for k in ("description", "sweep") if k in doc})
+            extra={k: doc[k] for k in ("description",) if k in doc})
     except (TypeError, ValueError) as exc:
         raise ConfigError(f"{path}: {exc}") from None
+    except ConfigError as exc:
+        raise ConfigError(exc if str(exc).startswith(str(path)) else f"{path}: {exc}") from None

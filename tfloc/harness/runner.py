@@ -115,16 +115,19 @@ def execute_local(tasks: list[Task], jobs: int, timeout_s: float,
                 pass
         futures = {pool.schedule(run_task, args=(t,), timeout=timeout_s): t for t in tasks}
         for fut in as_completed(futures):
-            t = futures[fut]
-            try:
-                row = fut.result()
-            except (TimeoutError, FutureTimeout):
-                row = failure_row(t, "timeout")
-            except ProcessExpired as exc:
-                row = failure_row(t, f"error:worker died ({exc})")
-            except Exception as exc:  # noqa: BLE001
-                row = failure_row(t, f"error:{type(exc).__name__}: {exc}")
-            on_row(row)
+            on_row(collect(fut, futures[fut]))
+
+
+def collect(fut, task: Task) -> dict:
+    """The row of a pebble future of ``run_task(task)``: its result, or a timeout/error row."""
+    try:
+        return fut.result()
+    except (TimeoutError, FutureTimeout):
+        return failure_row(task, "timeout")
+    except ProcessExpired as exc:
+        return failure_row(task, f"error:worker died ({exc})")
+    except Exception as exc:  # noqa: BLE001
+        return failure_row(task, f"error:{type(exc).__name__}: {exc}")
 
 
 Executor = Callable[[list[Task], int, float, Callable[[dict], None]], None]

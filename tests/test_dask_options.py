@@ -1,0 +1,36 @@
+"""``--scheduler`` errors: bad addresses and a missing ``distributed`` are one-line messages."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tfloc.errors import ConfigError
+from tfloc.harness.dask_executor import execute_dask, parse_scheduler
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.mark.parametrize("address, parsed", [("local:3", ("local", 3)),
+                                             ("tcp://10.0.0.5:8786", ("remote", "tcp://10.0.0.5:8786")),
+                                             ("tls://sched.lab:8786", ("remote", "tls://sched.lab:8786"))])
+def test_scheduler_addresses(address, parsed):
+    assert parse_scheduler(address) == parsed
+
+
+@pytest.mark.parametrize("address", ["local:0", "local", "10.0.0.5:8786", "local:two"])
+def test_bad_scheduler_is_a_one_line_cli_error(address, tmp_path):
+    r = subprocess.run([sys.executable, "-m", "tfloc.cli", "bench", "data/scenarios/detail-1",
+                        "--matchers", "tf", "--out", str(tmp_path / "r"), "--scheduler", address],
+                       cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2 and "--scheduler" in r.stderr and "Traceback" not in r.stderr
+    assert not (tmp_path / "r" / "estimates.csv").exists()
+
+
+def test_missing_distributed_names_the_extra(monkeypatch):
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed -> ImportError
+    with pytest.raises(ConfigError, match=r"pip install tfloc\[dask\]"):
+        execute_dask("local:2")

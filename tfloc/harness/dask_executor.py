@@ -1,0 +1,132 @@
+"""Run a benchmark's tasks on a Dask cluster: ``tfloc bench ... --scheduler ADDRESS``.
+
+``ADDRESS`` is a running scheduler (``tcp://HOST:8786``) or ``local:N``, a
+:class:`distributed.LocalCluster` of N single-threaded worker processes on 127.0.0.1. Dask does the
+scheduling; tfloc only submits its (scan, matcher) tasks, which carry a dataset path, a scan id
+and a matcher spec (never a map), and writes each row to ``estimates.csv`` as its task finishes.
+The client is the only writer, so every task ends in exactly one row: when a worker dies, Dask
+runs its tasks again elsewhere; a task that kills workers repeatedly (``KilledWorker``) becomes an
+``error:worker died`` row. The per-task time limit and the per-worker data caches are those of
+:mod:`tfloc.harness.dask_worker`. Resume after a crash of the client is the runner's (finished
+keys are skipped). ``distributed`` is an optional dependency (``pip install tfloc[dask]``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import re
+import uuid
+from collections.abc import Callable, Iterator
+
+from ..errors import ConfigError
+from .runner import Executor
+from .task import Task, failure_row
+
+INSTALL_HINT = "pip install tfloc[dask]"
+_LOCAL = re.compile(r"local:(\d+)")
+
+
+def parse_scheduler(address: str) -> tuple[str, int | str]:
+    """``("local", N)`` for ``local:N``, ``("remote", address)`` for ``proto://host:port``."""
+    m = _LOCAL.fullmatch(address)
+    if m:
+        n = int(m.group(1))
+        if n < 1:
+            raise ConfigError(f"--scheduler {address}: local:N needs N ≥ 1 workers")
+        return "local", n
+    if re.fullmatch(r"[a-z+]+://\S+", address):
+        return "remote", address
+    raise ConfigError(f"--scheduler {address!r}: expected local:N or a scheduler address like "
+                      "tcp://HOST:8786")
+
+
+def _require_distributed() -> None:
+    try:
+        import distributed  # noqa: F401
+    except ImportError:
+        raise ConfigError(f"--scheduler needs dask.distributed, which is not installed: "
+                          f"{INSTALL_HINT}") from None
+
+
+@contextlib.contextmanager
+def connect(address: str) -> Iterator:
+    """A :class:`distributed.Client` for ``address`` (starting and closing a LocalCluster for
+    ``local:N``). Worker processes are started non-daemonic, so that they can run task processes."""
+    import dask
+    from distributed import Client, LocalCluster
+
+    kind, where = parse_scheduler(address)
+    with dask.config.set({"distributed.worker.daemon": False}):  # also for workers restarted later
+        if kind == "local":
+            with LocalCluster(n_workers=where, threads_per_worker=1, processes=True,
+                              host="127.0.0.1", dashboard_address=None) as cluster, \
+                    Client(cluster) as client:
+                client.wait_for_workers(where, timeout=120)
+                yield client
+            return
+        try:
+            client = Client(where, timeout=30)
+        except (OSError, TimeoutError) as exc:
+            raise ConfigError(f"--scheduler {where}: cannot connect ({exc})") from None
+        with client:
+            yield client
+
+
+def check_workers(client, tasks: list[Task]) -> None:
+    """Fail at once, naming the worker, if a worker cannot run tasks (missing data, daemonic)."""
+    from .dask_worker import preflight
+
+    datasets = sorted({t.dataset for t in tasks})
+    bad = {w: p for w, p in client.run(preflight, datasets).items() if p}
+    if bad:
+        w, problems = next(iter(bad.items()))
+        more = f" (and {len(bad) - 1} more workers)" if len(bad) > 1 else ""
+        raise ConfigError(f"Dask worker {w} {'; '.join(problems)}{more}")
+
+
+def host_threads(client) -> dict[str, int]:
+    """Worker address → the Dask threads of all workers on the same machine."""
+    try:
+        workers = client.scheduler_info(n_workers=-1)["workers"]
+    except TypeError:  # distributed < 2025: every worker is listed anyway
+        workers = client.scheduler_info()["workers"]
+    per_host: dict[str, int] = {}
+    for w in workers.values():
+        per_host[w["host"]] = per_host.get(w["host"], 0) + int(w["nthreads"])
+    return {addr: per_host[w["host"]] for addr, w in workers.items()}
+
+
+def execute_dask(address: str) -> Executor:
+    """An :data:`~tfloc.harness.runner.Executor` running tasks on the Dask cluster at ``address``
+    (``local:N`` or ``tcp://HOST:PORT``); ``jobs`` is ignored (the workers set the parallelism)."""
+    parse_scheduler(address)
+    _require_distributed()
+
+    def execute(tasks: list[Task], jobs: int, timeout_s: float,
+                on_row: Callable[[dict], None]) -> None:
+        from distributed import as_completed
+        from distributed.scheduler import KilledWorker
+
+        from .dask_worker import PLUGIN_NAME, TaskPool, run_on_worker
+
+        with connect(address) as client:
+            check_workers(client, tasks)
+            client.register_plugin(TaskPool(host_threads(client)), name=PLUGIN_NAME)
+            run_id = uuid.uuid4().hex[:12]  # keys never collide with an earlier client's
+            futures = client.map(run_on_worker, tasks, timeout_s=timeout_s, pure=False,
+                                 key=[f"tfloc-{run_id}-{i}" for i in range(len(tasks))])
+            by_key = {f.key: t for f, t in zip(futures, tasks, strict=True)}
+            finished = as_completed(futures)
+            del futures  # as_completed holds each future until it is done, then we release it
+            for fut in finished:
+                t = by_key[fut.key]
+                try:
+                    row = fut.result()
+                except KilledWorker as exc:
+                    row = failure_row(t, f"error:worker died ({exc})")
+                except Exception as exc:  # noqa: BLE001 - a failed task is a row, not a crash
+                    row = failure_row(t, f"error:{type(exc).__name__}: {exc}")
+                on_row(row)
+                fut.release()
+
+    return execute
