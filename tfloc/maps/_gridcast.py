@@ -30,6 +30,21 @@ def _entry(x0: float, y0: float, dx: float, dy: float, W: int, H: int) -> tuple[
 
 
 @njit(cache=True, nogil=True)
+def _start(x0: float, y0: float, dx: float, dy: float, t0: float, W: int, H: int):
+    """DDA state where the ray enters the grid at parameter ``t0``: the cell ``(i, j)``, the steps
+    ``(sx, sy)``, the parameter per cell ``(tdx, tdy)`` and the next x/y cell crossings ``(tx, ty)``."""
+    x, y = x0 + t0 * dx, y0 + t0 * dy
+    i, j = min(max(int(np.floor(x)), 0), W - 1), min(max(int(np.floor(y)), 0), H - 1)
+    sx = 1 if dx > 0 else -1
+    sy = 1 if dy > 0 else -1
+    tdx = abs(1.0 / dx) if dx != 0.0 else np.inf
+    tdy = abs(1.0 / dy) if dy != 0.0 else np.inf
+    tx = t0 + ((i + 1 - x) / dx if dx > 0 else (x - i) / -dx) if dx != 0.0 else np.inf
+    ty = t0 + ((j + 1 - y) / dy if dy > 0 else (y - j) / -dy) if dy != 0.0 else np.inf
+    return i, j, sx, sy, tdx, tdy, tx, ty
+
+
+@njit(cache=True, nogil=True)
 def _march(occ: np.ndarray, x0: float, y0: float, dx: float, dy: float, tmax: float) -> float:
     """Distance (cell units) along the unit ray to the first occupied cell, ``inf`` if none before
     ``tmax``. The hit is the midpoint of the ray's chord through that cell (an unbiased estimate of
@@ -39,14 +54,7 @@ def _march(occ: np.ndarray, x0: float, y0: float, dx: float, dy: float, tmax: fl
     if t0 > t1 or t0 > tmax:
         return np.inf
     t1 = min(t1, tmax)
-    x, y = x0 + t0 * dx, y0 + t0 * dy
-    i, j = min(max(int(np.floor(x)), 0), W - 1), min(max(int(np.floor(y)), 0), H - 1)
-    sx = 1 if dx > 0 else -1
-    sy = 1 if dy > 0 else -1
-    tdx = abs(1.0 / dx) if dx != 0.0 else np.inf
-    tdy = abs(1.0 / dy) if dy != 0.0 else np.inf
-    tx = t0 + ((i + 1 - x) / dx if dx > 0 else (x - i) / -dx) if dx != 0.0 else np.inf
-    ty = t0 + ((j + 1 - y) / dy if dy > 0 else (y - j) / -dy) if dy != 0.0 else np.inf
+    i, j, sx, sy, tdx, tdy, tx, ty = _start(x0, y0, dx, dy, t0, W, H)
     t = t0
     while t <= t1:
         tn = min(tx, ty)
@@ -102,15 +110,8 @@ def carve_grid(passes: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> None
         if t0 > t1:
             continue
         t1 = min(t1, length)
-        x, y = x0 + t0 * dx, y0 + t0 * dy
-        i, j = min(max(int(np.floor(x)), 0), W - 1), min(max(int(np.floor(y)), 0), H - 1)
+        i, j, sx, sy, tdx, tdy, tx, ty = _start(x0, y0, dx, dy, t0, W, H)
         ie, je = int(np.floor(ends[k, 0])), int(np.floor(ends[k, 1]))
-        sx = 1 if dx > 0 else -1
-        sy = 1 if dy > 0 else -1
-        tdx = abs(1.0 / dx) if dx != 0.0 else np.inf
-        tdy = abs(1.0 / dy) if dy != 0.0 else np.inf
-        tx = t0 + ((i + 1 - x) / dx if dx > 0 else (x - i) / -dx) if dx != 0.0 else np.inf
-        ty = t0 + ((j + 1 - y) / dy if dy > 0 else (y - j) / -dy) if dy != 0.0 else np.inf
         t = t0
         while t < t1:
             if i == ie and j == je:
