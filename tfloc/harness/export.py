@@ -37,8 +37,9 @@ class Exported:
     stamps: str  # "stamp" | "index" | "run order"
 
 
-def read_estimates(path: Path) -> list[dict]:
-    """The rows of an ``estimates.csv``, checking that the needed columns exist."""
+def _read_rows(path: Path) -> list[dict]:
+    """The rows of an ``estimates.csv`` as strings (export needs no DataFrame; see
+    :func:`tfloc.harness.results.read_estimates` for that), checking the needed columns exist."""
     if not path.is_file():
         raise DatasetError(f"{path}: no such results file (is the run directory right?)")
     with path.open(newline="") as fh:
@@ -120,7 +121,7 @@ def export_tum(run_dir: str | Path, out_dir: str | Path, datasets_root: Path | N
     """Write ``out_dir/<dataset>/{reference,initial,<matcher>}.tum`` for a run (``<dataset>``: the
     last part of the run's dataset name or path); returns what was written."""
     run_dir, out_dir = Path(run_dir), Path(out_dir)
-    rows = read_estimates(run_dir / "estimates.csv")
+    rows = _read_rows(run_dir / "estimates.csv")
     by_ds: dict[str, list[dict]] = {}
     for r in rows:
         by_ds.setdefault(r["dataset"], []).append(r)
