@@ -34,6 +34,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    import pandas as pd
+
     from ..harness import guard
     from ..harness.config import load_config, parse_matchers
 
@@ -46,7 +48,7 @@ def run(args: argparse.Namespace) -> int:
         old = guard.read_reference(args.reference) if args.reference.exists() else current.iloc[:0]
         if args.matchers and args.reference.exists():  # keep the other matchers' reference rows
             keep = old[~old.matcher.isin(current.matcher.unique())]
-            current = guard.pd.concat([keep, current]).sort_values(list(guard.KEY), ignore_index=True)
+            current = pd.concat([keep, current]).sort_values(list(guard.KEY), ignore_index=True)
         guard.write_reference(current, args.reference)
         print(f"updated {args.reference}:\n{guard.format_changes(old, current)}")
         return 0

@@ -33,7 +33,7 @@ def done_keys(path: Path) -> set[tuple[str, str, str]]:
     if not path.exists() or path.stat().st_size == 0:
         return set()
     with path.open(newline="") as fh:
-        return {(r["dataset"], r["scan_id"], r["matcher"]) for r in csv.DictReader(fh)}
+        return {tuple(r[k] for k in KEY) for r in csv.DictReader(fh)}
 
 
 class ResultWriter:

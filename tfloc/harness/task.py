@@ -11,7 +11,6 @@ import math
 import time
 from dataclasses import dataclass
 from functools import lru_cache
-from pathlib import Path
 from typing import Any
 
 from ..matcher import get_matcher
@@ -136,9 +135,3 @@ def warm_up(task: Task) -> None:
                 scan.initial)
     except Exception:  # noqa: BLE001 - the real run will report it
         pass
-
-
-
-
-def dataset_name(path: str | Path) -> str:
-    return read_scenario(path).name
