@@ -18,6 +18,7 @@ from pathlib import Path
 from tqdm import tqdm
 
 from ..harness.dataset import iter_scans, map_for, read_scenario
+from ..harness.task import status_of
 from ..matcher import get_matcher
 from ..problem import Problem
 
@@ -60,10 +61,9 @@ def run(args: argparse.Namespace) -> int:
             t0 = time.perf_counter()
             est = matcher.localize(problem)
             dt = time.perf_counter() - t0
-            status = "ok" if est.converged else str(est.info.get("status", "failed"))
             w.writerow([scan.scan_id, matcher.name, f"{est.pose.x:.6f}", f"{est.pose.y:.6f}",
                         f"{est.pose.theta:.7f}", f"{dt:.6f}", int(est.converged), est.iterations,
-                        est.evaluations, status])
+                        est.evaluations, status_of(est)])
             fh.flush()
     print(f"wrote {args.out}", file=sys.stderr)
     return 0

@@ -15,7 +15,7 @@ from typing import Any
 
 from ..matcher import get_matcher
 from ..pose import Pose, angdiff
-from ..problem import Problem
+from ..problem import Estimate, Problem
 from .dataset import Scan, Scenario, map_for, read_scans, read_scenario
 
 
@@ -87,6 +87,12 @@ def failure_row(task: Task, status: str, scan: Scan | None = None) -> dict[str, 
     return row
 
 
+def status_of(est: Estimate) -> str:
+    """``failed`` when the matcher declined to answer (``info["status"] == "no-answer"``) or gave a
+    non-finite pose, else ``ok``; whether it converged is reported separately."""
+    return "failed" if est.info.get("status") == "no-answer" or not est.pose.is_finite() else "ok"
+
+
 def run_task(task: Task) -> dict[str, Any]:
     """Run one task; exceptions from the matcher become an ``error:`` row (never raised)."""
     scenario, scans = load_dataset(task.dataset)
@@ -102,10 +108,11 @@ def run_task(task: Task) -> dict[str, Any]:
         return failure_row(task, f"error:{type(exc).__name__}: {exc}", scan)
     row = base_row(task, scan)
     p = est.pose
-    declined = est.info.get("status") == "no-answer" or not p.is_finite()
+    status = status_of(est)
+    declined = status == "failed"
     row.update(est_x=p.x, est_y=p.y, est_theta=p.theta, runtime_s=runtime,
                converged=int(bool(est.converged)), iterations=est.iterations,
-               evaluations=est.evaluations, status="failed" if declined else "ok",
+               evaluations=est.evaluations, status=status,
                info=json.dumps(est.info, default=str, separators=(",", ":")))
     if scan.true is None:
         return row
