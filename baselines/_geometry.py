@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from tfloc.pose import Pose, wrap_angle
+from tfloc.core.pose import Pose, wrap_angle
 
 
 def pose_to_matrix(pose: Pose, dim: int = 3) -> np.ndarray:

@@ -3,7 +3,7 @@
 Inputs are the map, the laser spec, the real scan and the initial pose (never the truth).
 Configuration choices and why:
 
-* **Likelihood field of the map** (:mod:`baselines.likelihood`): ``resolution`` = 2 cm cells,
+* **Likelihood field of the map** (:mod:`tfloc.baselines.likelihood`): ``resolution`` = 2 cm cells,
   distance by ``scipy.ndimage.distance_transform_edt``, likelihood ``exp(-d² / 2σ²)`` with
   ``sigma`` = 10 cm. σ is wide enough that a beam endpoint 10 m out, off by half a rotation step
   (0.5° ≈ 9 cm), still scores, so the discrete search does not skip the right rotation; the
@@ -37,8 +37,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from tfloc.pose import Pose, wrap_angle
-from tfloc.problem import Estimate, Problem
+from tfloc.core.pose import Pose, wrap_angle
+from tfloc.core.problem import Estimate, Problem
 
 from ._config import resolve_config
 from .likelihood import LikelihoodField, likelihood_field

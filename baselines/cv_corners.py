@@ -3,13 +3,13 @@
 Inputs are the map, the laser spec, the real scan and the initial pose (never the truth).
 Configuration choices and why:
 
-* **Corners by the same code path as** ``tf``: ``tfloc.tf.scan_corners`` (ShortStraw, Alg. 1–3)
+* **Corners by the same code path as** ``tf``: ``tfloc.paper.matcher.scan_corners`` (ShortStraw, Alg. 1–3)
   on the real scan and on the virtual scan ray-cast from the current pose estimate (at first the
   initial pose). The virtual scan, not the map's vertices, so that both corner sets come from the
   same detector and see the same occlusions; it works for any map (vector or grid). The one
   setting changed from ``tf``'s defaults is the resampling distance ``corner_spacing`` = 2 cm
   (``tf`` uses S = 1 m): corners land on resampled points, so S bounds their accuracy.
-* **Sub-sample corner positions** (``refine_corners``, :mod:`baselines._corner_refine`): a
+* **Sub-sample corner positions** (``refine_corners``, :mod:`tfloc.baselines._corner_refine`): a
   corner between two straight pieces of the scan moves to the intersection of the lines fitted
   to the raw points of those pieces; jump edges and field-of-view ends stay as ShortStraw put
   them. Without it, range noise (σ = 1 cm) leaves corners 1–3 cm off and the pose jitters by as
@@ -57,9 +57,9 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from tfloc.pose import Pose, angdiff, wrap_angle
-from tfloc.problem import Estimate, Problem
-from tfloc.tf import TfConfig, scan_corners
+from tfloc.core.pose import Pose, angdiff, wrap_angle
+from tfloc.core.problem import Estimate, Problem
+from tfloc.paper.matcher import TfConfig, scan_corners
 
 from ._config import resolve_config
 from ._corner_match import best_hypothesis, mutual_inliers, pair_hypotheses

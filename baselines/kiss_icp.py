@@ -45,12 +45,12 @@ import numpy as np
 from kiss_icp.mapping import VoxelHashMap
 from kiss_icp.registration import Registration
 
-from tfloc.pose import Pose
-from tfloc.problem import Estimate, Problem
+from tfloc.core.pose import Pose
+from tfloc.core.problem import Estimate, Problem
+from tfloc.maps.cache import cached, map_geometry
 
 from ._config import resolve_config
 from ._geometry import embed_z0, matrix_to_pose, pose_to_matrix
-from ._mapcache import cached, map_geometry
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,7 @@ from functools import cached_property
 import numpy as np
 from scipy.ndimage import distance_transform_edt, map_coordinates, maximum_filter
 
-from ._mapcache import cached
+from tfloc.maps.cache import cached
 
 _EDT_MARGIN_M = 1.0  # distance transform computed on bounds + 1 m; farther cells are "far" anyway
 

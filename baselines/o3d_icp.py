@@ -35,12 +35,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tfloc.pose import Pose
-from tfloc.problem import Estimate, Problem
+from tfloc.core.pose import Pose
+from tfloc.core.problem import Estimate, Problem
+from tfloc.maps.cache import map_geometry, point_to_line_residuals
 
 from ._config import resolve_config
 from ._geometry import embed_z0, matrix_to_pose, pose_to_matrix
-from ._mapcache import map_geometry, point_to_line_residuals
 from ._open3d import import_open3d
 
 o3d = import_open3d()

@@ -19,9 +19,9 @@ import pytest  # noqa: E402
 import shapely  # noqa: E402
 from shapely.geometry import LineString, Polygon, box  # noqa: E402
 
-from tfloc.laser import LaserSpec  # noqa: E402
+from tfloc.core.laser import LaserSpec  # noqa: E402
+from tfloc.core.pose import Pose  # noqa: E402
 from tfloc.maps.vector import VectorMap  # noqa: E402
-from tfloc.pose import Pose  # noqa: E402
 
 try:  # limit BLAS/OpenMP pools that are already loaded, if threadpoolctl is available
     from threadpoolctl import threadpool_limits

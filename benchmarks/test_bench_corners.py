@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from tfloc.corners import corner_candidates, resample, shortstraw
-from tfloc.tf import TfConfig
+from tfloc.paper.corners import corner_candidates, resample, shortstraw
+from tfloc.paper.matcher import TfConfig
 
 
 @pytest.fixture(scope="module")

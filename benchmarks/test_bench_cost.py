@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tfloc.pose import Pose
-from tfloc.problem import Problem
-from tfloc.tf import TfConfig, TurningFunctionMatcher, _Cost, scan_turning_function
+from tfloc.core.pose import Pose
+from tfloc.core.problem import Problem
+from tfloc.paper.matcher import TfConfig, TurningFunctionMatcher, _Cost, scan_turning_function
 
 
 @pytest.fixture(scope="module")

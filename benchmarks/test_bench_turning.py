@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tfloc.pose import Pose
-from tfloc.tf import TfConfig, scan_corners, scan_polygon
-from tfloc.turning import match, turning_function
+from tfloc.core.pose import Pose
+from tfloc.paper.matcher import TfConfig, scan_corners, scan_polygon
+from tfloc.paper.turning import match, turning_function
 
 
 @pytest.fixture(scope="module")

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 import tfloc
-from tfloc.harness.dataset import read_scans, read_scenario
-from tfloc.laser import LaserSpec
+from tfloc.core.laser import LaserSpec
+from tfloc.io.scenario import read_scans, read_scenario
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from tfloc.harness.results import COLUMNS
+from tfloc.io.estimates import COLUMNS
 
 
 def row(matcher: str = "A", dist_m: float | None = 0.01, orient_deg: float | None = 0.5,

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 from _baseline_cases import OFFSETS, errors, make_problem
+from tfloc.baselines.csm_corr import CorrelativeMatcher
 
 import tfloc
-from baselines.csm_corr import CorrelativeMatcher
 
 
 @pytest.mark.parametrize(("direction", "sign"), OFFSETS)

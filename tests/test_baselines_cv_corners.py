@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from _baseline_cases import OFFSETS, errors, make_problem
+from tfloc.baselines._corner_match import best_hypothesis, pair_hypotheses
+from tfloc.baselines._corner_refine import refine_corners
+from tfloc.baselines.cv_corners import CvCornersMatcher
 
 import tfloc
-from baselines._corner_match import best_hypothesis, pair_hypotheses
-from baselines._corner_refine import refine_corners
-from baselines.cv_corners import CvCornersMatcher
 from tfloc import Problem
 
 

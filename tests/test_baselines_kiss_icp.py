@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 from _baseline_cases import OFFSETS, errors, make_problem
+from tfloc.baselines.kiss_icp import KissIcpMatcher
 
 import tfloc
-from baselines.kiss_icp import KissIcpMatcher
 
 
 @pytest.mark.parametrize(("direction", "sign"), OFFSETS)

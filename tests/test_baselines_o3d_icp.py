@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 from _baseline_cases import OFFSETS, errors, make_problem
+from tfloc.baselines.o3d_icp import Open3dIcpMatcher
 
 import tfloc
-from baselines.o3d_icp import Open3dIcpMatcher
 
 
 @pytest.mark.parametrize(("direction", "sign"), OFFSETS)

@@ -11,10 +11,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from tfloc.baselines._config import resolve_config
+from tfloc.baselines._geometry import matrix_to_pose, polyline_normals, pose_to_matrix
+from tfloc.baselines.o3d_icp import Config as O3dConfig
 
-from baselines._config import resolve_config
-from baselines._geometry import matrix_to_pose, polyline_normals, pose_to_matrix
-from baselines.o3d_icp import Config as O3dConfig
 from tfloc import Pose
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -133,8 +133,8 @@ def test_tiny_scans_do_not_crash(name: str, n_returns: int) -> None:
 
 
 def test_missing_matcher_module_is_not_blamed_on_a_library(monkeypatch: pytest.MonkeyPatch) -> None:
-    import tfloc.matcher as registry
+    import tfloc.core.matcher as registry
 
-    monkeypatch.setitem(registry._registry(), "ghost", "baselines.no_such_module:Ghost")
-    with pytest.raises(registry.MatcherError, match="its module 'baselines.no_such_module' is not part"):
+    monkeypatch.setitem(registry._registry(), "ghost", "tfloc.baselines.no_such_module:Ghost")
+    with pytest.raises(registry.MatcherError, match="its module 'tfloc.baselines.no_such_module' is not part"):
         registry.get_matcher("ghost")

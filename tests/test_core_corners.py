@@ -7,7 +7,14 @@ import pytest
 from shapely.geometry import box
 
 from tfloc import LaserSpec, Pose, VectorMap
-from tfloc.corners import corner_candidates, is_line, merge_lines, resample, shortstraw, straws
+from tfloc.paper.corners import (
+    corner_candidates,
+    is_line,
+    merge_lines,
+    resample,
+    shortstraw,
+    straws,
+)
 
 
 def test_resample_is_equidistant_and_keeps_endpoints():

@@ -11,7 +11,7 @@ import pytest
 import tfloc
 from tfloc import InvalidProblemError, MapFormatError, Pose, Problem
 from tfloc.errors import DatasetError
-from tfloc.harness.dataset import Scan, read_scans, read_scenario, write_scenario
+from tfloc.io.scenario import Scan, read_scans, read_scenario, write_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 ROOM = ROOT / "data" / "maps" / "test-room.geojson"

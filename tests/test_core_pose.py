@@ -6,7 +6,7 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tfloc.pose import Pose, angdiff, wrap_angle
+from tfloc.core.pose import Pose, angdiff, wrap_angle
 
 coord = st.floats(-50, 50, allow_nan=False)
 angle = st.floats(-10, 10, allow_nan=False)

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from tfloc.turning import match, turning_function
+from tfloc.paper.turning import match, turning_function
 
 
 def rotate(p: np.ndarray, a: float) -> np.ndarray:

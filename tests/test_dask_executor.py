@@ -21,8 +21,8 @@ from test_harness_runner import make_dataset  # noqa: E402
 from tfloc.errors import ConfigError  # noqa: E402
 from tfloc.harness.config import MatcherSpec, RunConfig  # noqa: E402
 from tfloc.harness.dask_executor import execute_dask  # noqa: E402
-from tfloc.harness.results import read_estimates  # noqa: E402
 from tfloc.harness.runner import run  # noqa: E402
+from tfloc.io.estimates import read_estimates  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 TESTS = Path(__file__).resolve().parent

@@ -8,10 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tfloc.core.laser import LaserSpec
+from tfloc.core.pose import Pose
 from tfloc.errors import DatasetError
-from tfloc.harness.dataset import Scan, read_scans, read_scenario, write_scenario
-from tfloc.laser import LaserSpec
-from tfloc.pose import Pose
+from tfloc.io.scenario import Scan, read_scans, read_scenario, write_scenario
 
 MAP = Path(__file__).resolve().parents[1] / "data" / "maps" / "test-room.geojson"
 LASER = LaserSpec.lms200()

@@ -12,12 +12,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tfloc.core.laser import LaserSpec
+from tfloc.core.matcher import available_matchers, get_matcher
+from tfloc.core.pose import Pose
+from tfloc.core.problem import Problem
 from tfloc.errors import MatcherError
-from tfloc.laser import LaserSpec
 from tfloc.maps.build import rasterize
-from tfloc.matcher import available_matchers, get_matcher
-from tfloc.pose import Pose
-from tfloc.problem import Problem
 
 ROOM = Path(__file__).resolve().parents[1] / "data" / "maps" / "test-room.geojson"
 

@@ -8,10 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tfloc.laser import LaserSpec
+from tfloc.core.laser import LaserSpec
+from tfloc.core.pose import Pose
 from tfloc.maps import GridMap, Map
 from tfloc.maps.build import grid_from_scans, rasterize
-from tfloc.pose import Pose
 
 ROOM = Path(__file__).resolve().parents[1] / "data" / "maps" / "test-room.geojson"
 

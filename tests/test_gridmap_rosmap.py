@@ -9,11 +9,11 @@ import pytest
 from PIL import Image
 
 import tfloc
+from tfloc.core.laser import LaserSpec
+from tfloc.core.pose import Pose
 from tfloc.errors import MapFormatError
 from tfloc.io.rosmap import read_ros_map, write_ros_map
-from tfloc.laser import LaserSpec
 from tfloc.maps import GridMap
-from tfloc.pose import Pose
 
 
 def _random_grid(seed: int = 0) -> GridMap:

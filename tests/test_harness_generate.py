@@ -5,11 +5,11 @@ import math
 
 import numpy as np
 
-from tfloc.harness.dataset import read_scans, read_scenario
-from tfloc.harness.generate import ANGLE_BINS_DEG, DIST_BINS_M, BundleSpec, generate_bundle
-from tfloc.harness.offices import OFFICES
+from tfloc.core.pose import angdiff
+from tfloc.datasets.offices import OFFICES
+from tfloc.datasets.synthetic import ANGLE_BINS_DEG, DIST_BINS_M, BundleSpec, generate_bundle
 from tfloc.io.geojson import read_vector_map
-from tfloc.pose import angdiff
+from tfloc.io.scenario import read_scans, read_scenario
 
 
 def _all_files(root):

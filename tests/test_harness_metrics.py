@@ -9,15 +9,8 @@ import pandas as pd
 import pytest
 
 from tests._estimates import frame, row
-from tfloc.harness.metrics import (
-    Thresholds,
-    angle_bin,
-    classify,
-    dist_bin,
-    prepare,
-    summarize,
-)
-from tfloc.harness.summary import scenario_summary, summary_table
+from tfloc.evaluation.metrics import Thresholds, angle_bin, classify, dist_bin, prepare, summarize
+from tfloc.evaluation.summary import scenario_summary, summary_table
 
 
 def errors_frame() -> pd.DataFrame:

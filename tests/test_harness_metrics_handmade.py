@@ -1,4 +1,4 @@
-"""Metrics (tfloc.harness.metrics) against hand-computed examples."""
+"""Metrics (tfloc.evaluation.metrics) against hand-computed examples."""
 
 import math
 
@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from tfloc.harness.metrics import Thresholds, angle_bin, classify, dist_bin, prepare, summarize
+from tfloc.evaluation.metrics import Thresholds, angle_bin, classify, dist_bin, prepare, summarize
 
 
 def _row(d_m, o_deg, init_d_m, init_o_deg, status="ok", score_est=1.0, score_true=0.5,

@@ -10,9 +10,9 @@ import pytest
 from tests._estimates import frame, row, synthetic_run
 from tfloc.cli import main
 from tfloc.errors import ConfigError
-from tfloc.harness.metrics import METRIC_COLUMNS
-from tfloc.harness.report import write_report
-from tfloc.harness.summary import SUMMARY_KEYS
+from tfloc.evaluation.metrics import METRIC_COLUMNS
+from tfloc.evaluation.summary import SUMMARY_KEYS
+from tfloc.report.report import write_report
 
 FIGURES = {"scenario_errors.png", "basin.png", "error_cdf.png", "runtime.png", "outcomes.png"}
 

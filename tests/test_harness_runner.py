@@ -13,12 +13,12 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from tfloc.core.pose import Pose
 from tfloc.errors import DatasetError
 from tfloc.harness.config import MatcherSpec, RunConfig
-from tfloc.harness.dataset import Scan, write_scenario
-from tfloc.harness.results import read_estimates
 from tfloc.harness.runner import run
-from tfloc.pose import Pose
+from tfloc.io.estimates import read_estimates
+from tfloc.io.scenario import Scan, write_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 ROOM = ROOT / "data" / "maps" / "test-room.geojson"

@@ -10,9 +10,9 @@ from test_harness_runner import make_dataset
 
 from tfloc.errors import ConfigError
 from tfloc.harness.config import load_config
-from tfloc.harness.report import write_report
-from tfloc.harness.results import read_estimates
 from tfloc.harness.runner import run
+from tfloc.io.estimates import read_estimates
+from tfloc.report.report import write_report
 
 
 def write(tmp_path: Path, body: str) -> Path:

@@ -8,8 +8,8 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tfloc.harness.interpolate import interpolate_poses
-from tfloc.pose import angdiff
+from tfloc.core.pose import angdiff
+from tfloc.datasets.interpolate import interpolate_poses
 
 T = np.array([0.0, 1.0, 2.0, 4.0])
 P = np.array([[0.0, 0.0, 3.0], [1.0, 2.0, -3.0], [3.0, 2.0, 0.0], [3.0, 6.0, 1.0]])

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from numba import njit
 
-from tfloc.corners import _resample_into, corner_candidates, merge_lines, resample, shortstraw
-from tfloc.laser import LaserSpec
+from tfloc.core.laser import LaserSpec
+from tfloc.core.pose import Pose
 from tfloc.maps.vector import VectorMap
-from tfloc.pose import Pose
+from tfloc.paper.corners import _resample_into, corner_candidates, merge_lines, resample, shortstraw
 
 
 # --- oracles: the implementations before the numba rewrite, verbatim -------------------------

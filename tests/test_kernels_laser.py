@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tfloc.laser import LaserSpec
+from tfloc.core.laser import LaserSpec
 
 
 def _reference(laser: LaserSpec, r: np.ndarray, keep_invalid: bool) -> np.ndarray:

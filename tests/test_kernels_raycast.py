@@ -9,10 +9,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tfloc.laser import LaserSpec
+from tfloc.core.laser import LaserSpec
+from tfloc.core.pose import Pose
 from tfloc.maps._raycast import raycast_segments, raycast_segments_bruteforce
 from tfloc.maps.vector import VectorMap
-from tfloc.pose import Pose
 
 LASERS = [
     LaserSpec.lms200(),

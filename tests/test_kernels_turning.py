@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from tfloc.turning import TWO_PI, Match, TurningFunction, match, turning_function
+from tfloc.paper.turning import TWO_PI, Match, TurningFunction, match, turning_function
 
 
 # --- oracles: the implementations before the numba rewrite, verbatim -------------------------
@@ -113,10 +113,10 @@ def test_match_of_a_rotated_copy_is_near_zero():
 
 def test_match_of_scan_polygons_matches_oracle():
     """Polygons as the tf matcher builds them: ShortStraw corners closed through the origin."""
-    from tfloc.laser import LaserSpec
+    from tfloc.core.laser import LaserSpec
+    from tfloc.core.pose import Pose
     from tfloc.maps.vector import VectorMap
-    from tfloc.pose import Pose
-    from tfloc.tf import TfConfig, scan_corners, scan_polygon
+    from tfloc.paper.matcher import TfConfig, scan_corners, scan_polygon
 
     rng = np.random.default_rng(11)
     laser = LaserSpec.lms200()
@@ -136,7 +136,7 @@ def test_match_of_scan_polygons_matches_oracle():
 
 
 def test_mod1_is_python_modulo():
-    from tfloc.turning import _mod1
+    from tfloc.paper.turning import _mod1
 
     xs = np.concatenate((np.random.default_rng(0).uniform(-3, 3, 20000),
                          [0.0, -0.0, 1.0, -1.0, 1 - 1e-17, -1e-300, 5e-324, -5e-324,

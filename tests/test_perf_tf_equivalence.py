@@ -12,10 +12,10 @@ from test_kernels_corners import shortstraw_ref
 from test_kernels_turning import match_ref, turning_function_ref
 
 import tfloc.maps.vector
-import tfloc.tf
+import tfloc.paper.matcher
 from tfloc import Pose, Problem
 from tfloc.maps._raycast import raycast_segments_bruteforce
-from tfloc.tf import TfConfig, TurningFunctionMatcher
+from tfloc.paper.matcher import TfConfig, TurningFunctionMatcher
 
 TRUE = Pose(3.0, 3.5, 0.4)
 
@@ -36,9 +36,9 @@ def test_localize_matches_the_reference_pipeline(test_room, lms200, config, monk
     fast = [matcher.localize(p) for p in problems]
     with monkeypatch.context() as mp:
         mp.setattr(tfloc.maps.vector, "raycast_segments", raycast_segments_bruteforce)
-        mp.setattr(tfloc.tf, "shortstraw", shortstraw_ref)
-        mp.setattr(tfloc.tf, "turning_function", turning_function_ref)
-        mp.setattr(tfloc.tf, "match", lambda real, virtual: match_ref(real, virtual)[0])
+        mp.setattr(tfloc.paper.matcher, "shortstraw", shortstraw_ref)
+        mp.setattr(tfloc.paper.matcher, "turning_function", turning_function_ref)
+        mp.setattr(tfloc.paper.matcher, "match", lambda real, virtual: match_ref(real, virtual)[0])
         ref = [matcher.localize(p) for p in problems]
     for f, r in zip(fast, ref, strict=True):
         np.testing.assert_allclose(f.pose.as_array(), r.pose.as_array(), rtol=0, atol=1e-9)

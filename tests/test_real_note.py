@@ -8,8 +8,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from tfloc.harness.dataset import read_scans, read_scenario
-from tfloc.real.note import relation_stats, write_note
+from tfloc.io.scenario import read_scans, read_scenario
+from tfloc.report.relations_note import relation_stats, write_note
 
 DATASET = Path(__file__).resolve().parents[1] / "data" / "scenarios" / "real-csail-relations"
 

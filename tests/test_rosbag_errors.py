@@ -22,8 +22,8 @@ from _rosbag_cases import (
 )
 
 from tfloc.cli import main
+from tfloc.datasets.from_bag import BagImport, import_bag
 from tfloc.errors import BagError, DatasetError, TflocError
-from tfloc.harness.from_bag import BagImport, import_bag
 from tfloc.io.rosbag import Bag
 from tfloc.io.rosmap import write_ros_map
 

@@ -28,11 +28,11 @@ from _rosbag_cases import (
 
 from tfloc import load_map
 from tfloc.cli import main
-from tfloc.harness.dataset import read_scans, read_scenario
-from tfloc.harness.from_bag import BagImport, import_bag
+from tfloc.core.pose import Pose, angdiff
+from tfloc.datasets.from_bag import BagImport, import_bag
 from tfloc.io.rosbag import Bag
 from tfloc.io.rosmap import write_ros_map
-from tfloc.pose import Pose, angdiff
+from tfloc.io.scenario import read_scans, read_scenario
 
 pytest.importorskip("rosbags")  # the optional extra tfloc[ros]
 

@@ -8,11 +8,11 @@ from shapely.geometry import box
 
 import tfloc
 from tfloc import Pose, Problem, VectorMap
-from tfloc.distance_field import distance_field
-from tfloc.heading_histogram import rotation_candidates
-from tfloc.refine import refine
-from tfloc.tf import TfConfig, scan_turning_function
-from tfloc.tf_plus import TfPlusConfig, TurningFunctionPlusMatcher
+from tfloc.maps.fields import distance_field
+from tfloc.paper.matcher import TfConfig, scan_turning_function
+from tfloc.tfplus.headings import rotation_candidates
+from tfloc.tfplus.matcher import TfPlusConfig, TurningFunctionPlusMatcher
+from tfloc.tfplus.refine import refine
 
 TRUE = Pose(3.0, 3.5, 0.4)
 

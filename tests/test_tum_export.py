@@ -12,12 +12,12 @@ import numpy as np
 import pytest
 
 from tfloc.cli import main
+from tfloc.core.laser import LaserSpec
+from tfloc.core.pose import Pose, angdiff
 from tfloc.errors import DatasetError, LogFormatError
-from tfloc.harness.dataset import Scan, read_scans, read_scenario, write_scenario
-from tfloc.harness.export import export_tum
+from tfloc.io.scenario import Scan, read_scans, read_scenario, write_scenario
 from tfloc.io.tum import read_tum, write_tum
-from tfloc.laser import LaserSpec
-from tfloc.pose import Pose, angdiff
+from tfloc.report.export import export_tum
 
 file_interface = pytest.importorskip("evo.tools.file_interface")
 ROOT = Path(__file__).resolve().parents[1]

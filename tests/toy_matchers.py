@@ -8,8 +8,8 @@ import time
 
 import numpy as np
 
-from tfloc.pose import Pose
-from tfloc.problem import Estimate, Problem
+from tfloc.core.pose import Pose
+from tfloc.core.problem import Estimate, Problem
 
 
 class Stay:

@@ -1,5 +1,7 @@
 """tfloc: 2D laser localization by turning-function scan matching, and a benchmark harness.
 
+This module is the public face only; the layers below it are described in docs/DESIGN.md.
+
 Public API::
 
     import tfloc
@@ -9,17 +11,17 @@ Public API::
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from .core.laser import LaserSpec
+from .core.matcher import Matcher, available_matchers, get_matcher
+from .core.pose import Pose, angdiff
+from .core.problem import Estimate, Problem
 from .errors import InvalidProblemError, MapFormatError, MatcherError, TflocError
-from .laser import LaserSpec
+from .io.maps import load_map
 from .maps import GridMap, Map, VectorMap
-from .matcher import Matcher, available_matchers, get_matcher
-from .pose import Pose, angdiff
-from .problem import Estimate, Problem
 
 __version__ = "0.1.0"
 
@@ -28,23 +30,6 @@ __all__ = [
     "MatcherError", "Pose", "Problem", "TflocError", "VectorMap", "angdiff",
     "available_matchers", "get_matcher", "load_map", "localize",
 ]
-
-
-def load_map(path: str | Path) -> Map:
-    """Load a map by its file type: ``.geojson``/``.json`` → VectorMap, ``.yaml`` → GridMap."""
-    path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix in (".geojson", ".json"):
-        from .io.geojson import read_vector_map
-
-        return read_vector_map(path)
-    if suffix in (".yaml", ".yml"):
-        try:
-            from .io.rosmap import read_ros_map
-        except ImportError:
-            raise MapFormatError(f"{path}: ROS map support is not available in this build") from None
-        return read_ros_map(path)
-    raise MapFormatError(f"{path}: unknown map type {suffix!r} (expected .geojson or .yaml)")
 
 
 def localize(map: Map, laser: LaserSpec, ranges: np.ndarray, initial: Pose,

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from tfloc.harness import guard
+from tfloc.evaluation import guard
 from tfloc.harness.config import load_config
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from tfloc.harness import guard
+from tfloc.evaluation import guard
 from tfloc.harness.config import MatcherSpec, load_config
 
 ROOT = Path(__file__).resolve().parents[2]

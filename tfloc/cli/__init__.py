@@ -11,7 +11,7 @@ import importlib
 import pkgutil
 import sys
 
-from ..errors import TflocError
+from tfloc.errors import TflocError
 
 
 def _commands() -> dict[str, object]:

@@ -20,9 +20,9 @@ import math
 import sys
 from pathlib import Path
 
-from ..errors import ConfigError
-from ..harness.config import RunConfig, load_config, parse_matchers
-from ..matcher import available_matchers
+from tfloc.core.matcher import available_matchers
+from tfloc.errors import ConfigError
+from tfloc.harness.config import RunConfig, load_config, parse_matchers
 
 HELP = "run matchers over scenario datasets (resumable), writing RUN/estimates.csv"
 
@@ -75,13 +75,13 @@ def config_from_args(args: argparse.Namespace) -> RunConfig:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..harness.runner import execute_local
-    from ..harness.runner import run as run_benchmark
+    from tfloc.harness.runner import execute_local
+    from tfloc.harness.runner import run as run_benchmark
 
     cfg = config_from_args(args)
     executor = execute_local
     if args.scheduler:
-        from ..harness.dask_executor import execute_dask
+        from tfloc.harness.dask_executor import execute_dask
 
         executor = execute_dask(args.scheduler)
     out = run_benchmark(cfg, progress=args.progress, executor=executor, regenerate=args.regenerate)

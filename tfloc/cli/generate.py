@@ -12,7 +12,7 @@ HELP = "generate the office maps and scenario datasets (reproducible from one se
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    from ..harness.generate import MASTER_SEED
+    from tfloc.datasets.synthetic import MASTER_SEED
 
     p.add_argument("--out", default="data", help="output root (default: data)")
     p.add_argument("--seed", type=int, default=MASTER_SEED, help=f"master seed (default {MASTER_SEED})")
@@ -28,8 +28,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..harness.generate import BundleSpec, generate_bundle
-    from ..harness.noise import NoiseModel
+    from tfloc.datasets.noise import NoiseModel
+    from tfloc.datasets.synthetic import BundleSpec, generate_bundle
 
     detail = args.detail_per_cell if args.detail_per_cell is not None else max(1, args.per_cell // 3)
     spec = BundleSpec(seed=args.seed, pool_per_cell=args.per_cell, detail_per_cell=detail,

@@ -16,13 +16,13 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..errors import ConfigError
+from tfloc.errors import ConfigError
 
 HELP = "accuracy regression guard: rerun a fixed subset and compare with the reference"
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    from ..harness.guard import CONFIG, REFERENCE
+    from tfloc.evaluation.guard import CONFIG, REFERENCE
 
     p.add_argument("--config", type=Path, default=CONFIG, help=f"subset run configuration ({CONFIG})")
     p.add_argument("--reference", type=Path, default=REFERENCE, help=f"reference metrics ({REFERENCE})")
@@ -36,8 +36,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     import pandas as pd
 
-    from ..harness import guard
-    from ..harness.config import load_config, parse_matchers
+    from tfloc.evaluation import guard
+    from tfloc.harness.config import load_config, parse_matchers
 
     cfg = load_config(args.config)
     if args.matchers:

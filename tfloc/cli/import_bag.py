@@ -17,7 +17,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..pose import Pose
+from tfloc.core.pose import Pose
 
 HELP = "make a scenario dataset from a ROS 1/ROS 2 bag (LaserScan + reference poses + map)"
 
@@ -53,8 +53,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..errors import ConfigError
-    from ..harness.from_bag import BagImport, import_bag
+    from tfloc.datasets.from_bag import BagImport, import_bag
+    from tfloc.errors import ConfigError
 
     if args.initial_frames and not args.initial_topic:
         raise ConfigError("--initial-frames needs --initial-topic")

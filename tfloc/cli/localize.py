@@ -17,10 +17,10 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from ..harness.dataset import iter_scans, map_for, read_scenario
-from ..harness.task import status_of
-from ..matcher import get_matcher
-from ..problem import Problem
+from tfloc.core.matcher import get_matcher
+from tfloc.core.problem import Problem
+from tfloc.harness.task import status_of
+from tfloc.io.scenario import iter_scans, map_for, read_scenario
 
 HELP = "localize the scans of a dataset with one matcher (no scoring)"
 COLUMNS = ["scan_id", "matcher", "est_x", "est_y", "est_theta", "runtime_s", "converged",
@@ -43,7 +43,7 @@ def run(args: argparse.Namespace) -> int:
     matcher = get_matcher(args.matcher)
     cache: dict = {}
     if args.map is not None:
-        from .. import load_map
+        from tfloc.io.maps import load_map
 
         cache[scenario.map_path] = load_map(args.map)
     args.out.parent.mkdir(parents=True, exist_ok=True)

@@ -14,7 +14,7 @@ HELP = "build the real-log scenario datasets (MIT CSAIL relations, Intel/CSAIL s
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from ..real.datasets import DEFAULT_SEED
+    from tfloc.datasets.real import DEFAULT_SEED
 
     parser.add_argument("--real", type=Path, default=Path("data/real"),
                         help="directory with the logs (default: data/real)")
@@ -27,7 +27,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..real.datasets import build_all
+    from tfloc.datasets.real import build_all
 
     for root in build_all(args.real, args.out, args.seed, args.resolution):
         print(root)

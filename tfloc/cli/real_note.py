@@ -20,7 +20,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..real.note import write_note
+    from tfloc.report.relations_note import write_note
 
     print(write_note(args.results, args.dataset, args.max_dist_cm / 100.0, args.max_angle_deg))
     return 0

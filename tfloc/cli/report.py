@@ -29,8 +29,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..harness.metrics import Thresholds
-    from ..harness.report import load_run, write_report
+    from tfloc.evaluation.metrics import Thresholds
+    from tfloc.report.report import load_run, write_report
 
     thr = None
     if args.success_cm is not None or args.success_deg is not None:

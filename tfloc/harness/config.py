@@ -34,7 +34,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from ..errors import ConfigError
+from tfloc.errors import ConfigError
 
 
 @dataclass(frozen=True)

@@ -18,7 +18,8 @@ import re
 import uuid
 from collections.abc import Callable, Iterator
 
-from ..errors import ConfigError
+from tfloc.errors import ConfigError
+
 from .runner import Executor
 from .task import Task, failure_row
 

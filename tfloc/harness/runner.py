@@ -25,9 +25,10 @@ from pathlib import Path
 from pebble import ProcessExpired, ProcessPool
 from tqdm import tqdm
 
+from tfloc.io.estimates import ResultWriter, done_keys
+from tfloc.io.scenario import iter_scans, read_scenario
+
 from .config import RunConfig
-from .dataset import iter_scans, read_scenario
-from .results import ResultWriter, done_keys
 from .task import Task, failure_row, run_task, warm_up
 
 THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS",

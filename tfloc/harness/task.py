@@ -13,10 +13,10 @@ from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
 
-from ..matcher import get_matcher
-from ..pose import Pose, angdiff
-from ..problem import Estimate, Problem
-from .dataset import Scan, Scenario, map_for, read_scans, read_scenario
+from tfloc.core.matcher import get_matcher
+from tfloc.core.pose import Pose, angdiff
+from tfloc.core.problem import Estimate, Problem
+from tfloc.io.scenario import Scan, Scenario, map_for, read_scans, read_scenario
 
 
 @dataclass(frozen=True)

@@ -26,8 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import LogFormatError
-from ..pose import Pose
+from tfloc.core.pose import Pose
+from tfloc.errors import LogFormatError
 
 _MSG = re.compile(r"^[A-Z][A-Z0-9_]*$")
 

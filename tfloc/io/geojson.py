@@ -13,8 +13,8 @@ from pathlib import Path
 import shapely
 from shapely.geometry import mapping, shape
 
-from ..errors import MapFormatError
-from ..maps.vector import VectorMap
+from tfloc.errors import MapFormatError
+from tfloc.maps.vector import VectorMap
 
 _ROLES = {"wall", "obstacle", "outline"}
 

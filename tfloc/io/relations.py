@@ -14,8 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import LogFormatError
-from ..pose import Pose
+from tfloc.core.pose import Pose
+from tfloc.errors import LogFormatError
+
 from .carmen import LaserRecord
 
 _FIELDS = ("t1", "t2", "dx", "dy", "dz", "droll", "dpitch", "dyaw")

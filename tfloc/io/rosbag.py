@@ -22,9 +22,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import BagError
-from ..laser import LaserSpec
-from ..maps.grid import GridMap
+from tfloc.core.laser import LaserSpec
+from tfloc.errors import BagError
+from tfloc.maps.grid import GridMap
+
 from .tum import quaternion_yaw
 
 SCAN_TYPES = ("sensor_msgs/msg/LaserScan",)

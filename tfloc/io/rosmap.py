@@ -16,8 +16,8 @@ import numpy as np
 import yaml
 from PIL import Image, UnidentifiedImageError
 
-from ..errors import MapFormatError
-from ..maps.grid import GridMap
+from tfloc.errors import MapFormatError
+from tfloc.maps.grid import GridMap
 
 
 def _num(doc: dict, key: str, path: Path, default: float | None = None) -> float:

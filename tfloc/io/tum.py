@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import LogFormatError
+from tfloc.errors import LogFormatError
 
 HEADER = "# timestamp x y z qx qy qz qw"
 

@@ -1,7 +1,7 @@
 """Maps: the :class:`Map` protocol, :class:`VectorMap` (segments) and :class:`GridMap` (occupancy grid)."""
 
-from .base import Map
-from .grid import GridMap
-from .vector import VectorMap
+from tfloc.maps.base import Map
+from tfloc.maps.grid import GridMap
+from tfloc.maps.vector import VectorMap
 
 __all__ = ["GridMap", "Map", "VectorMap"]

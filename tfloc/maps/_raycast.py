@@ -128,7 +128,7 @@ def raycast_segments(poses: np.ndarray, rel_angles: np.ndarray, segs: np.ndarray
     ``(M, 4)`` = (ax, ay, bx, by). No hit before ``max_range`` gives ``inf``. Metres, radians.
 
     ``rel_angles`` (relative to each pose's heading) should be uniformly spaced and increasing,
-    as a :class:`~tfloc.laser.LaserSpec` gives them; otherwise (deviation above 1e-6 rad) the
+    as a :class:`~tfloc.core.laser.LaserSpec` gives them; otherwise (deviation above 1e-6 rad) the
     brute-force kernel is used. Segments farther than ``max_range`` are culled; each remaining
     segment is intersected only with the beams inside the arc it subtends (wrap-around of
     360° scanners included). A segment within rounding distance of the sensor is intersected

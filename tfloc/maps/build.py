@@ -7,7 +7,8 @@ import math
 
 import numpy as np
 
-from ..laser import LaserSpec
+from tfloc.core.laser import LaserSpec
+
 from ._gridcast import carve_grid
 from .grid import GridMap
 from .vector import VectorMap

@@ -9,9 +9,10 @@ from functools import cached_property
 import numpy as np
 from scipy import ndimage
 
-from ..errors import MapFormatError
-from ..laser import LaserSpec
-from ..pose import Pose
+from tfloc.core.laser import LaserSpec
+from tfloc.core.pose import Pose
+from tfloc.errors import MapFormatError
+
 from ._gridcast import raycast_grid
 from .base import as_pose_array
 

@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
-from ..laser import LaserSpec
-from ..pose import Pose
+from tfloc.core.laser import LaserSpec
+from tfloc.core.pose import Pose
+
 from .vector import VectorMap
 
 

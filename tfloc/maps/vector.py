@@ -9,8 +9,9 @@ import numpy as np
 import shapely
 from shapely.geometry.base import BaseGeometry
 
-from ..laser import LaserSpec
-from ..pose import Pose
+from tfloc.core.laser import LaserSpec
+from tfloc.core.pose import Pose
+
 from ._raycast import raycast_segments
 from .base import as_pose_array
 

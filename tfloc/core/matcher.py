@@ -1,0 +1,75 @@
+"""The matcher protocol and the registry (entry-point group ``tfloc.matchers``).
+
+A third party adds a matcher with one line in its own ``pyproject.toml``::
+
+    [project.entry-points."tfloc.matchers"]
+    my-icp = "my_pkg.icp:MyIcpMatcher"
+
+The entry point names a class (or factory) that takes keyword overrides of its configuration
+and returns an object with ``name``, ``localize(problem)`` and ``score(problem, pose)``.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+from importlib.metadata import entry_points
+from typing import Any, Protocol, runtime_checkable
+
+from tfloc.errors import MatcherError
+
+from .pose import Pose
+from .problem import Estimate, Problem
+
+GROUP = "tfloc.matchers"
+
+@runtime_checkable
+class Matcher(Protocol):
+    """What the harness needs of a localization method. It must never look at the true pose."""
+
+    name: str
+
+    def localize(self, problem: Problem) -> Estimate:
+        """Estimate the robot pose for ``problem``."""
+        ...
+
+    def score(self, problem: Problem, pose: Pose) -> float:
+        """The matcher's own objective at ``pose`` (lower is better); used to classify failures."""
+        ...
+
+
+@cache
+def _registry() -> dict[str, str]:
+    """Matcher name → ``module:attr``, from the installed entry points (the package's own
+    matchers are declared in its ``pyproject.toml`` like anyone else's)."""
+    return {ep.name: ep.value for ep in entry_points(group=GROUP)}
+
+
+def available_matchers() -> list[str]:
+    """Names of all registered matchers (whether or not their optional library is installed)."""
+    return sorted(_registry())
+
+
+def get_matcher(name: str, **params: Any) -> Matcher:
+    """Instantiate the registered matcher ``name`` with configuration overrides ``params``.
+
+    Raises :class:`MatcherError` for an unknown name, a missing optional library or a bad parameter.
+    """
+    reg = _registry()
+    if name not in reg:
+        raise MatcherError(f"unknown matcher {name!r}; registered: {', '.join(sorted(reg))}")
+    module, _, attr = reg[name].partition(":")
+    try:
+        mod = __import__(module, fromlist=[attr])
+        factory = getattr(mod, attr)
+    except ImportError as exc:
+        missing = exc.name or ""
+        if missing and (module == missing or module.startswith(missing + ".")):
+            raise MatcherError(f"matcher {name!r}: its module {module!r} is not part of this installation") from None
+        lib = f"the library {missing.partition('.')[0]!r}" if missing else "a library"
+        raise MatcherError(
+            f"matcher {name!r} needs {lib}, which is not installed or failed to import: {exc} "
+            f"(install the project with its dependencies: pip install -e .)") from None
+    try:
+        return factory(**params)
+    except TypeError as exc:
+        raise MatcherError(f"matcher {name!r}: bad parameters {params}: {exc}") from None

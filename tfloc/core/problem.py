@@ -1,0 +1,88 @@
+"""The question every matcher answers (:class:`Problem`) and its answer (:class:`Estimate`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from tfloc.errors import InvalidProblemError
+
+from .laser import LaserSpec
+from .pose import Pose
+
+if TYPE_CHECKING:
+    from tfloc.maps.base import Map
+
+
+def check_ranges(ranges: Any, laser: LaserSpec, where: str = "scan") -> np.ndarray:
+    """Validate one scan's ranges (metres) against ``laser`` and return them as float array.
+
+    ``inf``/``nan``/≥ max_range mean *no return* and are allowed; a wrong beam count, negative
+    ranges or a scan with no return at all are errors naming ``where``.
+    """
+    try:
+        r = np.asarray(ranges, dtype=float).reshape(-1)
+    except (TypeError, ValueError) as exc:
+        raise InvalidProblemError(f"{where}: ranges are not numeric ({exc})") from None
+    if r.size != laser.n_beams:
+        raise InvalidProblemError(
+            f"{where}: {r.size} ranges, but the laser has {laser.n_beams} beams")
+    with np.errstate(invalid="ignore"):
+        neg = np.flatnonzero(r < 0)
+    if neg.size:
+        raise InvalidProblemError(f"{where}: negative range {r[neg[0]]:g} at beam {neg[0]}")
+    if not laser.valid(r).any():
+        raise InvalidProblemError(f"{where}: no beam has a return (all ranges are inf/nan/≥ max_range)")
+    return r
+
+
+@dataclass(frozen=True, eq=False)
+class Problem:
+    """Given a map, a laser spec, one real scan (RSD) and an initial pose guess (VP): where is the robot?
+
+    Attributes:
+        map: the known map (:class:`~tfloc.maps.base.Map`).
+        laser: the scanner that took ``ranges``.
+        ranges: the real scan, metres, shape ``(laser.n_beams,)``; inf/nan/≥ max_range = no return.
+        initial: the initial pose guess (VP), metres/radians, world frame.
+    """
+
+    map: Map
+    laser: LaserSpec
+    ranges: np.ndarray
+    initial: Pose
+    where: str = "scan"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "ranges", check_ranges(self.ranges, self.laser, self.where))
+        if not self.initial.is_finite():
+            raise InvalidProblemError(f"{self.where}: initial pose is not finite: {self.initial}")
+        if not bool(self.map.in_bounds(np.array([[self.initial.x, self.initial.y]]))[0]):
+            raise InvalidProblemError(
+                f"{self.where}: initial pose ({self.initial.x:.3f}, {self.initial.y:.3f}) lies outside the map")
+
+    @property
+    def points(self) -> np.ndarray:
+        """The real scan as points in the sensor frame (Eq. 4), no-return beams dropped."""
+        return self.laser.to_points(self.ranges)
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """A matcher's answer.
+
+    Attributes:
+        pose: the estimated robot pose (metres, radians).
+        converged: whether the matcher's own stopping rule was met (not whether it is right).
+        iterations: outer iterations of the method.
+        evaluations: objective evaluations (for ``tf``: turning-function cost evaluations).
+        info: method-specific extras (JSON-serialisable values).
+    """
+
+    pose: Pose
+    converged: bool
+    iterations: int = 0
+    evaluations: int = 0
+    info: dict[str, Any] = field(default_factory=dict)

@@ -1,0 +1,188 @@
+"""A scenario dataset from a ROS bag: scans, reference poses at the scan stamps, a map, and
+initial poses (perturbed in the paper's bins from a seed, or from a second pose topic)."""
+
+from __future__ import annotations
+
+import shutil
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from tfloc.core.pose import Pose
+from tfloc.errors import BagError, DatasetError
+from tfloc.io.scenario import Scan, write_scenario
+
+from .interpolate import interpolate_poses
+
+
+@dataclass(frozen=True)
+class BagImport:
+    """What to import from a bag, and how.
+
+    Attributes:
+        bag: a ROS 1 ``.bag`` file, or a ROS 2 bag directory / ``.db3`` / ``.mcap`` file.
+        scan_topic: a ``sensor_msgs/LaserScan`` topic.
+        pose_topic: the reference poses (PoseStamped, PoseWithCovarianceStamped, Odometry or tf).
+        out: the dataset directory to write.
+        map_file: a map_server YAML (or GeoJSON) copied into the dataset, or
+        map_topic: a ``nav_msgs/OccupancyGrid`` topic saved as ``map.yaml`` + ``map.pgm``.
+        name: the dataset's name (default: the name of ``out``).
+        pose_frames: ``(parent, child)`` if ``pose_topic`` is a tf topic.
+        initial_topic: take initial poses from this pose topic instead of perturbing;
+        initial_frames: its frame pair if it is a tf topic;
+        align_initial: the initial topic is in another frame (e.g. odometry): align it to the
+            reference at the first imported scan, so its drift is the initial error.
+        seed, clearance_m: the perturbation (paper's 3 × 3 offset bins) when no initial topic.
+        every: keep every n-th scan message; limit: at most this many scans (0 = all).
+        max_pose_gap_s: a scan between two poses further apart than this is not covered.
+        laser_offset: the laser's pose in the frame of the reference poses (m, m, rad).
+    """
+
+    bag: Path
+    scan_topic: str
+    pose_topic: str
+    out: Path
+    map_file: Path | None = None
+    map_topic: str | None = None
+    name: str = ""
+    pose_frames: tuple[str, str] | None = None
+    initial_topic: str | None = None
+    initial_frames: tuple[str, str] | None = None
+    align_initial: bool = False
+    seed: int | None = None
+    clearance_m: float = 0.2
+    every: int = 1
+    limit: int = 0
+    max_pose_gap_s: float = 1.0
+    laser_offset: Pose = field(default_factory=Pose)
+
+
+@dataclass(frozen=True)
+class ImportSummary:
+    """What an import kept and skipped (counts of scan messages)."""
+
+    path: Path
+    messages: int
+    kept: int
+    outside_poses: int
+    outside_initial: int
+    no_return: int
+
+
+def import_bag(cfg: BagImport) -> ImportSummary:
+    """Read the bag and write the dataset directory ``cfg.out``; returns the counts."""
+    from tfloc.io.rosbag import Bag
+
+    from .real import Perturbation, perturb
+
+    if (cfg.map_file is None) == (cfg.map_topic is None):
+        raise BagError("give the map either as a file (--map) or as an OccupancyGrid topic (--map-topic)")
+    if cfg.every < 1 or cfg.limit < 0:
+        raise BagError(f"--every must be ≥ 1 and --limit ≥ 0, got {cfg.every} and {cfg.limit}")
+    out = Path(cfg.out)
+    if (out / "scenario.json").exists() or (out / "scans.csv").exists():
+        raise DatasetError(f"{out}: a dataset exists there already; choose another --out or remove it")
+    with Bag(cfg.bag) as bag:
+        scans = bag.scans(cfg.scan_topic)
+        ref = bag.poses(cfg.pose_topic, cfg.pose_frames)
+        init = bag.poses(cfg.initial_topic, cfg.initial_frames) if cfg.initial_topic else None
+        grid = bag.grid(cfg.map_topic) if cfg.map_topic else None
+
+    pick = np.flatnonzero(scans.index % cfg.every == 0)
+    t = scans.stamps[pick]
+    truth, covered = interpolate_poses(ref.stamps, ref.poses, t, cfg.max_pose_gap_s)
+    if not covered.any():
+        raise BagError(f"{cfg.bag}: {cfg.pose_topic} covers none of the {t.size} scans on {cfg.scan_topic} "
+                       f"(scan message {scans.index[pick[0]]} at t={t[0]:.3f} s; poses span "
+                       f"{_span(ref.stamps)}, max gap {cfg.max_pose_gap_s:g} s)")
+    keep = covered.copy()
+    outside_init = 0
+    if init is not None:
+        start, init_cov = interpolate_poses(init.stamps, init.poses, t, cfg.max_pose_gap_s)
+        outside_init = int(np.count_nonzero(keep & ~init_cov))
+        keep &= init_cov
+        if not keep.any():
+            raise BagError(f"{cfg.bag}: {cfg.initial_topic} covers none of the scans on {cfg.scan_topic} "
+                           f"that {cfg.pose_topic} covers (poses span {_span(init.stamps)})")
+    no_return = scans.laser.valid(scans.ranges[pick]).sum(axis=1) == 0
+    n_empty = int(np.count_nonzero(keep & no_return))
+    keep &= ~no_return
+    rows = np.flatnonzero(keep)
+    if cfg.limit:
+        rows = rows[:cfg.limit]
+    if rows.size == 0:
+        raise BagError(f"{cfg.bag}: no scan on {cfg.scan_topic} is left to import (all lack a return)")
+    off = cfg.laser_offset
+    true_p = np.array([Pose.from_array(truth[k]).compose(off).as_array() for k in rows])
+
+    from tfloc.io.maps import load_map
+
+    the_map = grid if grid is not None else load_map(cfg.map_file)
+    if not the_map.in_bounds(true_p[:, :2]).any():
+        raise BagError(f"{cfg.bag}: none of the {cfg.pose_topic} poses at the scans lies inside the map "
+                       f"(bounds {tuple(round(b, 2) for b in the_map.bounds)} m); are they in the map frame?")
+    if init is not None:
+        ip = start[rows]
+        if cfg.align_initial:  # express the initial stream in the reference frame at the first scan
+            T = Pose.from_array(truth[rows[0]]).compose(Pose.from_array(ip[0]).inverse())
+            ip = np.array([T.compose(Pose.from_array(p)).as_array() for p in ip])
+        init_p = np.array([Pose.from_array(p).compose(off).as_array() for p in ip])
+        groups = [cfg.initial_topic.strip("/").replace("/", "-")] * rows.size
+        how = {"initial_topic": cfg.initial_topic, "align_initial": cfg.align_initial}
+        init_text = f"initial poses from {cfg.initial_topic}" + (" (aligned at the first scan)"
+                                                                  if cfg.align_initial else "")
+    else:
+        pcfg = Perturbation(clearance_m=cfg.clearance_m) if cfg.seed is None else \
+            Perturbation(seed=cfg.seed, clearance_m=cfg.clearance_m)
+        init_p, groups = perturb(true_p, the_map, pcfg)
+        how = {"perturbation": {"seed": pcfg.seed, "clearance_m": pcfg.clearance_m,
+                                "bins": "0-1/1-2/2-3 m x 0-5/5-10/10-15 deg, groups d{i}-a{j}"}}
+        init_text = f"initial poses perturbed in the paper's 3x3 offset bins (seed {pcfg.seed})"
+    rows_out = [Scan(f"s{scans.index[pick[k]]:05d}", g, scans.ranges[pick[k]], Pose.from_array(ip_),
+                     Pose.from_array(tp), stamp=float(t[k]))
+                for k, g, ip_, tp in zip(rows, groups, init_p, true_p, strict=True)]
+    las = scans.laser
+    out.mkdir(parents=True, exist_ok=True)
+    map_path = _save_map(cfg, grid, out)
+    source = {"bag": str(cfg.bag), "scan_topic": cfg.scan_topic, "pose_topic": cfg.pose_topic,
+              "pose_frames": list(cfg.pose_frames) if cfg.pose_frames else None,
+              "map_topic": cfg.map_topic, "laser_frame": scans.frame_id, "pose_frame": ref.frame_id,
+              "laser_offset": [off.x, off.y, off.theta],
+              "angle_min": las.angle_min, "angle_increment": las.resolution, "range_min": scans.range_min,
+              "range_max": las.max_range, "n_beams": las.n_beams, "every": cfg.every,
+              "max_pose_gap_s": cfg.max_pose_gap_s, **how,
+              "scan_messages": int(scans.index.size), "imported": int(rows.size),
+              "skipped": {"outside_poses": int(np.count_nonzero(~covered)),
+                          "outside_initial": outside_init, "no_return": n_empty}}
+    name = cfg.name or out.name
+    write_scenario(out, name, map_path, las, rows_out,
+                   description=(f"Imported from ROS bag {Path(cfg.bag).name}: {cfg.scan_topic} scans, "
+                                f"reference poses from {cfg.pose_topic} interpolated to the scan stamps, "
+                                f"{init_text}."),
+                   source=source)
+    return ImportSummary(out, int(scans.index.size), int(rows.size), int(np.count_nonzero(~covered)),
+                         outside_init, n_empty)
+
+
+def _span(stamps: np.ndarray) -> str:
+    return f"t={stamps[0]:.3f}…{stamps[-1]:.3f} s ({stamps.size} poses)"
+
+
+def _save_map(cfg: BagImport, grid, out: Path) -> Path:
+    """Put the map into the dataset directory; return its path."""
+    if grid is not None:
+        from tfloc.io.rosmap import write_ros_map
+
+        return write_ros_map(grid, out / "map.yaml")
+    src = Path(cfg.map_file)
+    if src.suffix.lower() not in (".yaml", ".yml"):
+        return Path(shutil.copyfile(src, out / src.name))
+    doc = yaml.safe_load(src.read_text())
+    img = src.parent / doc["image"]
+    shutil.copyfile(img, out / img.name)
+    doc["image"] = img.name
+    dst = out / src.name
+    dst.write_text(f"# copied from {src} by tfloc import-bag\n" + yaml.safe_dump(doc, sort_keys=False))
+    return dst

@@ -1,0 +1,191 @@
+"""Accuracy, success, failure-outcome and runtime metrics over a run's estimates (pure functions).
+
+Input is the ``estimates.csv`` DataFrame (:func:`tfloc.io.estimates.read_estimates`); errors
+there are in metres and radians, the metrics here are reported in cm, degrees, ms and percent.
+
+Which rows count where (stated in every report):
+
+* **rows with truth**: the true pose is known. They all count in the success rate and in the
+  outcome shares; a scan without an answer (``failed``, ``timeout``, ``error:*``) counts as a
+  failure with outcome ``no-answer``.
+* **rows with an estimate**: status ``ok`` or ``failed`` with a finite pose, hence finite
+  errors. Error and improvement statistics use only these; the others are *excluded* and
+  counted in ``n_excluded``.
+* **timed rows**: status ``ok`` or ``failed`` with a runtime (timeouts and errors have none).
+
+Bins are left-closed, right-open: ``[0, 100)``, ``[100, 200)``, ``[200, 300)`` cm and
+``[300, ∞)``; an initial offset of exactly 100 cm falls in ``100–200``. Angle bins likewise
+``[0, 5)``, ``[5, 10)``, ``[10, 15)``, ``[15, ∞)`` degrees. Offsets are rounded to 1e-6 cm /
+1e-6 ° before binning, so unit conversions cannot move a value across an edge.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+DIST_EDGES_CM = (0.0, 100.0, 200.0, 300.0)
+ANGLE_EDGES_DEG = (0.0, 5.0, 10.0, 15.0)
+DIST_BINS = ("0–100", "100–200", "200–300", "≥300")
+ANGLE_BINS = ("0–5", "5–10", "10–15", "≥15")
+OUTCOMES = ("success", "local-optimum", "ambiguous", "no-answer")
+UNSCORED = "unscored"  # failed under overridden thresholds but the run recorded no scores
+METRIC_COLUMNS = (
+    "n", "n_truth", "n_est", "n_excluded", "n_timeout", "n_error",
+    "dist_mean_cm", "dist_std_cm", "dist_median_cm", "dist_p90_cm", "dist_max_cm",
+    "orient_mean_deg", "orient_std_deg", "orient_median_deg", "orient_p90_deg", "orient_max_deg",
+    "dist_impr_mean_pct", "dist_impr_median_pct", "dist_impr_min_pct",
+    "orient_impr_mean_pct", "orient_impr_median_pct", "orient_impr_min_pct",
+    "success_rate_pct",
+    *(f"n_{o.replace('-', '_')}" for o in (*OUTCOMES, UNSCORED)),
+    *(f"share_{o.replace('-', '_')}_pct" for o in OUTCOMES),
+    "runtime_median_ms", "runtime_p95_ms", "n_timed")
+
+
+@dataclass(frozen=True)
+class Thresholds:
+    """Success: distance error ≤ ``dist_m`` (metres) and orientation error ≤ ``orient_deg``."""
+
+    dist_m: float = 0.10
+    orient_deg: float = 2.0
+
+    @classmethod
+    def from_run(cls, run: dict) -> Thresholds:
+        """The thresholds recorded in a ``run.json`` document (defaults if absent)."""
+        s = run.get("config", {}).get("success", {})
+        return cls(float(s.get("dist_m", 0.10)), float(s.get("orient_deg", 2.0)))
+
+
+def _bin(values: pd.Series, edges: tuple[float, ...], labels: tuple[str, ...]) -> pd.Series:
+    v = np.round(values.to_numpy(dtype=float), 6)
+    idx = np.searchsorted(np.asarray(edges), v, side="right") - 1  # [lo, hi)
+    ok = np.isfinite(v) & (v >= 0)
+    out = np.where(ok, np.asarray(labels, dtype=object)[np.clip(idx, 0, len(labels) - 1)], None)
+    return pd.Series(pd.Categorical(out, categories=list(labels), ordered=True), index=values.index)
+
+
+def dist_bin(init_dist_err_m: pd.Series) -> pd.Series:
+    """Initial distance offset bins (labels :data:`DIST_BINS`, cm) of metres; NaN → missing."""
+    return _bin(pd.to_numeric(init_dist_err_m, errors="coerce") * 100.0, DIST_EDGES_CM, DIST_BINS)
+
+
+def angle_bin(init_orient_err_rad: pd.Series) -> pd.Series:
+    """Initial angle offset bins (labels :data:`ANGLE_BINS`, degrees) of radians; NaN → missing."""
+    deg = np.degrees(pd.to_numeric(init_orient_err_rad, errors="coerce").abs())
+    return _bin(deg, ANGLE_EDGES_DEG, ANGLE_BINS)
+
+
+def has_truth(df: pd.DataFrame) -> pd.Series:
+    """Rows whose true pose is known."""
+    return pd.to_numeric(df["true_x"], errors="coerce").notna()
+
+
+def has_estimate(df: pd.DataFrame) -> pd.Series:
+    """Rows with status ok/failed and finite errors (the rows of the error statistics)."""
+    d = pd.to_numeric(df["dist_err_m"], errors="coerce")
+    o = pd.to_numeric(df["orient_err_rad"], errors="coerce")
+    return df["status"].isin(["ok", "failed"]) & np.isfinite(d) & np.isfinite(o)
+
+
+def classify(df: pd.DataFrame, thr: Thresholds) -> pd.Series:
+    """The outcome of each row under thresholds ``thr`` (the runner's rule, recomputed).
+
+    No truth → missing; status not ``ok`` → ``no-answer``; within both thresholds →
+    ``success``; otherwise ``local-optimum`` if the matcher scored the truth lower than its
+    answer, ``ambiguous`` if not. A row that failed only under stricter thresholds than the
+    run's has no recorded scores: it keeps a recorded failure outcome, else ``unscored``.
+    """
+    d = pd.to_numeric(df["dist_err_m"], errors="coerce")
+    o = np.degrees(pd.to_numeric(df["orient_err_rad"], errors="coerce"))
+    nan = pd.Series(np.nan, index=df.index)
+    s_est = pd.to_numeric(df.get("score_est", nan), errors="coerce")
+    s_true = pd.to_numeric(df.get("score_true", nan), errors="coerce")
+    recorded = df.get("outcome", pd.Series("", index=df.index)).fillna("").astype(str)
+    scored = s_est.notna() & s_true.notna()
+    fail = np.where(scored, np.where(s_true < s_est, "local-optimum", "ambiguous"),
+                    np.where(recorded.isin(["local-optimum", "ambiguous"]), recorded, UNSCORED))
+    within = (d <= thr.dist_m) & (o <= thr.orient_deg)
+    out = np.where(df["status"] != "ok", "no-answer", np.where(within, "success", fail))
+    return pd.Series(np.where(has_truth(df), out, None), index=df.index, dtype=object)
+
+
+def prepare(df: pd.DataFrame, thr: Thresholds) -> pd.DataFrame:
+    """``df`` plus derived columns: bins, errors in cm/deg, improvements (%), outcome, runtime (ms)."""
+    out = df.copy()
+    num = {c: pd.to_numeric(out[c], errors="coerce") for c in
+           ("dist_err_m", "orient_err_rad", "init_dist_err_m", "init_orient_err_rad", "runtime_s")}
+    est = has_estimate(out)
+    out["dist_bin"] = dist_bin(num["init_dist_err_m"])
+    out["angle_bin"] = angle_bin(num["init_orient_err_rad"])
+    out["truth"] = has_truth(out)
+    out["estimate"] = est & out["truth"]
+    out["dist_err_cm"] = (num["dist_err_m"] * 100.0).where(out["estimate"])
+    out["orient_err_deg"] = np.degrees(num["orient_err_rad"]).where(out["estimate"])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        di = 100.0 * (1.0 - num["dist_err_m"] / num["init_dist_err_m"])
+        oi = 100.0 * (1.0 - num["orient_err_rad"] / num["init_orient_err_rad"])
+    out["dist_impr_pct"] = di.where(out["estimate"] & (num["init_dist_err_m"] > 0))
+    out["orient_impr_pct"] = oi.where(out["estimate"] & (num["init_orient_err_rad"] > 0))
+    out["outcome_eval"] = classify(out, thr)
+    timed = out["status"].isin(["ok", "failed"]) & num["runtime_s"].notna()
+    out["runtime_ms"] = (num["runtime_s"] * 1000.0).where(timed)
+    return out
+
+
+def _q(s: pd.Series, q: float) -> float:
+    s = s.dropna()
+    return float(np.percentile(s, q)) if len(s) else np.nan
+
+
+def _stats(s: pd.Series, name: str, unit: str) -> dict[str, float]:
+    s = s.dropna()
+    return {f"{name}_mean_{unit}": s.mean() if len(s) else np.nan,
+            f"{name}_std_{unit}": s.std(ddof=1) if len(s) > 1 else np.nan,
+            f"{name}_median_{unit}": _q(s, 50), f"{name}_p90_{unit}": _q(s, 90),
+            f"{name}_max_{unit}": s.max() if len(s) else np.nan}
+
+
+def group_metrics(g: pd.DataFrame) -> dict[str, float]:
+    """All metrics of one group of :func:`prepare`-d rows (see :data:`METRIC_COLUMNS`)."""
+    n_truth = int(g["truth"].sum())
+    status = g["status"].fillna("").astype(str)
+    m: dict[str, float] = {
+        "n": len(g), "n_truth": n_truth, "n_est": int(g["estimate"].sum()),
+        "n_excluded": n_truth - int(g["estimate"].sum()),
+        "n_timeout": int((status == "timeout").sum()), "n_error": int(status.str.startswith("error").sum())}
+    m.update(_stats(g["dist_err_cm"], "dist", "cm"))
+    m.update(_stats(g["orient_err_deg"], "orient", "deg"))
+    for k in ("dist", "orient"):
+        s = g[f"{k}_impr_pct"].dropna()
+        m[f"{k}_impr_mean_pct"] = s.mean() if len(s) else np.nan
+        m[f"{k}_impr_median_pct"] = _q(s, 50)
+        m[f"{k}_impr_min_pct"] = s.min() if len(s) else np.nan
+    counts = g["outcome_eval"].value_counts()
+    for o in (*OUTCOMES, UNSCORED):
+        m[f"n_{o.replace('-', '_')}"] = int(counts.get(o, 0))
+    for o in OUTCOMES:
+        m[f"share_{o.replace('-', '_')}_pct"] = 100.0 * counts.get(o, 0) / n_truth if n_truth else np.nan
+    m["success_rate_pct"] = m["share_success_pct"]
+    rt = g["runtime_ms"].dropna()
+    m.update(runtime_median_ms=_q(rt, 50), runtime_p95_ms=_q(rt, 95), n_timed=len(rt))
+    return m
+
+
+def summarize(df: pd.DataFrame, by: list[str] | tuple[str, ...] = ("matcher",),
+              thresholds: Thresholds | None = None) -> pd.DataFrame:
+    """One row of metrics per group of ``by`` (``[]`` = one overall row).
+
+    ``df`` is raw estimates or already :func:`prepare`-d (detected by the ``outcome_eval``
+    column); ``thresholds`` defaults to 10 cm / 2°. Empty groups of categorical bins are omitted.
+    """
+    p = df if "outcome_eval" in df.columns else prepare(df, thresholds or Thresholds())
+    by = list(by)
+    if not by:
+        return pd.DataFrame([group_metrics(p)], columns=list(METRIC_COLUMNS))
+    rows = []
+    for key, g in p.groupby(by, observed=True, sort=True, dropna=False):
+        key = key if isinstance(key, tuple) else (key,)
+        rows.append({**dict(zip(by, key, strict=True)), **group_metrics(g)})
+    return pd.DataFrame(rows, columns=[*by, *METRIC_COLUMNS])

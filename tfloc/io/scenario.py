@@ -1,0 +1,221 @@
+"""Scenario datasets: ``scenario.json`` + ``scans.csv`` (format in DESIGN.md), strict I/O.
+
+``scans.csv`` columns: ``scan_id,group,true_x,true_y,true_theta,init_x,init_y,init_theta,ranges``
+(metres, radians). ``true_*`` may be empty (truth unknown). ``ranges`` holds space-separated
+floats; ``inf``, ``nan`` or values ≥ max_range mean no return. Optional columns: ``stamp``
+(the scan's time in seconds, e.g. from a ROS bag; may be empty) and ``ref_ranges``.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from tfloc.core.laser import LaserSpec
+from tfloc.core.pose import Pose
+from tfloc.errors import DatasetError
+
+COLUMNS = ["scan_id", "group", "true_x", "true_y", "true_theta", "init_x", "init_y", "init_theta",
+           "ranges"]
+
+
+@dataclass(frozen=True, eq=False)
+class Scan:
+    """One row of ``scans.csv``: the real scan, its initial guess and (maybe) its true pose."""
+
+    scan_id: str
+    group: str
+    ranges: np.ndarray
+    initial: Pose
+    true: Pose | None = None
+    line: int = 0  # 1-based line in scans.csv, for messages
+    ref_ranges: np.ndarray | None = None  # scan-to-scan datasets: the reference scan (see map_for)
+    stamp: float | None = None  # seconds (optional ``stamp`` column), e.g. the ROS header stamp
+
+
+@dataclass(frozen=True, eq=False)
+class Scenario:
+    """A scenario dataset directory's metadata (``scenario.json``)."""
+
+    name: str
+    map_path: Path
+    laser: LaserSpec
+    description: str = ""
+    root: Path = field(default_factory=Path)
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def scans_path(self) -> Path:
+        return self.root / "scans.csv"
+
+
+def read_scenario(root: str | Path) -> Scenario:
+    """Read and validate ``root/scenario.json``."""
+    root = Path(root)
+    path = root / "scenario.json"
+    if not path.is_file():
+        raise DatasetError(f"{root}: not a scenario dataset (no scenario.json)")
+    try:
+        doc = json.loads(path.read_text())
+    except json.JSONDecodeError as exc:
+        raise DatasetError(f"{path}: not valid JSON ({exc})") from None
+    for key in ("name", "map", "laser"):
+        if key not in doc:
+            raise DatasetError(f"{path}: missing field {key!r}")
+    las = doc["laser"]
+    try:
+        laser = LaserSpec.from_degrees(float(las["max_range"]), float(las["fov_deg"]),
+                                       float(las["resolution_deg"]),
+                                       None if las.get("angle_min_deg") is None else float(las["angle_min_deg"]))
+    except (KeyError, TypeError, ValueError) as exc:
+        raise DatasetError(f"{path}: bad 'laser' field ({exc!r}); needs max_range, fov_deg, "
+                           "resolution_deg[, angle_min_deg]") from None
+    if not (laser.max_range > 0 and laser.resolution > 0 and laser.fov > 0):
+        raise DatasetError(f"{path}: laser max_range, fov_deg and resolution_deg must be positive")
+    extra = {k: v for k, v in doc.items() if k not in ("name", "map", "laser", "description")}
+    return Scenario(str(doc["name"]), (root / doc["map"]).resolve(), laser,
+                    str(doc.get("description", "")), root, extra)
+
+
+def _float(text: str, path: Path, line: int, column: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        raise DatasetError(f"{path}:{line}: column {column!r} is not a number: {text!r}") from None
+
+
+def _pose(row: dict, prefix: str, path: Path, line: int, optional: bool) -> Pose | None:
+    vals = [row.get(f"{prefix}_{k}", "") or "" for k in ("x", "y", "theta")]
+    if optional and all(v.strip() == "" for v in vals):
+        return None
+    p = Pose(*(_float(v, path, line, f"{prefix}_{k}") for v, k in zip(vals, ("x", "y", "theta"), strict=True)))
+    if not p.is_finite():
+        raise DatasetError(f"{path}:{line}: {prefix} pose is not finite: {p}")
+    return p
+
+
+def parse_ranges(text: str, laser: LaserSpec, path: Path, line: int) -> np.ndarray:
+    """Parse the ``ranges`` field strictly: count, numbers, no negatives, at least one return."""
+    parts = text.split()
+    if len(parts) != laser.n_beams:
+        raise DatasetError(f"{path}:{line}: {len(parts)} ranges, expected {laser.n_beams} "
+                           f"(laser {math.degrees(laser.fov):g}°/{math.degrees(laser.resolution):g}°)")
+    try:
+        r = np.array(parts, dtype=float)
+    except ValueError:
+        bad = next(p for p in parts if not _is_float(p))
+        raise DatasetError(f"{path}:{line}: range {bad!r} is not a number") from None
+    with np.errstate(invalid="ignore"):
+        neg = np.flatnonzero(r < 0)
+    if neg.size:
+        raise DatasetError(f"{path}:{line}: negative range {r[neg[0]]:g} at beam {neg[0]}")
+    if not laser.valid(r).any():
+        raise DatasetError(f"{path}:{line}: scan has no return at all (every range inf/nan/≥ max_range)")
+    return r
+
+
+def _is_float(s: str) -> bool:
+    try:
+        float(s)
+        return True
+    except ValueError:
+        return False
+
+
+def iter_scans(scenario: Scenario) -> Iterator[Scan]:
+    """Yield the scans of ``scans.csv`` one by one, validating each row; errors name file:line."""
+    path = scenario.scans_path
+    if not path.is_file():
+        raise DatasetError(f"{scenario.root}: missing scans.csv")
+    with path.open(newline="") as fh:
+        reader = csv.DictReader(fh)
+        missing = [c for c in COLUMNS if c not in (reader.fieldnames or [])]
+        if missing:
+            raise DatasetError(f"{path}:1: header lacks column(s) {', '.join(missing)}")
+        seen: set[str] = set()
+        for row in reader:
+            line = reader.line_num
+            if None in row or any(row[c] is None for c in COLUMNS):
+                raise DatasetError(f"{path}:{line}: wrong number of fields (expected {len(COLUMNS)})")
+            sid = row["scan_id"].strip()
+            if not sid:
+                raise DatasetError(f"{path}:{line}: empty scan_id")
+            if sid in seen:
+                raise DatasetError(f"{path}:{line}: duplicate scan_id {sid!r}")
+            seen.add(sid)
+            ref = row.get("ref_ranges")
+            stamp = (row.get("stamp") or "").strip()
+            yield Scan(sid, row["group"].strip(),
+                       parse_ranges(row["ranges"], scenario.laser, path, line),
+                       _pose(row, "init", path, line, optional=False),
+                       _pose(row, "true", path, line, optional=True), line,
+                       parse_ranges(ref, scenario.laser, path, line) if ref else None,
+                       _stamp(stamp, path, line) if stamp else None)
+
+
+def _stamp(text: str, path: Path, line: int) -> float:
+    t = _float(text, path, line, "stamp")
+    if not math.isfinite(t):
+        raise DatasetError(f"{path}:{line}: stamp is not finite: {text!r}")
+    return t
+
+
+def map_for(scenario: Scenario, scan: Scan, cache: dict | None = None):
+    """The map a scan is localized in: the dataset's map file, or, for a scan-to-scan dataset
+    (optional ``ref_ranges`` column), the reference scan as a polyline map with the reference
+    robot at the origin (so ``true``/``init`` are relative poses)."""
+    if scan.ref_ranges is not None:
+        from tfloc.maps.scanmap import polyline_map_from_scan
+
+        return polyline_map_from_scan(scan.ref_ranges, scenario.laser)
+    cache = {} if cache is None else cache
+    if scenario.map_path not in cache:
+        from tfloc.io.maps import load_map
+
+        cache[scenario.map_path] = load_map(scenario.map_path)
+    return cache[scenario.map_path]
+
+
+def read_scans(scenario: Scenario) -> list[Scan]:
+    """All scans of a dataset (validated)."""
+    return list(iter_scans(scenario))
+
+
+def _fmt(v: float) -> str:
+    return "inf" if math.isinf(v) else ("nan" if math.isnan(v) else f"{v:.4f}".rstrip("0").rstrip("."))
+
+
+def write_scenario(root: str | Path, name: str, map_path: str | Path, laser: LaserSpec,
+                   scans: Iterable[Scan], description: str = "", **extra) -> Path:
+    """Write a dataset directory (``scenario.json`` + ``scans.csv``); ``map_path`` is stored
+    relative to ``root``. Ranges are written with 0.1 mm precision; a ``stamp`` column (µs) is
+    written only if some scan has a stamp."""
+    root = Path(root)
+    root.mkdir(parents=True, exist_ok=True)
+    rel = Path(os.path.relpath(Path(map_path).resolve(), root.resolve()))
+    doc = {"name": name, "map": rel.as_posix(), "description": description, "units": "metres, radians",
+           "laser": {"max_range": laser.max_range, "fov_deg": round(math.degrees(laser.fov), 9),
+                     "resolution_deg": round(math.degrees(laser.resolution), 9),
+                     "angle_min_deg": round(math.degrees(laser.angle_min), 9)}, **extra}
+    (root / "scenario.json").write_text(json.dumps(doc, indent=2) + "\n")
+    scans = list(scans)
+    with_ref = any(s.ref_ranges is not None for s in scans)
+    with_stamp = any(s.stamp is not None for s in scans)
+    with (root / "scans.csv").open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(COLUMNS + (["stamp"] if with_stamp else []) + (["ref_ranges"] if with_ref else []))
+        for s in scans:
+            t = ["", "", ""] if s.true is None else [f"{s.true.x:.6f}", f"{s.true.y:.6f}", f"{s.true.theta:.7f}"]
+            ref = [] if not with_ref else [" ".join(_fmt(v) for v in s.ref_ranges)
+                                           if s.ref_ranges is not None else ""]
+            stamp = [] if not with_stamp else ["" if s.stamp is None else f"{s.stamp:.6f}"]
+            w.writerow([s.scan_id, s.group, *t, f"{s.initial.x:.6f}", f"{s.initial.y:.6f}",
+                        f"{s.initial.theta:.7f}", " ".join(_fmt(v) for v in s.ranges), *stamp, *ref])
+    return root

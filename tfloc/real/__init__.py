@@ -1,1 +1,0 @@
-"""Real laser logs: building the scenario datasets from ``data/real/`` and settling log quirks."""

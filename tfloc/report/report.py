@@ -1,0 +1,236 @@
+"""``tfloc report RUN``: RUN/report.md, RUN/summary.csv and RUN/figures/*.png from a run's results.
+
+Reads ``estimates.csv`` and ``run.json`` (:mod:`tfloc.harness.runner`), computes the metrics
+(:mod:`tfloc.evaluation.metrics`, :mod:`tfloc.evaluation.summary`), draws the figures
+(:mod:`tfloc.report.figures`) and writes the markdown (:mod:`tfloc.report.sections`).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from pathlib import Path
+
+import pandas as pd
+
+from tfloc.errors import ConfigError
+from tfloc.evaluation.metrics import Thresholds, prepare, summarize
+from tfloc.evaluation.paper import CITATION
+from tfloc.evaluation.summary import (
+    POOL,
+    SCENARIO_I,
+    scenario_summary,
+    summary_table,
+    write_summary,
+)
+from tfloc.io.estimates import COLUMNS, read_estimates
+
+from . import figures as F
+from . import sections as S
+
+
+@dataclass(frozen=True)
+class ReportFiles:
+    """What :func:`write_report` wrote."""
+
+    report: Path
+    summary: Path
+    figures: tuple[Path, ...]
+
+
+def load_run(run_dir: Path) -> tuple[pd.DataFrame, dict]:
+    """The estimates and the ``run.json`` document (``{}`` when missing) of a run directory."""
+    if not (run_dir / "estimates.csv").is_file():
+        raise ConfigError(f"{run_dir}: no estimates.csv (not a run directory? run 'tfloc bench' first)")
+    try:
+        df = read_estimates(run_dir)
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError) as exc:
+        raise ConfigError(f"{run_dir / 'estimates.csv'}: unreadable ({exc})") from None
+    missing = [c for c in COLUMNS if c not in df.columns and c not in ("score_est", "score_true", "info")]
+    if missing:
+        raise ConfigError(f"{run_dir / 'estimates.csv'}: missing column(s) {', '.join(missing)}")
+    if df.empty:
+        raise ConfigError(f"{run_dir / 'estimates.csv'}: no results yet (no task of the run has finished)")
+    run_json = run_dir / "run.json"
+    try:
+        run = json.loads(run_json.read_text()) if run_json.is_file() else {}
+    except json.JSONDecodeError as exc:
+        raise ConfigError(f"{run_json}: not valid JSON ({exc})") from None
+    for c in ("status", "outcome", "group"):
+        df[c] = df[c].fillna("")
+    return df, run
+
+
+def scan_to_scan_datasets(run: dict, names: list[str]) -> set[str]:
+    """Datasets whose ``scenario.json`` says ``"scan_to_scan": true`` (or named ``*relations*``)."""
+    out = set()
+    for name in names:
+        path = Path(run.get("datasets", {}).get(name, "")) / "scenario.json"
+        try:
+            flag = bool(json.loads(path.read_text()).get("scan_to_scan", False)) if path.is_file() else None
+        except (OSError, json.JSONDecodeError):
+            flag = None
+        if flag or (flag is None and "relations" in name):
+            out.add(name)
+    return out
+
+
+def header(run_dir: Path, run: dict, df: pd.DataFrame, thr: Thresholds, s2s: set[str]) -> str:
+    """Title and provenance: run, dates, commit, machine, versions, datasets, matchers, thresholds."""
+    cfg = run.get("config", {})
+    git = run.get("git", {})
+    mach = run.get("machine", {})
+    sessions = run.get("sessions", [])
+    commit = git.get("commit") or "unknown"
+    if git.get("dirty"):
+        commit += " (working tree had uncommitted changes)"
+    lines = [f"# tfloc benchmark report: {cfg.get('name', run_dir.name)}\n",
+             f"- Run directory: `{run_dir}`",
+             f"- Report generated: {datetime.now(UTC).strftime('%Y-%m-%d %H:%M UTC')}",
+             f"- Run started: {sessions[0]['started'] if sessions else 'unknown'}"
+             + (f" ({len(sessions)} sessions, resumed)" if len(sessions) > 1 else ""),
+             f"- Commit: `{commit}`",
+             f"- Machine: {mach.get('platform', '?')}, {mach.get('cpu_count', '?')} CPUs, Python "
+             f"{mach.get('python', '?')}; {cfg.get('jobs', '?')} worker(s) × {run.get('threads_per_job', '?')} "
+             f"thread(s); time limit {cfg.get('timeout_s', '?')} s per scan",
+             "- Versions: " + (", ".join(f"{k} {v}" for k, v in run.get("versions", {}).items() if v) or "unknown")]
+    if not run:
+        lines.append("- **run.json is missing**: provenance unknown, default thresholds used.")
+    lim = cfg.get("limit_per_group")
+    if lim:
+        lines.append(f"- **Smoke run**: only the first {lim} scans of each group were run.")
+    specs = cfg.get("matchers") or [{"label": m, "name": m} for m in sorted(df["matcher"].unique())]
+    lines.append("- Matchers: " + ", ".join(
+        f"`{m['label']}`" + (f" ({m['name']} {json.dumps(m.get('params', {}))})"
+                             if m.get("params") or m["name"] != m["label"] else "") for m in specs))
+    lines.append("- Datasets: " + ", ".join(
+        f"{d} ({df.loc[df['dataset'] == d, 'scan_id'].nunique()} scans"
+        + (", scan-to-scan" if d in s2s else "") + ")" for d in df["dataset"].unique()))
+    lines.append(f"- Success thresholds: distance error ≤ {thr.dist_m * 100:g} cm and orientation "
+                 f"error ≤ {thr.orient_deg:g}°")
+    st = df["status"].where(~df["status"].str.startswith("error"), "error")
+    lines.append(f"- Rows: {len(df)} (" + ", ".join(f"{k}: {v}" for k, v in st.value_counts().items()) + ")")
+    return "\n".join(lines) + "\n"
+
+
+def definitions(thr: Thresholds) -> str:
+    """How every number of the report is defined."""
+    return f"""## Definitions
+
+- **Distance error** ‖(x̂, ŷ) − (x, y)‖ in cm; **orientation error** |angdiff(θ̂, θ)| in degrees
+  (the paper's Eq. 6). Mean, median, p90 (linear interpolation between order statistics), max.
+- **Improvement** (the paper's Tables 2–4): per scan, distance improvement = 100·(1 − dist_err /
+  init_dist_err) and orientation improvement = 100·(1 − orient_err / init_orient_err), where
+  init_* is the error of the initial pose; the tables give the **mean of the per-scan values**.
+  It is 100 % for a perfect answer, 0 % for no change and negative when the answer is worse than
+  the initial pose — one diverged scan with a small initial offset can pull the mean far below 0
+  (the worst per-scan value is in summary.csv, `*_impr_min_pct`). Scans with a zero initial
+  offset have no improvement and are left out of it.
+- **Success**: status `ok` and distance error ≤ {thr.dist_m * 100:g} cm and orientation error ≤
+  {thr.orient_deg:g}°. The **success rate** is over all scans with ground truth: a scan without
+  an answer counts as a failure.
+- **Outcome** of each scan: `success`; `local-optimum` (the matcher's own objective is lower at
+  the true pose than at its answer: the search stopped short); `ambiguous` (its objective prefers
+  the wrong pose); `no-answer` (status `failed`: the matcher declined or returned no finite pose;
+  `timeout`; `error`).
+- **Which rows count**: error and improvement statistics use scans with an estimate (status `ok`,
+  or `failed` with a finite pose). Timeouts, errors and failed scans without a pose have no error;
+  they are **excluded** from those statistics (the `n` column says how many: "(k excl.)") but
+  count as failures in the success rate and as `no-answer` in the outcomes.
+- **Runtime** per scan: the matcher's `localize` call only (data loading and numba compilation
+  happen before timing), median and p95 in ms over scans with status `ok` or `failed`.
+- **Bins** come from the true and initial poses (not from group labels): initial distance offset
+  [0, 100), [100, 200), [200, 300), [300, ∞) cm; initial angle offset [0, 5), [5, 10), [10, 15),
+  [15, ∞) degrees. Left edge included: an offset of exactly 100 cm is in 100–200.
+- **Scenarios** (the paper's Section 5): I = datasets {', '.join(SCENARIO_I)}; II = {POOL} by
+  initial angle offset; III = {POOL} by initial distance offset.
+- Published values: {CITATION}. The paper's tables give no success rates, medians or runtimes.
+"""
+
+
+def _dataset_section(p: pd.DataFrame, name: str, s2s: set[str]) -> str:
+    g = p[p["dataset"] == name]
+    out = [f"### {name}\n"]
+    if not g["truth"].any():
+        out.append("_No ground truth in this dataset: accuracy, success and outcome tables are skipped._\n")
+        out.append(S.runtime_only(summarize(g, ["matcher"])))
+        return "\n".join(out)
+    t = g[g["truth"]]
+    if name in s2s:
+        out.append("Scan-to-scan (Kümmerle et al. 2009 style): errors of the estimated relative pose.\n")
+        k = pd.concat([summarize(t, ["matcher"]).assign(group="all"), summarize(t, ["matcher", "group"])])
+        out.append(S.scan_to_scan(k.sort_values(["matcher", "group"], key=lambda s: s.replace("all", ""))))
+    else:
+        out.append(S.accuracy(summarize(t, ["matcher"])))
+        out.append("Success rate (%) by initial distance offset:\n")
+        out.append(S.success_by(t, "dist_bin", " cm"))
+        out.append("Success rate (%) by initial angle offset:\n")
+        out.append(S.success_by(t, "angle_bin", "°"))
+    out.append("Outcomes (count and share of scans with ground truth):\n")
+    out.append(S.outcomes(summarize(t, ["matcher"])))
+    return "\n".join(out)
+
+
+def render(run_dir: Path, run: dict, p: pd.DataFrame, thr: Thresholds, s2s: set[str],
+           figs: list[Path]) -> str:
+    """The whole report.md text."""
+    parts = [header(run_dir, run, p, thr, s2s), definitions(thr)]
+    truth = p[p["truth"]]
+    sc = scenario_summary(truth)
+    if not truth.empty and len(sc):
+        parts.append("## The paper's Tables 2–4: published tf against tfloc's tf\n")
+        parts.append(S.paper_vs_tf(sc))
+        parts.append("## Tables 2–4 for every matcher\n")
+        parts.append(S.all_matchers(sc))
+    elif truth.empty:
+        parts.append("## Scoring\n\n_No scan in this run has ground truth: accuracy, success and outcome "
+                     "sections are skipped; only runtimes are reported._\n")
+    else:
+        parts.append("_None of the paper's scenario datasets (detail-1/2/3, office-pool) is in this run: "
+                     "the paper's tables are not shown._\n")
+    parts.append("## Results per dataset\n")
+    parts += [_dataset_section(p, d, s2s) for d in p["dataset"].unique()]
+    s2m = truth[~truth["dataset"].isin(s2s)]
+    if s2m["dataset"].nunique() > 1:
+        names = ", ".join(s2m["dataset"].unique())
+        parts.append(f"## Scan-to-map datasets pooled ({names})\n")
+        if s2s:
+            parts.append("Scan-to-scan datasets are left out: their initial offsets are odometry, often "
+                         "under a millimetre, which makes the improvement meaningless.\n")
+        parts.append(S.accuracy(summarize(s2m, ["matcher"])))
+        parts.append("Outcomes:\n")
+        parts.append(S.outcomes(summarize(s2m, ["matcher"])))
+        parts.append("Success rate (%) by initial distance offset:\n")
+        parts.append(S.success_by(s2m, "dist_bin", " cm"))
+        parts.append("Success rate (%) by initial angle offset:\n")
+        parts.append(S.success_by(s2m, "angle_bin", "°"))
+    parts.append("## Tasks without an answer (timeouts, errors)\n")
+    parts.append(S.failures(p))
+    if figs:
+        parts.append("## Figures\n")
+        parts += [f"![{f.stem}](figures/{f.name})\n" for f in figs]
+    return "\n".join(parts)
+
+
+def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
+                 with_figures: bool = True) -> ReportFiles:
+    """Write report.md, summary.csv and figures/*.png into ``run_dir``; returns their paths."""
+    run_dir = Path(run_dir)
+    df, run = load_run(run_dir)
+    thr = thresholds or Thresholds.from_run(run)
+    p = prepare(df, thr)
+    s2s = scan_to_scan_datasets(run, list(p["dataset"].unique()))
+    summary = write_summary(summary_table(p, s2s), run_dir / "summary.csv")
+    figs: list[Path] = []
+    if with_figures:
+        fd = run_dir / "figures"
+        sc = scenario_summary(p[p["truth"]])
+        made = [F.fig_scenarios(sc, fd / "scenario_errors.png") if len(sc) else None,
+                F.fig_basin(p, fd / "basin.png", s2s), F.fig_cdf(p, fd / "error_cdf.png", thr),
+                F.fig_runtime(p, fd / "runtime.png"), F.fig_outcomes(p, fd / "outcomes.png", s2s)]
+        figs = [f for f in made if f is not None]
+    report = run_dir / "report.md"
+    report.write_text(render(run_dir, run, p, thr, s2s, figs))
+    return ReportFiles(report, summary, tuple(figs))
+

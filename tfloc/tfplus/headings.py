@@ -1,0 +1,51 @@
+"""Heading error from turning functions, without a position: edge-direction histograms.
+
+A turning function's value Θ(s) is the direction (radians, sensor frame) of the polygon edge at
+arc length s, whatever vertex the polygon starts at. Binning Θ mod 2π weighted by edge length
+gives an edge-direction histogram of the scan; rotating the robot shifts it circularly, and
+moving the robot mostly changes how long each wall looks, not its direction. The circular
+cross-correlation of the real and the virtual scan's histograms, searched over ±``max_rotation``
+(the initial guess's heading is that good), peaks at the rotation offset. The two closing edges
+through the sensor origin (:func:`tfloc.paper.matcher.scan_polygon`) are not walls and are left out.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tfloc.paper.turning import TurningFunction
+
+
+def edge_histogram(tf: TurningFunction, bins: int, smoothing: float, skip_closure: bool) -> np.ndarray:
+    """Length-weighted histogram ``(bins,)`` of edge directions over [0, 2π), smoothed by a
+    circular Gaussian of ``smoothing`` radians."""
+    lengths = np.diff(tf.breaks)
+    angles = np.mod(tf.angles, 2 * np.pi)
+    if skip_closure and len(angles) > 3:
+        lengths, angles = lengths[1:-1], angles[1:-1]
+    width = 2 * np.pi / bins
+    raw = np.bincount(np.minimum((angles / width).astype(np.int64), bins - 1), lengths, bins)
+    d = (np.arange(bins) + bins // 2) % bins - bins // 2            # circular bin offsets
+    kernel = np.exp(-0.5 * (d * width / smoothing) ** 2)
+    return np.real(np.fft.ifft(np.fft.fft(raw) * np.fft.fft(kernel)))
+
+
+def rotation_candidates(real: TurningFunction, virtual: TurningFunction, max_rotation: float,
+                        count: int = 2, bins: int = 720, smoothing: float = np.radians(1.0),
+                        skip_closure: bool = True) -> np.ndarray:
+    """Up to ``count`` rotation offsets (radians, real = virtual rotated by it), best first:
+    the highest local maxima of the histograms' circular cross-correlation within ±max_rotation."""
+    hr = edge_histogram(real, bins, smoothing, skip_closure)
+    hv = edge_histogram(virtual, bins, smoothing, skip_closure)
+    corr = np.real(np.fft.ifft(np.fft.fft(hr) * np.conj(np.fft.fft(hv))))   # corr[k]: hv shifted by k
+    width = 2 * np.pi / bins
+    k = int(np.floor(max_rotation / width))
+    shifts = np.arange(-k, k + 1)
+    c = corr[shifts % bins]
+    peak = (c >= np.roll(c, 1)) & (c >= np.roll(c, -1))
+    peak[0] = peak[-1] = False
+    order = np.argsort(-np.where(peak, c, -np.inf))[:count]
+    order = order[peak[order]]
+    if len(order) == 0:
+        order = np.array([int(np.argmax(c))])
+    return shifts[order] * width
