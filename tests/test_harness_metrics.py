@@ -9,7 +9,8 @@ import pandas as pd
 import pytest
 
 from tests._estimates import frame, row
-from tfloc.evaluation.metrics import Thresholds, angle_bin, classify, dist_bin, prepare, summarize
+from tfloc.evaluation.metrics import angle_bin, classify, dist_bin, prepare, summarize
+from tfloc.evaluation.outcome import Thresholds
 from tfloc.evaluation.summary import scenario_summary, summary_table
 
 

@@ -8,8 +8,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from tfloc.evaluation.relations import relation_stats
 from tfloc.io.scenario import read_scans, read_scenario
-from tfloc.report.relations_note import relation_stats, write_note
+from tfloc.report.relations_note import write_note
 
 DATASET = Path(__file__).resolve().parents[1] / "data" / "scenarios" / "real-csail-relations"
 
@@ -17,7 +18,8 @@ DATASET = Path(__file__).resolve().parents[1] / "data" / "scenarios" / "real-csa
 def test_relation_stats() -> None:
     s = relation_stats(np.array([0.0, 0.1, 0.2]), np.radians([1.0, -2.0, 3.0]), np.array([1, 1, 0]), np.array([0.001, 0.003, 0.002]))
     assert s["trans_mean_m"] == pytest.approx(0.1) and s["trans_max_m"] == pytest.approx(0.2)
-    assert s["trans_std_m"] == pytest.approx(np.std([0, 0.1, 0.2]))
+    # the sample standard deviation, as in report.md (the note used ddof = 0 before: two rules)
+    assert s["trans_std_m"] == pytest.approx(np.std([0, 0.1, 0.2], ddof=1)) == pytest.approx(0.1)
     assert s["trans_sq_mean_m2"] == pytest.approx((0.01 + 0.04) / 3)
     assert s["rot_mean_deg"] == pytest.approx(2.0) and s["rot_max_deg"] == pytest.approx(3.0)
     assert s["success"] == pytest.approx(2 / 3) and s["runtime_median_ms"] == pytest.approx(2.0)

@@ -16,12 +16,12 @@ Examples:
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from pathlib import Path
 
 from tfloc.core.matcher import available_matchers
 from tfloc.errors import ConfigError
+from tfloc.evaluation.outcome import Thresholds
 from tfloc.harness.config import RunConfig, load_config, parse_matchers
 
 HELP = "run matchers over scenario datasets (resumable), writing RUN/estimates.csv"
@@ -70,8 +70,9 @@ def config_from_args(args: argparse.Namespace) -> RunConfig:
     return cfg.with_overrides(
         name=args.name, out=args.out, jobs=args.jobs, timeout_s=args.timeout,
         limit_per_group=args.limit_per_group,
-        success_dist_m=None if args.success_cm is None else args.success_cm / 100.0,
-        success_orient_rad=None if args.success_deg is None else math.radians(args.success_deg))
+        success=None if args.success_cm is None and args.success_deg is None else Thresholds(
+            cfg.success.dist_m if args.success_cm is None else args.success_cm / 100.0,
+            cfg.success.orient_deg if args.success_deg is None else args.success_deg))
 
 
 def run(args: argparse.Namespace) -> int:

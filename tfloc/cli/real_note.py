@@ -20,7 +20,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from tfloc.evaluation.outcome import Thresholds
     from tfloc.report.relations_note import write_note
 
-    print(write_note(args.results, args.dataset, args.max_dist_cm / 100.0, args.max_angle_deg))
+    print(write_note(args.results, args.dataset, Thresholds(args.max_dist_cm / 100.0, args.max_angle_deg)))
     return 0

@@ -29,7 +29,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from tfloc.evaluation.metrics import Thresholds
+    from tfloc.evaluation.outcome import Thresholds
     from tfloc.report.report import load_run, write_report
 
     thr = None

@@ -27,7 +27,8 @@ from tfloc.harness.config import RunConfig
 from tfloc.harness.runner import run as run_benchmark
 from tfloc.io.estimates import read_estimates
 
-from .metrics import Thresholds, summarize
+from .metrics import summarize
+from .outcome import Thresholds
 
 CONFIG = Path("benchmarks/regression.toml")
 REFERENCE = Path("results/reference/summary.csv")
@@ -125,8 +126,7 @@ def run_subset(config: RunConfig, fresh: bool = True, progress: bool | None = No
     if fresh and Path(config.out).exists():
         shutil.rmtree(config.out)
     out = run_benchmark(config, progress=progress)
-    thr = Thresholds(config.success_dist_m, float(np.degrees(config.success_orient_rad)))
-    return guard_summary(read_estimates(out), thr)
+    return guard_summary(read_estimates(out), config.success)
 
 
 def read_reference(path: Path = REFERENCE) -> pd.DataFrame:

@@ -21,16 +21,15 @@ Bins are left-closed, right-open: ``[0, 100)``, ``[100, 200)``, ``[200, 300)`` c
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 import pandas as pd
+
+from .outcome import NO_ANSWER, OUTCOMES, SUCCESS, Thresholds, failure_kind
 
 DIST_EDGES_CM = (0.0, 100.0, 200.0, 300.0)
 ANGLE_EDGES_DEG = (0.0, 5.0, 10.0, 15.0)
 DIST_BINS = ("0–100", "100–200", "200–300", "≥300")
 ANGLE_BINS = ("0–5", "5–10", "10–15", "≥15")
-OUTCOMES = ("success", "local-optimum", "ambiguous", "no-answer")
 UNSCORED = "unscored"  # failed under overridden thresholds but the run recorded no scores
 METRIC_COLUMNS = (
     "n", "n_truth", "n_est", "n_excluded", "n_timeout", "n_error",
@@ -42,20 +41,6 @@ METRIC_COLUMNS = (
     *(f"n_{o.replace('-', '_')}" for o in (*OUTCOMES, UNSCORED)),
     *(f"share_{o.replace('-', '_')}_pct" for o in OUTCOMES),
     "runtime_median_ms", "runtime_p95_ms", "n_timed")
-
-
-@dataclass(frozen=True)
-class Thresholds:
-    """Success: distance error ≤ ``dist_m`` (metres) and orientation error ≤ ``orient_deg``."""
-
-    dist_m: float = 0.10
-    orient_deg: float = 2.0
-
-    @classmethod
-    def from_run(cls, run: dict) -> Thresholds:
-        """The thresholds recorded in a ``run.json`` document (defaults if absent)."""
-        s = run.get("config", {}).get("success", {})
-        return cls(float(s.get("dist_m", 0.10)), float(s.get("orient_deg", 2.0)))
 
 
 def _bin(values: pd.Series, edges: tuple[float, ...], labels: tuple[str, ...]) -> pd.Series:
@@ -98,16 +83,15 @@ def classify(df: pd.DataFrame, thr: Thresholds) -> pd.Series:
     run's has no recorded scores: it keeps a recorded failure outcome, else ``unscored``.
     """
     d = pd.to_numeric(df["dist_err_m"], errors="coerce")
-    o = np.degrees(pd.to_numeric(df["orient_err_rad"], errors="coerce"))
+    o = pd.to_numeric(df["orient_err_rad"], errors="coerce")
     nan = pd.Series(np.nan, index=df.index)
     s_est = pd.to_numeric(df.get("score_est", nan), errors="coerce")
     s_true = pd.to_numeric(df.get("score_true", nan), errors="coerce")
     recorded = df.get("outcome", pd.Series("", index=df.index)).fillna("").astype(str)
     scored = s_est.notna() & s_true.notna()
-    fail = np.where(scored, np.where(s_true < s_est, "local-optimum", "ambiguous"),
-                    np.where(recorded.isin(["local-optimum", "ambiguous"]), recorded, UNSCORED))
-    within = (d <= thr.dist_m) & (o <= thr.orient_deg)
-    out = np.where(df["status"] != "ok", "no-answer", np.where(within, "success", fail))
+    fail = np.where(scored, failure_kind(s_est, s_true),
+                    np.where(recorded.isin(OUTCOMES[1:3]), recorded, UNSCORED))
+    out = np.where(df["status"] != "ok", NO_ANSWER, np.where(thr.success(d, o), SUCCESS, fail))
     return pd.Series(np.where(has_truth(df), out, None), index=df.index, dtype=object)
 
 

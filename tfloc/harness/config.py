@@ -28,13 +28,13 @@ from __future__ import annotations
 
 import itertools
 import json
-import math
 import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 from tfloc.errors import ConfigError
+from tfloc.evaluation.outcome import Thresholds
 
 
 @dataclass(frozen=True)
@@ -65,8 +65,7 @@ class RunConfig:
     jobs: int = 2
     timeout_s: float = 60.0
     limit_per_group: int = 0
-    success_dist_m: float = 0.10
-    success_orient_rad: float = math.radians(2.0)
+    success: Thresholds = Thresholds()
     extra: dict = field(default_factory=dict, compare=False)
 
     def __post_init__(self) -> None:
@@ -87,8 +86,7 @@ class RunConfig:
         return {"name": self.name, "out": str(self.out), "datasets": [str(d) for d in self.datasets],
                 "matchers": [{"label": m.label, "name": m.name, "params": m.params} for m in self.matchers],
                 "jobs": self.jobs, "timeout_s": self.timeout_s, "limit_per_group": self.limit_per_group,
-                "success": {"dist_m": self.success_dist_m,
-                            "orient_deg": math.degrees(self.success_orient_rad)}, **self.extra}
+                "success": self.success.to_dict(), **self.extra}
 
 
 def parse_matchers(entries: list, defaults: dict[str, dict], where: str) -> tuple[MatcherSpec, ...]:
@@ -169,8 +167,7 @@ def load_config(path: str | Path) -> RunConfig:
             + expand_sweeps(doc.get("sweep", []), doc.get("params", {}), str(path)),
             jobs=int(doc.get("jobs", 2)), timeout_s=float(doc.get("timeout_s", 60.0)),
             limit_per_group=int(doc.get("limit_per_group", 0)),
-            success_dist_m=float(success.get("dist_m", 0.10)),
-            success_orient_rad=math.radians(float(success.get("orient_deg", 2.0))),
+            success=Thresholds.from_dict(success),
             extra={k: doc[k] for k in ("description",) if k in doc})
     except (TypeError, ValueError) as exc:
         raise ConfigError(f"{path}: {exc}") from None

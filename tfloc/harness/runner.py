@@ -49,7 +49,7 @@ def make_tasks(config: RunConfig) -> list[Task]:
                 continue
             for m in config.matchers:
                 tasks.append(Task(str(d), scenario.name, scan.scan_id, m.label, m.name, m.params_json,
-                                  config.success_dist_m, config.success_orient_rad))
+                                  config.success))
     return tasks
 
 

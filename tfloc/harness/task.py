@@ -7,15 +7,17 @@ loads a dataset's scans and map once and keeps them (module-level caches).
 from __future__ import annotations
 
 import json
-import math
 import time
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
 
+import numpy as np
+
 from tfloc.core.matcher import get_matcher
 from tfloc.core.pose import Pose, angdiff
 from tfloc.core.problem import Estimate, Problem
+from tfloc.evaluation.outcome import AMBIGUOUS, NO_ANSWER, Thresholds, outcome
 from tfloc.io.scenario import Scan, Scenario, map_for, read_scans, read_scenario
 
 
@@ -29,8 +31,7 @@ class Task:
     label: str            # matcher label in the results
     matcher: str          # registered matcher name (or "module:Class")
     params_json: str = "{}"
-    success_dist_m: float = 0.10
-    success_orient_rad: float = math.radians(2.0)
+    thresholds: Thresholds = Thresholds()
 
     @property
     def key(self) -> tuple[str, str, str]:
@@ -83,7 +84,7 @@ def failure_row(task: Task, status: str, scan: Scan | None = None) -> dict[str, 
         except Exception:  # noqa: BLE001 - the row must be written whatever went wrong
             scan = None
     row = base_row(task, scan)
-    row.update(status=status.replace("\n", " ")[:300], outcome="no-answer" if scan and scan.true else "")
+    row.update(status=status.replace("\n", " ")[:300], outcome=NO_ANSWER if scan and scan.true else "")
     return row
 
 
@@ -118,17 +119,15 @@ def run_task(task: Task) -> dict[str, Any]:
         return row
     d, o = p.distance_to(scan.true), abs(angdiff(p.theta, scan.true.theta))
     row.update(dist_err_m=d, orient_err_rad=o)
-    if declined:
-        row["outcome"] = "no-answer"
-    elif d <= task.success_dist_m and o <= task.success_orient_rad:
-        row["outcome"] = "success"
-    else:  # why did it fail? compare the matcher's own objective at its answer and at the truth
-        try:
-            s_est, s_true = float(matcher.score(problem, p)), float(matcher.score(problem, scan.true))
-            row.update(score_est=s_est, score_true=s_true,
-                       outcome="local-optimum" if s_true < s_est else "ambiguous")
-        except Exception as exc:  # noqa: BLE001
-            row.update(outcome="ambiguous", info=row["info"][:-1] + f',"score_error":{json.dumps(str(exc))}}}')
+    if declined or task.thresholds.success(d, o):
+        row["outcome"] = outcome(not declined, d, o, np.nan, np.nan, task.thresholds)
+        return row
+    try:  # why did it fail? compare the matcher's own objective at its answer and at the truth
+        s_est, s_true = float(matcher.score(problem, p)), float(matcher.score(problem, scan.true))
+        row.update(score_est=s_est, score_true=s_true,
+                   outcome=outcome(True, d, o, s_est, s_true, task.thresholds))
+    except Exception as exc:  # noqa: BLE001
+        row.update(outcome=AMBIGUOUS, info=row["info"][:-1] + f',"score_error":{json.dumps(str(exc))}}}')
     return row
 
 

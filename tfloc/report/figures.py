@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from tfloc.evaluation.metrics import OUTCOMES, Thresholds
+from tfloc.evaluation.outcome import OUTCOMES, Thresholds
 from tfloc.evaluation.paper import PAPER_TF
 from tfloc.evaluation.summary import POOL, SCENARIO_I
 

@@ -3,7 +3,8 @@ them, next to the published figures, with what can and cannot be compared.
 
 Relation errors (Kümmerle et al. 2009, Sec. 3): for every relation δ* and its estimate δ, the
 translational error ‖trans(δ ⊖ δ*)‖ (m) and the rotational error |rot(δ ⊖ δ*)| (deg); reported as
-mean ± standard deviation and max, absolute (m, deg) and squared (m², deg²).
+mean ± standard deviation and max, absolute (m, deg) and squared (m², deg²)
+(:mod:`tfloc.evaluation.relations`).
 """
 
 from __future__ import annotations
@@ -15,6 +16,8 @@ import pandas as pd
 
 from tfloc.core.pose import angdiff
 from tfloc.errors import DatasetError
+from tfloc.evaluation.outcome import Thresholds
+from tfloc.evaluation.relations import relation_stats
 from tfloc.io.scenario import read_scans, read_scenario
 
 #: Kümmerle et al. 2009 (Auton. Robots 27:387-407), MIT CSAIL: errors on its 1172 relations of the
@@ -29,23 +32,6 @@ PUBLISHED_CSAIL = (
     ("Graph mapping (Kümmerle et al. 2009)", 0.004, 0.009, None),
 )
 
-def relation_stats(trans_m: np.ndarray, rot_rad: np.ndarray, success: np.ndarray | None = None,
-                   runtime_s: np.ndarray | None = None) -> dict:
-    """Kümmerle-style summary of per-relation errors (m, rad in; m, deg, ms out)."""
-    t = np.asarray(trans_m, float)
-    r = np.degrees(np.abs(np.asarray(rot_rad, float)))
-    out = {"n": int(t.size), "trans_mean_m": t.mean(), "trans_std_m": t.std(), "trans_max_m": t.max(),
-           "trans_sq_mean_m2": (t ** 2).mean(), "trans_sq_std_m2": (t ** 2).std(),
-           "rot_mean_deg": r.mean(), "rot_std_deg": r.std(), "rot_max_deg": r.max(),
-           "rot_sq_mean_deg2": (r ** 2).mean(), "rot_sq_std_deg2": (r ** 2).std()}
-    if success is not None:
-        out["success"] = float(np.mean(success))
-    if runtime_s is not None and np.size(runtime_s):
-        out["runtime_median_ms"] = 1e3 * float(np.median(runtime_s))
-        out["runtime_mean_ms"] = 1e3 * float(np.mean(runtime_s))
-    return out
-
-
 def _row(label: str, s: dict) -> str:
     succ = f"{100 * s['success']:.1f} %" if "success" in s else "–"
     rt = (f"{s['runtime_median_ms']:.1f} / {s['runtime_mean_ms']:.1f}" if "runtime_median_ms" in s else "–")
@@ -54,8 +40,9 @@ def _row(label: str, s: dict) -> str:
             f"| {s['rot_mean_deg']:.2f} ± {s['rot_std_deg']:.2f} | {s['rot_max_deg']:.1f} | {succ} | {rt} |")
 
 
-def write_note(results: Path, dataset: Path, max_dist_m: float = 0.10, max_angle_deg: float = 2.0) -> Path:
+def write_note(results: Path, dataset: Path, thresholds: Thresholds | None = None) -> Path:
     """Write ``results/NOTE.md`` from ``results/estimates.csv`` (if present) and the dataset."""
+    thresholds = thresholds or Thresholds()
     results, dataset = Path(results), Path(dataset)
     sc = read_scenario(dataset)
     scans = read_scans(sc)
@@ -64,7 +51,7 @@ def write_note(results: Path, dataset: Path, max_dist_m: float = 0.10, max_angle
     I0 = np.array([s.initial.as_array() for s in scans])
     odo_t = np.hypot(*(T[:, :2] - I0[:, :2]).T)
     odo_r = angdiff(I0[:, 2], T[:, 2])
-    odo_ok = (odo_t <= max_dist_m) & (np.degrees(np.abs(odo_r)) <= max_angle_deg)
+    odo_ok = thresholds.success(odo_t, odo_r)
     est_path = results / "estimates.csv"
     est = pd.read_csv(est_path) if est_path.is_file() else None
     if est is not None:
@@ -83,7 +70,7 @@ def write_note(results: Path, dataset: Path, max_dist_m: float = 0.10, max_angle
         "drawn as a polyline map: the same virtual-sensor path as scan-to-map), starting from the raw "
         "odometry between the two scans, and is scored against the relation. Errors as Kümmerle et al.: "
         "translational ‖trans(δ ⊖ δ*)‖ and rotational |rot(δ ⊖ δ*)|, mean ± std and max over relations "
-        f"(absolute and squared). Success: ≤ {100 * max_dist_m:g} cm and ≤ {max_angle_deg:g}°. A scan a "
+        f"(absolute and squared). Success: ≤ {100 * thresholds.dist_m:g} cm and ≤ {thresholds.orient_deg:g}°. A scan a "
         "matcher failed on (error, timeout) counts with its initial guess, so every row covers all relations "
         "of the run.",
         "",
@@ -105,7 +92,7 @@ def write_note(results: Path, dataset: Path, max_dist_m: float = 0.10, max_angle
                 bad = df["status"].ne("ok") | df["dist_err_m"].isna()
                 t = np.where(bad, pd.Series(odo_t[mask], index=ids), df["dist_err_m"])
                 r = np.where(bad, pd.Series(odo_r[mask], index=ids), df["orient_err_rad"])
-                ok = (t <= max_dist_m) & (np.degrees(np.abs(r)) <= max_angle_deg)
+                ok = thresholds.success(t, r)
                 label = f"`{name}`" + (f" ({int(bad.sum())} not answered)" if bad.any() else "")
                 lines.append(_row(label, relation_stats(t, r, ok, df["runtime_s"].dropna().to_numpy())))
         lines.append("")

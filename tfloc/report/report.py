@@ -15,7 +15,8 @@ from pathlib import Path
 import pandas as pd
 
 from tfloc.errors import ConfigError
-from tfloc.evaluation.metrics import Thresholds, prepare, summarize
+from tfloc.evaluation.metrics import prepare, summarize
+from tfloc.evaluation.outcome import Thresholds
 from tfloc.evaluation.paper import CITATION
 from tfloc.evaluation.summary import (
     POOL,

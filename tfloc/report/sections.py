@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import pandas as pd
 
-from tfloc.evaluation.metrics import OUTCOMES, summarize
+from tfloc.evaluation.metrics import summarize
+from tfloc.evaluation.outcome import OUTCOMES
 from tfloc.evaluation.paper import PAPER_TF, TABLE_OF, paper_row
 
 from .mdtable import num, pm, table
