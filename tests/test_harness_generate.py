@@ -7,7 +7,8 @@ import numpy as np
 
 from tfloc.core.pose import angdiff
 from tfloc.datasets.offices import OFFICES
-from tfloc.datasets.synthetic import ANGLE_BINS_DEG, DIST_BINS_M, BundleSpec, generate_bundle
+from tfloc.datasets.protocol import ANGLE_BINS_DEG, DIST_BINS_M
+from tfloc.datasets.synthetic import BundleSpec, generate_bundle
 from tfloc.io.geojson import read_vector_map
 from tfloc.io.scenario import read_scans, read_scenario
 

@@ -75,7 +75,7 @@ def import_bag(cfg: BagImport) -> ImportSummary:
     """Read the bag and write the dataset directory ``cfg.out``; returns the counts."""
     from tfloc.io.rosbag import Bag
 
-    from .real import Perturbation, perturb
+    from .protocol import Perturbation, perturb
 
     if (cfg.map_file is None) == (cfg.map_topic is None):
         raise BagError("give the map either as a file (--map) or as an OccupancyGrid topic (--map-topic)")

@@ -10,8 +10,6 @@
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -26,15 +24,13 @@ from tfloc.io.scenario import Scan, write_scenario
 from tfloc.maps.build import grid_from_scans
 from tfloc.maps.grid import GridMap
 
+from .protocol import DEFAULT_SEED, Perturbation, perturb
+
 #: Ranges at or above this are the logs' no-return code (81.83–81.91 m).
 NO_RETURN_M = 80.0
 #: Largest range kept. The CSAIL logs record ``PARAM robot_front_laser_max 50``; the largest real
 #: returns are 42.40 m (CSAIL) and 25.38 m (Intel), so 50 m drops no real return.
 MAX_RANGE_M = 50.0
-#: Paper's offset bins: distance (m) × orientation (rad).
-DIST_BINS_M = ((0.0, 1.0), (1.0, 2.0), (2.0, 3.0))
-ANGLE_BINS_RAD = tuple((math.radians(a), math.radians(b)) for a, b in ((0, 5), (5, 10), (10, 15)))
-DEFAULT_SEED = 20091122
 
 CSAIL_LASER = LaserSpec.from_degrees(MAX_RANGE_M, 180.0, 0.5, -90.0)
 #: Intel: 180 beams at 1° from -90° (-90°…+89°), settled by measurement (data/real/intel/SPACING.md).
@@ -75,44 +71,10 @@ def relations_scans(clf: Path, relations: Path, laser: LaserSpec = CSAIL_LASER,
     return rows
 
 
-@dataclass(frozen=True)
-class Perturbation:
-    """How initial poses are drawn: the bins, the free-space clearance (m) and the seed."""
-
-    seed: int = DEFAULT_SEED
-    clearance_m: float = 0.2
-    max_tries: int = 10000
-
-
-def perturb(truth: np.ndarray, grid: GridMap, cfg: Perturbation) -> tuple[np.ndarray, list[str]]:
-    """Initial poses ``(N, 3)`` and groups ``d{i}-a{j}``: scan k gets bin ``perm[k] mod 9`` (a
-    seeded balanced assignment), a distance and an angle magnitude uniform in that bin, a uniform
-    direction and a random sign; redrawn until the position is free (``clearance_m``) and in
-    bounds."""
-    rng = np.random.default_rng(cfg.seed)
-    n = len(truth)
-    bins = rng.permutation(n) % (len(DIST_BINS_M) * len(ANGLE_BINS_RAD))
-    init = np.empty((n, 3))
-    groups = []
-    for k in range(n):
-        di, ai = divmod(int(bins[k]), len(ANGLE_BINS_RAD))
-        (d0, d1), (a0, a1) = DIST_BINS_M[di], ANGLE_BINS_RAD[ai]
-        for _ in range(cfg.max_tries):
-            d, phi = rng.uniform(d0, d1), rng.uniform(-math.pi, math.pi)
-            xy = truth[k, :2] + d * np.array([math.cos(phi), math.sin(phi)])
-            if grid.in_bounds(xy)[0] and grid.is_free(xy, cfg.clearance_m)[0]:
-                break
-        else:
-            raise DatasetError(f"scan {k}: no free initial position in bin d{di + 1} after {cfg.max_tries} draws")
-        dth = rng.uniform(a0, a1) * rng.choice((-1.0, 1.0))
-        init[k] = (xy[0], xy[1], math.atan2(math.sin(truth[k, 2] + dth), math.cos(truth[k, 2] + dth)))
-        groups.append(f"d{di + 1}-a{ai + 1}")
-    return init, groups
-
-
 def scan_to_map(log_path: Path, laser: LaserSpec, resolution: float = 0.05,
-                cfg: Perturbation = Perturbation()) -> tuple[GridMap, list[Scan]]:
+                cfg: Perturbation | None = None) -> tuple[GridMap, list[Scan]]:
     """The grid map of a corrected log and its scans with perturbed initial poses."""
+    cfg = cfg or Perturbation()
     log = read_carmen(log_path)
     scans = _front(log, laser)
     R = np.vstack([clean_ranges(s.ranges) for s in scans])

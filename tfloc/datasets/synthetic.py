@@ -1,11 +1,9 @@
 """Scenario datasets of the paper's protocol: true and initial poses in free space, noisy scans.
 
-Every scan belongs to a stratum (cell) of a 3 × 3 grid: the initial distance offset
-‖VP − true‖ in 0–1, 1–2 or 2–3 m, crossed with the initial angle offset |θ_VP − θ_true| in
-0–5°, 5–10° or 10–15°. Cell labels are ``d{i}-a{j}``. Within a cell the distance offset is
-uniform, its direction uniform, and the angle offset uniform with a random sign. Both poses
-lie in free space with a clearance (default 0.3 m). The real scan is the map's raycast from
-the true pose plus :class:`~tfloc.datasets.noise.NoiseModel` noise.
+Every scan belongs to a cell of the protocol's 3 × 3 offset grid (:mod:`tfloc.datasets.protocol`,
+which also draws the initial pose). Both poses lie in free space with a clearance (default
+0.3 m). The real scan is the map's raycast from the true pose plus
+:class:`~tfloc.datasets.noise.NoiseModel` noise.
 
 The bundle (:func:`generate_bundle`) is drawn from one master seed, with one child seed per
 dataset (``numpy.random.SeedSequence.spawn``), so it is reproducible bit for bit.
@@ -20,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from tfloc.core.laser import LaserSpec
-from tfloc.core.pose import Pose, wrap_angle
+from tfloc.core.pose import Pose
 from tfloc.errors import ConfigError
 from tfloc.io.geojson import read_vector_map, write_vector_map
 from tfloc.io.scenario import Scan, write_scenario
@@ -28,26 +26,9 @@ from tfloc.maps.vector import VectorMap
 
 from .noise import NoiseModel
 from .offices import OFFICES
+from .protocol import Stratum, initial_pose, strata
 
-DIST_BINS_M = ((0.0, 1.0), (1.0, 2.0), (2.0, 3.0))
-ANGLE_BINS_DEG = ((0.0, 5.0), (5.0, 10.0), (10.0, 15.0))
 MASTER_SEED = 20261122
-_EDGE = 1e-4  # keep offsets this far inside their bin (m / deg), so CSV rounding cannot move a scan
-
-
-@dataclass(frozen=True)
-class Stratum:
-    """One cell of the grid: initial distance offset range (m) × angle offset range (degrees)."""
-
-    label: str
-    dist_m: tuple[float, float]
-    angle_deg: tuple[float, float]
-
-
-def strata() -> list[Stratum]:
-    """The 3 × 3 grid ``d1-a1 … d3-a3`` of the paper's protocol."""
-    return [Stratum(f"d{i + 1}-a{j + 1}", d, a)
-            for i, d in enumerate(DIST_BINS_M) for j, a in enumerate(ANGLE_BINS_DEG)]
 
 
 def sample_free_pose(m: VectorMap, rng: np.random.Generator, clearance: float) -> Pose:
@@ -65,19 +46,11 @@ def sample_free_pose(m: VectorMap, rng: np.random.Generator, clearance: float) -
 def sample_pose_pair(m: VectorMap, cell: Stratum, rng: np.random.Generator,
                      clearance: float = 0.3, tries: int = 64) -> tuple[Pose, Pose]:
     """A true pose and an initial pose (VP) offset from it as ``cell`` prescribes, both free."""
-    (dlo, dhi), (alo, ahi) = cell.dist_m, cell.angle_deg
     while True:
         true = sample_free_pose(m, rng, clearance)
-        d = rng.uniform(dlo + _EDGE, dhi - _EDGE, size=tries)
-        phi = rng.uniform(-math.pi, math.pi, size=tries)
-        da = np.radians(rng.uniform(alo + _EDGE, ahi - _EDGE, size=tries))
-        sign = np.where(rng.random(tries) < 0.5, -1.0, 1.0)
-        xy = np.column_stack((true.x + d * np.cos(phi), true.y + d * np.sin(phi)))
-        ok = np.flatnonzero(m.is_free(xy, clearance))
-        if ok.size:
-            k = ok[0]
-            return true, Pose(float(xy[k, 0]), float(xy[k, 1]),
-                              float(wrap_angle(true.theta + sign[k] * da[k])))
+        init = initial_pose(true, cell, rng, lambda xy: m.is_free(xy, clearance), tries)
+        if init is not None:
+            return true, init
 
 
 def sample_scans(m: VectorMap, laser: LaserSpec, noise: NoiseModel, per_cell: int,

@@ -21,15 +21,26 @@ Bins are left-closed, right-open: ``[0, 100)``, ``[100, 200)``, ``[200, 300)`` c
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pandas as pd
 
+from tfloc.datasets.protocol import ANGLE_BINS_DEG, DIST_BINS_M
+
 from .outcome import NO_ANSWER, OUTCOMES, SUCCESS, Thresholds, failure_kind
 
-DIST_EDGES_CM = (0.0, 100.0, 200.0, 300.0)
-ANGLE_EDGES_DEG = (0.0, 5.0, 10.0, 15.0)
-DIST_BINS = ("0–100", "100–200", "200–300", "≥300")
-ANGLE_BINS = ("0–5", "5–10", "10–15", "≥15")
+#: The protocol's offset bins (:mod:`tfloc.datasets.protocol`) as report bins, plus an open last bin.
+DIST_EDGES_CM = (*(100.0 * lo for lo, _ in DIST_BINS_M), 100.0 * DIST_BINS_M[-1][1])
+ANGLE_EDGES_DEG = (*(lo for lo, _ in ANGLE_BINS_DEG), ANGLE_BINS_DEG[-1][1])
+
+
+def _labels(edges: tuple[float, ...]) -> tuple[str, ...]:
+    return (*(f"{a:g}–{b:g}" for a, b in itertools.pairwise(edges)), f"≥{edges[-1]:g}")
+
+
+DIST_BINS = _labels(DIST_EDGES_CM)
+ANGLE_BINS = _labels(ANGLE_EDGES_DEG)
 UNSCORED = "unscored"  # failed under overridden thresholds but the run recorded no scores
 METRIC_COLUMNS = (
     "n", "n_truth", "n_est", "n_excluded", "n_timeout", "n_error",
