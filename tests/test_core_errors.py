@@ -91,7 +91,7 @@ def test_problem_validation(test_room, lms200):
         Problem(test_room, lms200, good[:-1], Pose(3, 3.5, 0))
     with pytest.raises(InvalidProblemError, match="negative range"):
         Problem(test_room, lms200, np.where(np.arange(181) == 5, -1.0, good), Pose(3, 3.5, 0))
-    with pytest.raises(InvalidProblemError, match="no beam has a return"):
+    with pytest.raises(InvalidProblemError, match="no return at all"):
         Problem(test_room, lms200, np.full(181, np.nan), Pose(3, 3.5, 0))
     with pytest.raises(InvalidProblemError, match="outside the map"):
         Problem(test_room, lms200, good, Pose(30, 3.5, 0))

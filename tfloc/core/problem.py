@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from tfloc.errors import InvalidProblemError
+from tfloc.errors import InvalidProblemError, TflocError
 
 from .laser import LaserSpec
 from .pose import Pose
@@ -16,25 +17,27 @@ if TYPE_CHECKING:
     from tfloc.maps.base import Map
 
 
-def check_ranges(ranges: Any, laser: LaserSpec, where: str = "scan") -> np.ndarray:
-    """Validate one scan's ranges (metres) against ``laser`` and return them as float array.
+def check_ranges(ranges: Any, laser: LaserSpec, where: str = "scan",
+                 error: type[TflocError] = InvalidProblemError) -> np.ndarray:
+    """Validate one scan's ranges (metres) against ``laser`` and return them as a float array.
 
-    ``inf``/``nan``/≥ max_range mean *no return* and are allowed; a wrong beam count, negative
-    ranges or a scan with no return at all are errors naming ``where``.
+    The one range rule of tfloc (scan files, bags and the Python API all come here):
+    ``inf``/``nan``/≥ max_range mean *no return* and are allowed; a wrong beam count, a negative
+    range or a scan with no return at all raise ``error`` naming ``where`` (e.g. ``file:line``).
     """
     try:
         r = np.asarray(ranges, dtype=float).reshape(-1)
     except (TypeError, ValueError) as exc:
-        raise InvalidProblemError(f"{where}: ranges are not numeric ({exc})") from None
+        raise error(f"{where}: ranges are not numeric ({exc})") from None
     if r.size != laser.n_beams:
-        raise InvalidProblemError(
-            f"{where}: {r.size} ranges, but the laser has {laser.n_beams} beams")
+        raise error(f"{where}: {r.size} ranges, expected {laser.n_beams} "
+                    f"(laser {math.degrees(laser.fov):g}°/{math.degrees(laser.resolution):g}°)")
     with np.errstate(invalid="ignore"):
         neg = np.flatnonzero(r < 0)
     if neg.size:
-        raise InvalidProblemError(f"{where}: negative range {r[neg[0]]:g} at beam {neg[0]}")
+        raise error(f"{where}: negative range {r[neg[0]]:g} at beam {neg[0]}")
     if not laser.valid(r).any():
-        raise InvalidProblemError(f"{where}: no beam has a return (all ranges are inf/nan/≥ max_range)")
+        raise error(f"{where}: scan has no return at all (every range inf/nan/≥ max_range)")
     return r
 
 

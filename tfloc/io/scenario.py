@@ -20,6 +20,7 @@ import numpy as np
 
 from tfloc.core.laser import LaserSpec
 from tfloc.core.pose import Pose
+from tfloc.core.problem import check_ranges
 from tfloc.errors import DatasetError
 
 COLUMNS = ["scan_id", "group", "true_x", "true_y", "true_theta", "init_x", "init_y", "init_theta",
@@ -102,23 +103,15 @@ def _pose(row: dict, prefix: str, path: Path, line: int, optional: bool) -> Pose
 
 
 def parse_ranges(text: str, laser: LaserSpec, path: Path, line: int) -> np.ndarray:
-    """Parse the ``ranges`` field strictly: count, numbers, no negatives, at least one return."""
+    """Parse the ``ranges`` field: space-separated numbers, then the one range rule
+    (:func:`tfloc.core.problem.check_ranges`); errors name ``path:line``."""
     parts = text.split()
-    if len(parts) != laser.n_beams:
-        raise DatasetError(f"{path}:{line}: {len(parts)} ranges, expected {laser.n_beams} "
-                           f"(laser {math.degrees(laser.fov):g}°/{math.degrees(laser.resolution):g}°)")
     try:
         r = np.array(parts, dtype=float)
     except ValueError:
         bad = next(p for p in parts if not _is_float(p))
         raise DatasetError(f"{path}:{line}: range {bad!r} is not a number") from None
-    with np.errstate(invalid="ignore"):
-        neg = np.flatnonzero(r < 0)
-    if neg.size:
-        raise DatasetError(f"{path}:{line}: negative range {r[neg[0]]:g} at beam {neg[0]}")
-    if not laser.valid(r).any():
-        raise DatasetError(f"{path}:{line}: scan has no return at all (every range inf/nan/≥ max_range)")
-    return r
+    return check_ranges(r, laser, f"{path}:{line}", DatasetError)
 
 
 def _is_float(s: str) -> bool:
