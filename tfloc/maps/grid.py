@@ -15,6 +15,7 @@ from tfloc.errors import MapFormatError
 
 from ._gridcast import raycast_grid
 from .base import as_pose_array
+from .fields import edt_metres
 
 
 @dataclass(frozen=True, eq=False)
@@ -80,7 +81,7 @@ class GridMap:
         (a large value if the map has no occupied cell)."""
         if not self.occupied.any():
             return np.full(self.shape, np.inf)
-        return ndimage.distance_transform_edt(~self.occupied, sampling=self.resolution)
+        return edt_metres(~self.occupied, self.resolution)
 
     @property
     def bounds(self) -> tuple[float, float, float, float]:

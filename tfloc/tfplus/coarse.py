@@ -39,7 +39,8 @@ def lattice(map_: Map, field: DistanceField, centre: np.ndarray, radius: float, 
 def grid_scores(field: DistanceField, points: np.ndarray, positions: np.ndarray,
                 headings: np.ndarray) -> np.ndarray:
     """Mean distance-field value ``(N, H)`` of ``points`` ``(M, 2)`` at every position × heading."""
-    return grid_scores_kernel(field.table, float(field.origin[0]), float(field.origin[1]),
+    cx, cy = field.corner
+    return grid_scores_kernel(field.distance, float(cx), float(cy),
                               field.resolution, np.ascontiguousarray(points, dtype=float),
                               np.ascontiguousarray(positions, dtype=float),
                               np.ascontiguousarray(headings, dtype=float))

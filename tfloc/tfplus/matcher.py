@@ -115,19 +115,9 @@ class TfPlusConfig:
     tf: TfConfig = TfConfig(spacing=0.05)
 
 
-_FIELDS: dict[int, tuple[Map, float, float, DistanceField]] = {}
-
-
 def _field(map_: Map, cfg: TfPlusConfig) -> DistanceField:
-    """The map's distance field, built once per map object and configuration."""
-    hit = _FIELDS.get(id(map_))
-    if hit is not None and hit[0] is map_ and hit[1:3] == (cfg.field_resolution, cfg.field_truncation):
-        return hit[3]
-    if len(_FIELDS) > 16:
-        _FIELDS.clear()
-    f = distance_field(map_, cfg.field_resolution, cfg.field_truncation)
-    _FIELDS[id(map_)] = (map_, cfg.field_resolution, cfg.field_truncation, f)
-    return f
+    """The map's distance field, truncated at ``field_truncation`` (built once per map)."""
+    return distance_field(map_, cfg.field_resolution, cfg.field_truncation)
 
 
 def heading_seeds(problem: Problem, cfg: TfPlusConfig) -> tuple[np.ndarray, dict]:
