@@ -8,6 +8,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from tfloc.core.pose import wrap_angle
+
 
 @dataclass(frozen=True)
 class Hypotheses:
@@ -52,7 +54,7 @@ def pair_hypotheses(a: np.ndarray, b: np.ndarray, length_tol: float, min_length:
     order = np.lexsort((pb, pa))  # the (a-pair, b-pair) order of the former all-pairs search
     pa, pb = pa[order], pb[order]
     theta = np.arctan2(vb[pb, 1], vb[pb, 0]) - np.arctan2(va[pa, 1], va[pa, 0])
-    theta = (theta + np.pi) % (2 * np.pi) - np.pi
+    theta = wrap_angle(theta)
     c, s = np.cos(theta), np.sin(theta)
     # Anchor on the pair midpoints: rotate a's midpoint and move it onto b's midpoint.
     ma = a[ia[pa]] + 0.5 * va[pa]

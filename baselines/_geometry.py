@@ -40,20 +40,3 @@ def embed_z0(points: np.ndarray) -> np.ndarray:
     """``(N, 2)`` planar points (or vectors) → ``(N, 3)`` with z = 0, float64, C-contiguous."""
     p = np.asarray(points, dtype=float).reshape(-1, 2)
     return np.ascontiguousarray(np.column_stack((p, np.zeros(len(p)))))
-
-
-def polyline_normals(points: np.ndarray) -> np.ndarray:
-    """Unit in-plane normals of an ordered ``(N, 2)`` point sequence (a scan), vectorised.
-
-    The tangent at each point is the central difference of its neighbours (one-sided at the ends);
-    the normal is the tangent turned by +90°. Degenerate tangents give a zero normal.
-    """
-    p = np.asarray(points, dtype=float).reshape(-1, 2)
-    if len(p) < 2:
-        return np.zeros_like(p)
-    tangent = np.gradient(p, axis=0)
-    norm = np.hypot(tangent[:, 0], tangent[:, 1])
-    ok = norm > 1e-12
-    normals = np.zeros_like(p)
-    normals[ok] = np.column_stack((-tangent[ok, 1], tangent[ok, 0])) / norm[ok, None]
-    return normals

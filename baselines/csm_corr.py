@@ -37,10 +37,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
+from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose, wrap_angle
 from tfloc.core.problem import Estimate, Problem
+from tfloc.errors import ParameterError
 
-from ._config import resolve_config
 from .likelihood import LikelihoodField, likelihood_field
 
 
@@ -76,10 +77,10 @@ class CorrelativeMatcher:
     name = "csm-corr"
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
-        self.config = resolve_config(Config, config, overrides)
+        self.config = resolve_params(Config, config, overrides)
         c = self.config
         if c.resolution <= 0 or c.sigma <= 0 or c.xy_step_cells < 1 or c.block < 1 or c.rot_step_deg <= 0:
-            raise TypeError(f"resolution, sigma, rot_step_deg must be > 0 and xy_step_cells, block ≥ 1: {c}")
+            raise ParameterError(f"resolution, sigma, rot_step_deg must be > 0 and xy_step_cells, block ≥ 1: {c}")
 
     def _field(self, problem: Problem) -> LikelihoodField:
         c = self.config

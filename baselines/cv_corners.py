@@ -57,11 +57,11 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose, angdiff, wrap_angle
 from tfloc.core.problem import Estimate, Problem
 from tfloc.paper.matcher import TfConfig, scan_corners
 
-from ._config import resolve_config
 from ._corner_match import best_hypothesis, mutual_inliers, pair_hypotheses
 from ._corner_refine import refine_corners
 
@@ -97,7 +97,7 @@ class CvCornersMatcher:
     name = "cv-corners"
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
-        self.config = resolve_config(Config, config, overrides)
+        self.config = resolve_params(Config, config, overrides)
         self._tf_config = TfConfig(spacing=self.config.corner_spacing)
 
     def _corners(self, ranges: np.ndarray, problem: Problem) -> np.ndarray:

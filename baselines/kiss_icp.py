@@ -45,11 +45,12 @@ import numpy as np
 from kiss_icp.mapping import VoxelHashMap
 from kiss_icp.registration import Registration
 
+from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
+from tfloc.errors import ParameterError
 from tfloc.maps.cache import cached, map_geometry
 
-from ._config import resolve_config
 from ._geometry import embed_z0, matrix_to_pose, pose_to_matrix
 
 
@@ -85,9 +86,9 @@ class KissIcpMatcher:
     name = "kiss-icp"
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
-        self.config = resolve_config(Config, config, overrides)
+        self.config = resolve_params(Config, config, overrides)
         if not self.config.voxel_sizes or min(self.config.voxel_sizes) <= 0:
-            raise TypeError(f"voxel_sizes must be positive metres, got {self.config.voxel_sizes}")
+            raise ParameterError(f"voxel_sizes must be positive metres, got {self.config.voxel_sizes}")
         self._registration = Registration(max_num_iterations=self.config.max_num_iterations,
                                           convergence_criterion=self.config.convergence_criterion,
                                           max_num_threads=self.config.max_num_threads)

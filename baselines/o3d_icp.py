@@ -35,11 +35,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
+from tfloc.errors import ParameterError
 from tfloc.maps.cache import map_geometry, point_to_line_residuals
 
-from ._config import resolve_config
 from ._geometry import embed_z0, matrix_to_pose, pose_to_matrix
 from ._open3d import import_open3d
 
@@ -66,9 +67,9 @@ class Open3dIcpMatcher:
     name = "o3d-icp"
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
-        self.config = resolve_config(Config, config, overrides)
+        self.config = resolve_params(Config, config, overrides)
         if not self.config.gates or min(self.config.gates) <= 0:
-            raise TypeError(f"gates must be positive metres, got {self.config.gates}")
+            raise ParameterError(f"gates must be positive metres, got {self.config.gates}")
 
     def localize(self, problem: Problem) -> Estimate:
         """Register the real scan to the map near ``problem.initial``."""

@@ -11,11 +11,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from tfloc.baselines._config import resolve_config
-from tfloc.baselines._geometry import matrix_to_pose, polyline_normals, pose_to_matrix
+from tfloc.baselines._geometry import matrix_to_pose, pose_to_matrix
 from tfloc.baselines.o3d_icp import Config as O3dConfig
 
 from tfloc import Pose
+from tfloc.core.params import resolve_params
+from tfloc.errors import ParameterError
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -66,17 +67,11 @@ def test_se2_round_trip_and_projection() -> None:
     assert abs(matrix_to_pose(t).theta - 2.9) < 1e-3
 
 
-def test_polyline_normals_are_unit_and_perpendicular() -> None:
-    pts = np.column_stack((np.linspace(0, 1, 11), np.full(11, 2.0)))
-    n = polyline_normals(pts)
-    assert np.allclose(n, [[0.0, 1.0]] * 11)
-
-
-def test_resolve_config_rejects_unknown_and_tuples_lists() -> None:
-    cfg = resolve_config(O3dConfig, None, {"gates": [0.5, 0.1]})
+def test_resolve_params_rejects_unknown_and_tuples_lists() -> None:
+    cfg = resolve_params(O3dConfig, None, {"gates": [0.5, 0.1]})
     assert cfg.gates == (0.5, 0.1)
-    with pytest.raises(TypeError, match="bogus"):
-        resolve_config(O3dConfig, None, {"bogus": 1})
+    with pytest.raises(ParameterError, match="bogus"):
+        resolve_params(O3dConfig, None, {"bogus": 1})
 
 
 class _ProtocolOnlyMap:

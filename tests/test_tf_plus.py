@@ -83,8 +83,10 @@ def test_config_overrides_and_bad_parameters():
     assert tfloc.get_matcher("tf-plus").name == "tf-plus"
     with pytest.raises(tfloc.MatcherError):
         tfloc.get_matcher("tf-plus", no_such_parameter=1)
-    with pytest.raises(ValueError):
+    with pytest.raises(tfloc.errors.ParameterError, match="select"):
         TurningFunctionPlusMatcher(select="nearest")
+    with pytest.raises(tfloc.errors.ParameterError, match="tf-plus.*select"):
+        tfloc.get_matcher("tf-plus", select="nearest")
 
 
 def test_ablation_switches_run(test_room, lms200):

@@ -31,6 +31,10 @@ class MatcherError(TflocError):
     """A matcher is unknown, misconfigured or its optional library is missing."""
 
 
+class ParameterError(MatcherError):
+    """A matcher parameter is unknown or has a bad value."""
+
+
 class ConfigError(TflocError):
     """A run configuration (TOML) or a command-line option is invalid."""
 

@@ -15,7 +15,7 @@ from functools import cache
 from importlib.metadata import entry_points
 from typing import Any, Protocol, runtime_checkable
 
-from tfloc.errors import MatcherError
+from tfloc.errors import MatcherError, ParameterError
 
 from .pose import Pose
 from .problem import Estimate, Problem
@@ -52,7 +52,8 @@ def available_matchers() -> list[str]:
 def get_matcher(name: str, **params: Any) -> Matcher:
     """Instantiate the registered matcher ``name`` with configuration overrides ``params``.
 
-    Raises :class:`MatcherError` for an unknown name, a missing optional library or a bad parameter.
+    Raises :class:`MatcherError` for an unknown name or a missing optional library, and its
+    subclass :class:`ParameterError` for an unknown parameter or a bad value.
     """
     reg = _registry()
     if name not in reg:
@@ -71,5 +72,7 @@ def get_matcher(name: str, **params: Any) -> Matcher:
             f"(install the project with its dependencies: pip install -e .)") from None
     try:
         return factory(**params)
-    except TypeError as exc:
-        raise MatcherError(f"matcher {name!r}: bad parameters {params}: {exc}") from None
+    except ParameterError as exc:
+        raise ParameterError(f"matcher {name!r}: {exc}") from None
+    except TypeError as exc:  # a third-party factory that rejects a keyword the Python way
+        raise ParameterError(f"matcher {name!r}: bad parameters {params}: {exc}") from None

@@ -38,11 +38,12 @@ Readings (the text is ambiguous or wrong; each choice is the one that works):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from tfloc.core.laser import LaserSpec
+from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose, wrap_angle
 from tfloc.core.problem import Estimate, Problem
 
@@ -201,7 +202,7 @@ class TurningFunctionMatcher:
     name = "tf"
 
     def __init__(self, config: TfConfig | None = None, **overrides) -> None:
-        self.config = replace(config or TfConfig(), **overrides)
+        self.config = resolve_params(TfConfig, config, overrides)
 
     def localize(self, problem: Problem) -> Estimate:
         cfg = self.config

@@ -26,6 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from tfloc.core.pose import wrap_angle
+
 TWO_PI = 2.0 * np.pi
 
 
@@ -265,5 +267,5 @@ def match(real: TurningFunction, virtual: TurningFunction) -> Match:
     the wrap); on each piece the difference is constant, so the integrals are exact sums.
     """
     err2, rot, k = _match(real.breaks, real.angles, virtual.breaks, virtual.angles)
-    rotation = (float(rot) + np.pi) % TWO_PI - np.pi
+    rotation = wrap_angle(float(rot))
     return Match(math.sqrt(max(err2, 0.0)), rotation, int(k))

@@ -35,12 +35,14 @@ never the true pose.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
+from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
+from tfloc.errors import ParameterError
 from tfloc.maps.base import Map
 from tfloc.maps.fields import DistanceField, distance_field
 from tfloc.paper.matcher import TfConfig, scan_turning_function
@@ -175,9 +177,9 @@ class TurningFunctionPlusMatcher:
     name = "tf-plus"
 
     def __init__(self, config: TfPlusConfig | None = None, **overrides) -> None:
-        self.config = replace(config or TfPlusConfig(), **overrides)
+        self.config = resolve_params(TfPlusConfig, config, overrides)
         if self.config.select not in ("residual", "tf"):
-            raise ValueError(f"select must be 'residual' or 'tf', not {self.config.select!r}")
+            raise ParameterError(f"select must be 'residual' or 'tf', not {self.config.select!r}")
 
     def localize(self, problem: Problem) -> Estimate:
         cfg = self.config
