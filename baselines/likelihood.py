@@ -70,7 +70,7 @@ class LikelihoodField:
 
 
 def likelihood_field(map_: object, resolution: float, sigma: float, pad: float) -> LikelihoodField:
-    """The likelihood field of ``map_`` (any :class:`~tfloc.maps.base.Map`), built once per map and
+    """The likelihood field of ``map_`` (any :class:`~tfloc.core.map.Map`), built once per map and
     parameters: cells of ``resolution`` metres reaching ``pad`` metres beyond the capped band."""
     def build() -> LikelihoodField:
         f = distance_field(map_, resolution, max(_CAP_M, 10.0 * sigma), pad)

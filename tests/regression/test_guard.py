@@ -1,7 +1,7 @@
 """The accuracy regression guard: rerun the fixed-seed subset and compare with the reference.
 
 Fails with a readable table of every metric that got worse than its tolerance allows (see
-tfloc/harness/guard.py for the tolerances and why). Update the reference deliberately with
+tfloc/evaluation/guard.py for the tolerances and why). Update the reference deliberately with
 `tfloc guard --update`.
 """
 
@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from tfloc.cli.guard import run_subset
 from tfloc.evaluation import guard
 from tfloc.harness.config import load_config
 
@@ -37,7 +38,7 @@ def test_reference_covers_every_guarded_matcher(config, reference):
 
 
 def test_no_accuracy_regression(config, reference):
-    current = guard.run_subset(config, progress=False)
+    current = run_subset(config, progress=False)
     diff = guard.compare(current, reference)
     assert len(diff) == len(reference) * len(guard.RULES)
     assert not diff.worse.any(), "accuracy regression:\n" + guard.format_table(diff)

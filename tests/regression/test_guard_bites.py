@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from tfloc.cli.guard import run_subset
 from tfloc.evaluation import guard
 from tfloc.harness.config import MatcherSpec, load_config
 
@@ -20,7 +21,7 @@ def test_degraded_tf_is_caught(tmp_path):
     broken = MatcherSpec.make("tf", {"straw_t": 0.0}, label="tf")
     cfg = load_config(ROOT / guard.CONFIG).with_overrides(
         out=tmp_path / "run", matchers=(broken,), limit_per_group=3)
-    current = guard.run_subset(cfg, progress=False)
+    current = run_subset(cfg, progress=False)
     diff = guard.compare(current, guard.read_reference(ROOT / guard.REFERENCE))
     worse = diff[diff.worse]
     assert len(worse), "the guard did not notice a tf that finds no corners"

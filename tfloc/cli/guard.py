@@ -2,7 +2,7 @@
 its metrics with the committed reference (results/reference/summary.csv).
 
 Exits 1 and prints a table of every metric that got worse than its tolerance allows
-(tolerances and their justification: tfloc/harness/guard.py). With --update, rewrites the
+(tolerances and their justification: tfloc/evaluation/guard.py). With --update, rewrites the
 reference deliberately and prints what changed.
 
 Examples:
@@ -13,10 +13,17 @@ Examples:
 from __future__ import annotations
 
 import argparse
+import shutil
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from tfloc.errors import ConfigError
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from tfloc.harness.config import RunConfig
 
 HELP = "accuracy regression guard: rerun a fixed subset and compare with the reference"
 
@@ -43,7 +50,7 @@ def run(args: argparse.Namespace) -> int:
     if args.matchers:
         cfg = cfg.with_overrides(matchers=parse_matchers(args.matchers.split(","), {}, "--matchers"))
     cfg = cfg.with_overrides(jobs=args.jobs)
-    current = guard.run_subset(cfg, fresh=not args.resume)
+    current = run_subset(cfg, fresh=not args.resume)
     if args.update:
         old = guard.read_reference(args.reference) if args.reference.exists() else current.iloc[:0]
         if args.matchers and args.reference.exists():  # keep the other matchers' reference rows
@@ -62,3 +69,15 @@ def run(args: argparse.Namespace) -> int:
         return 1
     print(f"\nall {len(diff)} guarded metrics within tolerance", file=sys.stderr)
     return 0
+
+
+def run_subset(config: RunConfig, fresh: bool = True, progress: bool | None = None) -> pd.DataFrame:
+    """Run the guard's subset (from scratch unless ``fresh`` is False) and summarise it."""
+    from tfloc.evaluation.guard import guard_summary
+    from tfloc.harness.runner import run as run_benchmark
+    from tfloc.io.estimates import read_estimates
+
+    if fresh and Path(config.out).exists():
+        shutil.rmtree(config.out)
+    out = run_benchmark(config, progress=progress)
+    return guard_summary(read_estimates(out), config.success)

@@ -14,7 +14,7 @@ from .laser import LaserSpec
 from .pose import Pose
 
 if TYPE_CHECKING:
-    from tfloc.maps.base import Map
+    from tfloc.core.map import Map
 
 
 def check_ranges(ranges: Any, laser: LaserSpec, where: str = "scan",
@@ -46,7 +46,7 @@ class Problem:
     """Given a map, a laser spec, one real scan (RSD) and an initial pose guess (VP): where is the robot?
 
     Attributes:
-        map: the known map (:class:`~tfloc.maps.base.Map`).
+        map: the known map (:class:`~tfloc.core.map.Map`).
         laser: the scanner that took ``ranges``.
         ranges: the real scan, metres, shape ``(laser.n_beams,)``; inf/nan/≥ max_range = no return.
         initial: the initial pose guess (VP), metres/radians, world frame.

@@ -18,9 +18,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tfloc.core.map import Map
 from tfloc.core.pose import Pose, wrap_angle
 from tfloc.errors import DatasetError
-from tfloc.maps.base import Map
 
 DIST_BINS_M = ((0.0, 1.0), (1.0, 2.0), (2.0, 3.0))
 ANGLE_BINS_DEG = ((0.0, 5.0), (5.0, 10.0), (10.0, 15.0))

@@ -16,16 +16,11 @@ elsewhere); they are far below any change worth making to a matcher.
 
 from __future__ import annotations
 
-import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
-
-from tfloc.harness.config import RunConfig
-from tfloc.harness.runner import run as run_benchmark
-from tfloc.io.estimates import read_estimates
 
 from .metrics import summarize
 from .outcome import Thresholds
@@ -119,14 +114,6 @@ def format_changes(old: pd.DataFrame, new: pd.DataFrame) -> str:
             if not (np.isclose(a, b, equal_nan=True)):
                 lines.append(f"{r.matcher:12s} {r.group:6s} {k:18s} {a:10.3f} -> {b:10.3f}")
     return "\n".join(lines) if lines else "no change"
-
-
-def run_subset(config: RunConfig, fresh: bool = True, progress: bool | None = None) -> pd.DataFrame:
-    """Run the guard's subset (from scratch unless ``fresh`` is False) and summarise it."""
-    if fresh and Path(config.out).exists():
-        shutil.rmtree(config.out)
-    out = run_benchmark(config, progress=progress)
-    return guard_summary(read_estimates(out), config.success)
 
 
 def read_reference(path: Path = REFERENCE) -> pd.DataFrame:

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from tfloc.core.map import Map
 from tfloc.errors import MapFormatError
-from tfloc.maps.base import Map
 
 
 def load_map(path: str | Path) -> Map:

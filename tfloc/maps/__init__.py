@@ -1,6 +1,6 @@
 """Maps: the :class:`Map` protocol, :class:`VectorMap` (segments) and :class:`GridMap` (occupancy grid)."""
 
-from tfloc.maps.base import Map
+from tfloc.core.map import Map
 from tfloc.maps.grid import GridMap
 from tfloc.maps.vector import VectorMap
 

@@ -19,7 +19,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.ndimage import distance_transform_edt, map_coordinates
 
-from .base import Map
+from tfloc.core.map import Map
+
 from .cache import cached
 
 

@@ -10,11 +10,11 @@ import numpy as np
 from scipy import ndimage
 
 from tfloc.core.laser import LaserSpec
+from tfloc.core.map import as_pose_array
 from tfloc.core.pose import Pose
 from tfloc.errors import MapFormatError
 
 from ._gridcast import raycast_grid
-from .base import as_pose_array
 from .fields import edt_metres
 
 

@@ -10,10 +10,10 @@ import shapely
 from shapely.geometry.base import BaseGeometry
 
 from tfloc.core.laser import LaserSpec
+from tfloc.core.map import as_pose_array
 from tfloc.core.pose import Pose
 
 from ._raycast import raycast_segments
-from .base import as_pose_array
 
 
 def _segments_of(geom: BaseGeometry) -> np.ndarray:

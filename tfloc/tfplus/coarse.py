@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tfloc.maps.base import Map
+from tfloc.core.map import Map
 from tfloc.maps.fields import DistanceField
 
 from .kernels import grid_scores_kernel

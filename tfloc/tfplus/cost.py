@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from tfloc.core.laser import LaserSpec
-from tfloc.maps.base import Map
+from tfloc.core.map import Map
 
 from .refine import residuals_to
 

@@ -28,7 +28,7 @@ needs ~1800 cost evaluations per scan). Stages:
 
 Each stage can be switched off (``tf_seed``, ``heading_sweep``, ``grid``, ``refine``,
 ``beam_check``, ``tie_tolerance=0``) for the ablation in
-``benchmarks/tfplus_ablation.py``. It uses only the :class:`~tfloc.maps.base.Map` protocol and
+``benchmarks/tfplus_ablation.py``. It uses only the :class:`~tfloc.core.map.Map` protocol and
 never the true pose.
 """
 
@@ -39,11 +39,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tfloc.core.map import Map
 from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
 from tfloc.errors import ParameterError
-from tfloc.maps.base import Map
 from tfloc.maps.fields import DistanceField, distance_field
 from tfloc.paper.matcher import TfConfig, scan_turning_function
 from tfloc.paper.turning import match

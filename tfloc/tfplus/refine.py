@@ -20,8 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from tfloc.core.laser import LaserSpec
+from tfloc.core.map import Map
 from tfloc.core.pose import wrap_angle
-from tfloc.maps.base import Map
 
 from .kernels import pairs_kernel
 

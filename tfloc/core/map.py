@@ -6,8 +6,8 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from tfloc.core.laser import LaserSpec
-from tfloc.core.pose import Pose
+from .laser import LaserSpec
+from .pose import Pose
 
 
 def as_pose_array(poses: Pose | np.ndarray | list) -> tuple[np.ndarray, bool]:
