@@ -20,7 +20,8 @@ why (the strongest honest setup we found for this method):
 * Per stage, ``max_correspondance_distance`` = ``gate_factor`` × voxel (3, i.e. no cut beyond
   what the neighbour-voxel search already reaches) and the Geman–McClure ``kernel`` =
   ``kernel_factor`` × voxel (1).
-  On the quick test-room check (``benchmarks/baselines_quick.py``, 90 problems, 0–3 m / 0–15°):
+  On the quick test-room check (90 problems, 0–3 m / 0–15°; a script of the first session, since replaced by
+  the harness's run configurations):
   voxels 1.0 → 0.3 → 0.1 with kernel voxel/3 succeeded on 56 %, with kernel = voxel on 66 %,
   with kernel voxel/10 on 50 %; a 2 m first voxel with kernel = voxel on 69 %, a 3 m one on 71 %
   (one or two problems more: noise at this size, so the 2 m stage that matches ``o3d-icp``'s

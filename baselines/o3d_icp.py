@@ -14,7 +14,8 @@ Configuration choices and why (the strongest honest setup we found for this meth
 * **Coarse-to-fine correspondence gates** ``gates`` = 2.0 → 1.0 → 0.5 → 0.2 → 0.1 m. One small
   gate finds no partners at large offsets and stalls; one large gate pairs points with the wrong
   wall near convergence. Each stage starts from the previous stage's result. On the quick
-  test-room check (``benchmarks/baselines_quick.py``, 90 problems, 0–3 m / 0–15°) the schedule
+  test-room check (90 problems, 0–3 m / 0–15°; a script of the first session, since replaced by
+  the harness's run configurations) the schedule
   1.0 → … → 0.1 m succeeded on 54 %, adding a 2 m first stage on 76 %; a 3 m or 1.5 m first
   stage and 60 instead of 30 iterations per stage gained nothing (76 %, 66 %, 76 %).
 * **Projected onto SE(2) after every stage** (z, roll, pitch are unconstrained by in-plane

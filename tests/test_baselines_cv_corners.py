@@ -1,38 +1,14 @@
-"""Baseline ``cv-corners``: recovers a known 0.3 m / 5° offset; its score prefers the truth."""
+"""Baseline ``cv-corners``: too few corners is a no-answer; its hypotheses and corner refinement."""
 
 from __future__ import annotations
 
 import numpy as np
-import pytest
-from _baseline_cases import OFFSETS, errors, make_problem
+from _baseline_cases import make_problem
 from tfloc.baselines._corner_match import best_hypothesis, pair_hypotheses
 from tfloc.baselines._corner_refine import refine_corners
 from tfloc.baselines.cv_corners import CvCornersMatcher
 
-import tfloc
 from tfloc import Problem
-
-
-@pytest.mark.parametrize(("direction", "sign"), OFFSETS)
-def test_recovers_known_offset(direction: float, sign: float) -> None:
-    problem, true = make_problem(direction, sign)
-    est = tfloc.get_matcher("cv-corners").localize(problem)
-    dist, orient = errors(est.pose, true)
-    assert dist <= 0.02 and orient <= 0.5, (est, dist, orient)
-    assert est.converged
-
-
-def test_score_prefers_truth() -> None:
-    problem, true = make_problem()
-    matcher = CvCornersMatcher()
-    assert matcher.score(problem, true) < matcher.score(problem, problem.initial)
-
-
-def test_registered_name_and_overrides() -> None:
-    matcher = tfloc.get_matcher("cv-corners")
-    assert isinstance(matcher, CvCornersMatcher) and matcher.name == "cv-corners"
-    with pytest.raises(tfloc.MatcherError, match="no_such_option"):
-        tfloc.get_matcher("cv-corners", no_such_option=1)
 
 
 def test_fewer_than_two_corners_is_a_no_answer() -> None:

@@ -116,7 +116,7 @@ def test_truncated_param_and_garbage_lines(tmp_path: Path) -> None:
 def test_truncated_gzip_file(tmp_path: Path) -> None:
     p = tmp_path / "cut.clf.gz"
     p.write_bytes(gzip.compress(CSAIL_HEAD.read_bytes())[:-40])
-    with pytest.raises(LogFormatError, match="cannot read log"):
+    with pytest.raises(LogFormatError, match="cut.clf.gz: damaged gzip data"):
         read_carmen(p)
 
 

@@ -35,6 +35,7 @@ from typing import Any
 
 from tfloc.errors import ConfigError
 from tfloc.evaluation.outcome import Thresholds
+from tfloc.io.text import parse_text
 
 
 @dataclass(frozen=True)
@@ -141,12 +142,7 @@ def expand_sweeps(sweeps: Any, defaults: dict[str, dict], where: str) -> tuple[M
 def load_config(path: str | Path) -> RunConfig:
     """Read a run configuration TOML file; errors name the file and the key."""
     path = Path(path)
-    try:
-        doc = tomllib.loads(path.read_text())
-    except FileNotFoundError:
-        raise ConfigError(f"{path}: no such run configuration") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: not valid TOML ({exc})") from None
+    doc = parse_text(path, ConfigError, "run configuration", tomllib.loads, tomllib.TOMLDecodeError, "TOML")
     known = {"name", "out", "datasets", "matchers", "jobs", "timeout_s", "limit_per_group",
              "success", "params", "description", "sweep"}
     unknown = sorted(set(doc) - known)

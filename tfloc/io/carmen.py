@@ -17,7 +17,6 @@ Layouts (CARMEN 0.7 logger)::
 
 from __future__ import annotations
 
-import gzip
 import math
 import re
 from collections import Counter
@@ -28,6 +27,8 @@ import numpy as np
 
 from tfloc.core.pose import Pose
 from tfloc.errors import LogFormatError
+
+from .text import read_text
 
 _MSG = re.compile(r"^[A-Z][A-Z0-9_]*$")
 
@@ -199,45 +200,34 @@ def _odom(c: _Line) -> OdomRecord:
     return OdomRecord(pose, tv, rv, acc, t, lt, host, c.lineno)
 
 
-def _open_text(path: Path):
-    with path.open("rb") as fh:
-        gz = fh.read(2) == b"\x1f\x8b"
-    return gzip.open(path, "rt", encoding="latin-1") if gz else path.open(encoding="latin-1")
-
-
 def read_carmen(path: str | Path) -> CarmenLog:
     """Read a CARMEN log (plain or gzip, detected by content). Errors name ``file:line``."""
     path = Path(path)
-    if not path.is_file():
-        raise LogFormatError(f"{path}: no such log file")
+    lines = read_text(path, LogFormatError, "log file", latin1=True).splitlines()
     lasers: list[LaserRecord] = []
     odom: list[OdomRecord] = []
     params: dict[str, str] = {}
     skipped: Counter[str] = Counter()
-    try:
-        with _open_text(path) as fh:
-            for lineno, text in enumerate(fh, start=1):
-                tok = text.split()
-                if not tok or tok[0].startswith("#"):
-                    continue
-                kind = tok[0]
-                if not _MSG.match(kind):
-                    raise LogFormatError(f"{path}:{lineno}: not a CARMEN message: starts with {kind[:20]!r}")
-                c = _Line(path, lineno, tok)
-                if kind in ("FLASER", "RLASER"):
-                    lasers.append(_flaser(c))
-                elif kind == "ROBOTLASER1":
-                    lasers.append(_robotlaser1(c))
-                elif kind == "ODOM":
-                    odom.append(_odom(c))
-                elif kind == "PARAM":
-                    if len(tok) < 3:
-                        raise c.fail("line is truncated: needs a name and a value")
-                    params[tok[1]] = tok[2]
-                else:
-                    skipped[kind] += 1
-    except (OSError, EOFError, gzip.BadGzipFile) as exc:
-        raise LogFormatError(f"{path}: cannot read log ({exc})") from None
+    for lineno, text in enumerate(lines, start=1):
+        tok = text.split()
+        if not tok or tok[0].startswith("#"):
+            continue
+        kind = tok[0]
+        if not _MSG.match(kind):
+            raise LogFormatError(f"{path}:{lineno}: not a CARMEN message: starts with {kind[:20]!r}")
+        c = _Line(path, lineno, tok)
+        if kind in ("FLASER", "RLASER"):
+            lasers.append(_flaser(c))
+        elif kind == "ROBOTLASER1":
+            lasers.append(_robotlaser1(c))
+        elif kind == "ODOM":
+            odom.append(_odom(c))
+        elif kind == "PARAM":
+            if len(tok) < 3:
+                raise c.fail("line is truncated: needs a name and a value")
+            params[tok[1]] = tok[2]
+        else:
+            skipped[kind] += 1
     if not lasers:
         raise LogFormatError(f"{path}: no laser scans (FLASER/RLASER/ROBOTLASER1) in the log")
     return CarmenLog(path, tuple(lasers), tuple(odom), params, dict(skipped))

@@ -16,18 +16,15 @@ from shapely.geometry import mapping, shape
 from tfloc.errors import MapFormatError
 from tfloc.maps.vector import VectorMap
 
+from .text import parse_text
+
 _ROLES = {"wall", "obstacle", "outline"}
 
 
 def read_vector_map(path: str | Path) -> VectorMap:
     """Read a GeoJSON FeatureCollection into a VectorMap; errors name the file and feature."""
     path = Path(path)
-    try:
-        doc = json.loads(path.read_text())
-    except FileNotFoundError:
-        raise MapFormatError(f"{path}: no such map file") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise MapFormatError(f"{path}: not valid JSON ({exc})") from None
+    doc = parse_text(path, MapFormatError, "map file", json.loads, json.JSONDecodeError, "JSON")
     if not isinstance(doc, dict) or doc.get("type") != "FeatureCollection":
         raise MapFormatError(f"{path}: expected a GeoJSON FeatureCollection at the top level")
     feats = doc.get("features")

@@ -18,6 +18,7 @@ from tfloc.core.pose import Pose
 from tfloc.errors import LogFormatError
 
 from .carmen import LaserRecord
+from .text import read_text
 
 _FIELDS = ("t1", "t2", "dx", "dy", "dz", "droll", "dpitch", "dyaw")
 
@@ -35,10 +36,9 @@ class Relation:
 def read_relations(path: str | Path) -> tuple[Relation, ...]:
     """Read a relations file; ``#`` comments and blank lines are skipped."""
     path = Path(path)
-    if not path.is_file():
-        raise LogFormatError(f"{path}: no such relations file")
     out: list[Relation] = []
-    for lineno, text in enumerate(path.read_text(encoding="latin-1").splitlines(), start=1):
+    text_ = read_text(path, LogFormatError, "relations file", latin1=True)
+    for lineno, text in enumerate(text_.splitlines(), start=1):
         tok = text.split()
         if not tok or tok[0].startswith("#"):
             continue

@@ -19,6 +19,8 @@ from PIL import Image, UnidentifiedImageError
 from tfloc.errors import MapFormatError
 from tfloc.maps.grid import GridMap
 
+from .text import parse_text
+
 
 def _num(doc: dict, key: str, path: Path, default: float | None = None) -> float:
     if key not in doc:
@@ -34,12 +36,7 @@ def _num(doc: dict, key: str, path: Path, default: float | None = None) -> float
 def read_ros_map(yaml_path: str | Path) -> GridMap:
     """Read a map_server YAML and its image into a GridMap (unknown pixels become NaN)."""
     path = Path(yaml_path)
-    try:
-        doc = yaml.safe_load(path.read_text())
-    except FileNotFoundError:
-        raise MapFormatError(f"{path}: no such map file") from None
-    except (yaml.YAMLError, UnicodeDecodeError) as exc:
-        raise MapFormatError(f"{path}: not valid YAML ({str(exc).splitlines()[0]})") from None
+    doc = parse_text(path, MapFormatError, "map file", yaml.safe_load, yaml.YAMLError, "YAML")
     if not isinstance(doc, dict):
         raise MapFormatError(f"{path}: expected a mapping of map_server keys")
     if not isinstance(doc.get("image"), str):

@@ -23,6 +23,8 @@ from tfloc.core.pose import Pose
 from tfloc.core.problem import check_ranges
 from tfloc.errors import DatasetError
 
+from .text import csv_rows, parse_text
+
 COLUMNS = ["scan_id", "group", "true_x", "true_y", "true_theta", "init_x", "init_y", "init_theta",
            "ranges"]
 
@@ -63,10 +65,9 @@ def read_scenario(root: str | Path) -> Scenario:
     path = root / "scenario.json"
     if not path.is_file():
         raise DatasetError(f"{root}: not a scenario dataset (no scenario.json)")
-    try:
-        doc = json.loads(path.read_text())
-    except json.JSONDecodeError as exc:
-        raise DatasetError(f"{path}: not valid JSON ({exc})") from None
+    doc = parse_text(path, DatasetError, "scenario.json", json.loads, json.JSONDecodeError, "JSON")
+    if not isinstance(doc, dict):
+        raise DatasetError(f"{path}: expected a JSON object of scenario fields")
     for key in ("name", "map", "laser"):
         if key not in doc:
             raise DatasetError(f"{path}: missing field {key!r}")
@@ -127,30 +128,25 @@ def iter_scans(scenario: Scenario) -> Iterator[Scan]:
     path = scenario.scans_path
     if not path.is_file():
         raise DatasetError(f"{scenario.root}: missing scans.csv")
-    with path.open(newline="") as fh:
-        reader = csv.DictReader(fh)
-        missing = [c for c in COLUMNS if c not in (reader.fieldnames or [])]
-        if missing:
-            raise DatasetError(f"{path}:1: header lacks column(s) {', '.join(missing)}")
-        seen: set[str] = set()
-        for row in reader:
-            line = reader.line_num
-            if None in row or any(row[c] is None for c in COLUMNS):
-                raise DatasetError(f"{path}:{line}: wrong number of fields (expected {len(COLUMNS)})")
-            sid = row["scan_id"].strip()
-            if not sid:
-                raise DatasetError(f"{path}:{line}: empty scan_id")
-            if sid in seen:
-                raise DatasetError(f"{path}:{line}: duplicate scan_id {sid!r}")
-            seen.add(sid)
-            ref = row.get("ref_ranges")
-            stamp = (row.get("stamp") or "").strip()
-            yield Scan(sid, row["group"].strip(),
-                       parse_ranges(row["ranges"], scenario.laser, path, line),
-                       _pose(row, "init", path, line, optional=False),
-                       _pose(row, "true", path, line, optional=True), line,
-                       parse_ranges(ref, scenario.laser, path, line) if ref else None,
-                       _stamp(stamp, path, line) if stamp else None)
+    _, rows = csv_rows(path, DatasetError, "scans.csv file", COLUMNS)
+    seen: set[str] = set()
+    for line, row in rows:
+        if None in row or any(row[c] is None for c in COLUMNS):
+            raise DatasetError(f"{path}:{line}: wrong number of fields (expected {len(COLUMNS)})")
+        sid = row["scan_id"].strip()
+        if not sid:
+            raise DatasetError(f"{path}:{line}: empty scan_id")
+        if sid in seen:
+            raise DatasetError(f"{path}:{line}: duplicate scan_id {sid!r}")
+        seen.add(sid)
+        ref = row.get("ref_ranges")
+        stamp = (row.get("stamp") or "").strip()
+        yield Scan(sid, row["group"].strip(),
+                   parse_ranges(row["ranges"], scenario.laser, path, line),
+                   _pose(row, "init", path, line, optional=False),
+                   _pose(row, "true", path, line, optional=True), line,
+                   parse_ranges(ref, scenario.laser, path, line) if ref else None,
+                   _stamp(stamp, path, line) if stamp else None)
 
 
 def _stamp(text: str, path: Path, line: int) -> float:

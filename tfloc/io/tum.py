@@ -13,6 +13,8 @@ import numpy as np
 
 from tfloc.errors import LogFormatError
 
+from .text import read_text
+
 HEADER = "# timestamp x y z qx qy qz qw"
 
 
@@ -36,10 +38,7 @@ def read_tum(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     Blank lines and ``#`` comments are skipped; every other line needs eight numbers and a
     non-zero quaternion."""
     path = Path(path)
-    try:
-        text = path.read_text()
-    except (FileNotFoundError, UnicodeDecodeError) as exc:
-        raise LogFormatError(f"{path}: cannot read TUM file ({exc.__class__.__name__})") from None
+    text = read_text(path, LogFormatError, "TUM trajectory file")
     stamps, poses = [], []
     for n, raw in enumerate(text.splitlines(), start=1):
         line = raw.split("#", 1)[0].strip()

@@ -9,7 +9,6 @@ appearance in ``estimates.csv``. Rows without a finite pose are left out and cou
 
 from __future__ import annotations
 
-import csv
 import json
 import math
 from dataclasses import dataclass
@@ -18,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from tfloc.errors import DatasetError
+from tfloc.io.text import csv_rows
 from tfloc.io.tum import write_tum
 
 NEEDED = ("dataset", "scan_id", "matcher", "true_x", "true_y", "true_theta", "init_x", "init_y",
@@ -40,14 +40,8 @@ class Exported:
 def _read_rows(path: Path) -> list[dict]:
     """The rows of an ``estimates.csv`` as strings (export needs no DataFrame; see
     :func:`tfloc.io.estimates.read_estimates` for that), checking the needed columns exist."""
-    if not path.is_file():
-        raise DatasetError(f"{path}: no such results file (is the run directory right?)")
-    with path.open(newline="") as fh:
-        reader = csv.DictReader(fh)
-        missing = [c for c in NEEDED if c not in (reader.fieldnames or [])]
-        if missing:
-            raise DatasetError(f"{path}:1: header lacks column(s) {', '.join(missing)}")
-        return list(reader)
+    _, rows = csv_rows(path, DatasetError, "results file (is the run directory right?)", NEEDED)
+    return [row for _, row in rows]
 
 
 def _dataset_dirs(run_dir: Path) -> list[Path]:
@@ -91,17 +85,15 @@ def find_dataset(name: str, run_dir: Path, root: Path | None) -> Path | None:
 def scan_stamps(dataset_dir: Path) -> tuple[dict[str, float], str]:
     """``scan_id → time (s)`` from ``scans.csv``: its ``stamp`` column, else the row index."""
     path = dataset_dir / "scans.csv"
-    csv.field_size_limit(1 << 30)
-    with path.open(newline="") as fh:
-        reader = csv.DictReader(fh)
-        has = "stamp" in (reader.fieldnames or [])
-        out: dict[str, float] = {}
-        for k, row in enumerate(reader):
-            s = (row.get("stamp") or "").strip() if has else ""
-            try:
-                out[row["scan_id"].strip()] = float(s) if s else float(k)
-            except ValueError:
-                raise DatasetError(f"{path}:{reader.line_num}: stamp {s!r} is not a number") from None
+    header, rows = csv_rows(path, DatasetError, "scans.csv file", ["scan_id"])
+    has = "stamp" in header
+    out: dict[str, float] = {}
+    for k, (line, row) in enumerate(rows):
+        s = (row.get("stamp") or "").strip() if has else ""
+        try:
+            out[row["scan_id"].strip()] = float(s) if s else float(k)
+        except ValueError:
+            raise DatasetError(f"{path}:{line}: stamp {s!r} is not a number") from None
     return out, "stamp" if has else "index"
 
 
