@@ -1,1 +1,3 @@
-"""Readers and writers at the edges: GeoJSON maps, scenario datasets (CARMEN logs, ROS maps later)."""
+"""File formats at the edges: maps (``geojson``, ``rosmap``, ``maps.load_map``), scenario datasets
+(``scenario``), results (``estimates``), CARMEN logs and relations, ROS bags, TUM trajectories; all
+text read through ``text``."""
