@@ -44,6 +44,10 @@ Configuration choices and why:
   ``info["status"] = "no-answer"`` (never an exception). A later step that fails keeps the last
   good estimate.
 
+**Amortised per map**: nothing of its own; the map's ray-casting structures are built with the
+map (and by the harness's untimed warm-up). **Per scan**: every step's virtual scan, both corner
+sets and the hypotheses (they depend on the pose).
+
 ``score(problem, pose)`` is its own objective at ``pose``: minus the number of one-to-one corner
 inliers between the real scan and the virtual scan at ``pose`` (identity transform), plus their
 mean distance divided by ``inlier_tol`` (a tie-breaker in [0, 1]).

@@ -12,7 +12,7 @@ import pandas as pd
 COLUMNS = ["dataset", "scan_id", "group", "matcher",
            "true_x", "true_y", "true_theta", "init_x", "init_y", "init_theta",
            "est_x", "est_y", "est_theta", "dist_err_m", "orient_err_rad",
-           "init_dist_err_m", "init_orient_err_rad", "runtime_s", "converged", "iterations",
+           "init_dist_err_m", "init_orient_err_rad", "runtime_s", "cpu_s", "converged", "iterations",
            "evaluations", "status", "outcome", "score_est", "score_true", "info"]
 KEY = ("dataset", "scan_id", "matcher")
 
@@ -43,8 +43,9 @@ class ResultWriter:
         self.path = Path(path)
         repair(self.path)
         new = not self.path.exists() or self.path.stat().st_size == 0
+        header = COLUMNS if new else _header(self.path)  # resuming an older run keeps its columns
         self._fh = self.path.open("a", newline="")
-        self._w = csv.DictWriter(self._fh, fieldnames=COLUMNS, extrasaction="ignore")
+        self._w = csv.DictWriter(self._fh, fieldnames=header, extrasaction="ignore")
         if new:
             self._w.writeheader()
             self._sync()
@@ -65,6 +66,11 @@ class ResultWriter:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+def _header(path: Path) -> list[str]:
+    with path.open(newline="") as fh:
+        return next(csv.reader(fh))
 
 
 def _fmt(v: Any) -> Any:
