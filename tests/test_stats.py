@@ -81,3 +81,15 @@ def test_bootstrap_median_draws_the_same_distribution_as_resampling(n):
         # quantiles of a discrete distribution: equal or one order statistic apart
         assert np.searchsorted(v, lo) == pytest.approx(np.searchsorted(v, b_lo), abs=1)
         assert np.searchsorted(v, hi) == pytest.approx(np.searchsorted(v, b_hi), abs=1)
+
+
+def test_ratio_of_medians_is_paired_and_brackets_the_ratio():
+    from tfloc.evaluation.stats import ratio_of_medians
+
+    rng = np.random.default_rng(3)
+    b = rng.lognormal(2.0, 0.8, 200)
+    a = 3.0 * b  # exactly 3 × on every item: the paired interval collapses to 3
+    assert ratio_of_medians(a, b) == pytest.approx((3.0, 3.0, 3.0))
+    c = rng.lognormal(2.0, 0.8, 200)
+    r, lo, hi = ratio_of_medians(c, b)
+    assert lo < r < hi and lo > 0.5 and hi < 2.0

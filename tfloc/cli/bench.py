@@ -6,8 +6,12 @@ same command after an interruption (Ctrl-C, kill -9) resumes: finished (scan, ma
 are skipped, nothing is repeated or lost. Each task has a time limit; a matcher that raises or
 hangs gets an `error:`/`timeout` row and the run goes on.
 
+--quick runs a small stratified subset (the first 3 scans of every group of every dataset) into
+RUN-quick: a full report with figures in a few minutes (make quick).
+
 Examples:
   tfloc bench benchmarks/paper-protocol.toml
+  tfloc bench benchmarks/paper-protocol.toml --quick        # → results/paper-protocol-quick
   tfloc bench data/scenarios/detail-1 --matchers tf,csm-corr --out results/try --jobs 2
   tfloc bench benchmarks/paper-protocol.toml --scheduler tcp://HOST:8786   # on a Dask cluster
   tfloc bench benchmarks/paper-protocol.toml --scheduler local:2           # a local Dask cluster
@@ -25,6 +29,7 @@ from tfloc.evaluation.outcome import Thresholds
 from tfloc.harness.config import RunConfig, load_config, parse_matchers
 
 HELP = "run matchers over scenario datasets (resumable), writing RUN/estimates.csv"
+QUICK_PER_GROUP = 3
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -44,6 +49,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="run the tasks on a Dask cluster: a running scheduler, or local:N for a "
                    "LocalCluster of N workers (needs: pip install tfloc[dask]; default: a local "
                    "process pool of --jobs workers)")
+    p.add_argument("--quick", action="store_true",
+                   help=f"a quick first run: the first {QUICK_PER_GROUP} scans of each group (unless "
+                   "--limit-per-group says otherwise), into OUT-quick (unless --out is given)")
     p.add_argument("--regenerate", action="store_true",
                    help="if OUT holds a complete run, discard it and run again (an interrupted run "
                         "is still resumed); make bench uses this to reproduce the committed results")
@@ -67,6 +75,9 @@ def config_from_args(args: argparse.Namespace) -> RunConfig:
         cfg = RunConfig(name=name, out=args.out or Path("results") / name,
                         datasets=tuple(Path(d) for d in args.inputs),
                         matchers=parse_matchers(names, {}, "--matchers"))
+    if args.quick:
+        cfg = cfg.with_overrides(name=f"{cfg.name}-quick", out=cfg.out.with_name(f"{cfg.out.name}-quick"),
+                                 limit_per_group=QUICK_PER_GROUP)
     return cfg.with_overrides(
         name=args.name, out=args.out, jobs=args.jobs, timeout_s=args.timeout,
         limit_per_group=args.limit_per_group,

@@ -36,6 +36,11 @@ def _samples(sc: pd.DataFrame, scenario: str) -> list[str]:
     return [k for k in paper if k in measured] + [k for k in measured if k not in paper]
 
 
+def _scenarios(sc: pd.DataFrame) -> list[tuple[str, list[str]]]:
+    """The paper's scenarios present in ``sc`` with their samples, in table order."""
+    return [(s, _samples(sc, s)) for s in ("I", "II", "III") if _samples(sc, s)]
+
+
 def _label(scenario: str, key: str) -> str:
     r = paper_row(scenario, key)
     return f"{r.label} ({key}{UNIT[scenario]})" if r else f"— ({key}{UNIT[scenario]})"
@@ -76,10 +81,7 @@ def _paper(scenario: str, key: str) -> list[str] | None:
 def paper_vs_tf(sc: pd.DataFrame, matcher: str = "tf") -> str:
     """Tables 2–4 as in the paper, the published row above the measured ``matcher`` row."""
     out = []
-    for scenario in ("I", "II", "III"):
-        samples = _samples(sc, scenario)
-        if not samples:
-            continue
+    for scenario, samples in _scenarios(sc):
         out.append(f"### Table {TABLE_OF[scenario]} — Scenario {scenario}: {TITLES[scenario]}\n")
         mine = sc[(sc["scenario"] == scenario) & (sc["matcher"] == matcher)].set_index("sample")
         if mine.empty:
@@ -103,10 +105,7 @@ def paper_vs_tf(sc: pd.DataFrame, matcher: str = "tf") -> str:
 def all_matchers(sc: pd.DataFrame) -> str:
     """The same tables with every matcher of the run, grouped by sample (paper's tf row first)."""
     out = []
-    for scenario in ("I", "II", "III"):
-        samples = _samples(sc, scenario)
-        if not samples:
-            continue
+    for scenario, samples in _scenarios(sc):
         out.append(f"### Scenario {scenario} (Table {TABLE_OF[scenario]} layout): all matchers\n")
         rows = []
         s = sc[sc["scenario"] == scenario]
