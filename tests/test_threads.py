@@ -19,10 +19,13 @@ MATCHERS = ("tf", "tf-plus", "o3d-icp", "kiss-icp", "cv-corners", "csm-corr")
 def _probe(min_cpu_s: float = 0.3) -> tuple[dict, dict]:
     """In a worker: every matcher on a test-room scan, repeated until it has used ``min_cpu_s`` of
     CPU; returns the thread settings and per matcher (CPU s, wall s) of the repeated calls."""
+    import numba
+
     from tfloc import LaserSpec, Pose, Problem, get_matcher, load_map
     from tfloc.harness.task import warm
     from tfloc.harness.threads import thread_settings
 
+    assert numba.njit(lambda x: x + 1)(1) == 2  # compiling after the limits were set still works
     room = load_map(ROOT / "data" / "maps" / "test-room.geojson")
     laser = LaserSpec.lms200()
     true = Pose(3.0, 3.5, 0.3)

@@ -6,8 +6,10 @@ Every library with a thread pool is therefore limited to ``n`` threads (1 in the
 
 * BLAS and OpenMP runtimes already loaded: ``threadpoolctl.threadpool_limits``; those loaded
   later read ``OMP_NUM_THREADS``, ``OPENBLAS_NUM_THREADS``, ... (set here first).
-* numba: ``numba.set_num_threads`` (its ``NUMBA_NUM_THREADS`` is read when numba is imported,
-  which in a spawned worker happens before any initializer runs).
+* numba: ``NUMBA_NUM_THREADS``, read into numba's configuration again
+  (``numba.core.config.reload_config``: numba was imported before any initializer runs). Its
+  thread pool is not launched here: numba refuses a configuration that differs from a launched
+  pool's size when it next compiles. (tfloc's kernels are not parallel; this bounds any that are.)
 * OpenCV: ``cv2.setNumThreads`` (it ignores the variables above).
 * open3d: ``open3d.utility.set_max_threads``. open3d ignores ``OMP_NUM_THREADS`` (measured:
   ``get_max_threads()`` is 2 on 2 cores with ``OMP_NUM_THREADS=1``), so the limit is applied
@@ -34,13 +36,13 @@ def limit_threads(n: int = 1) -> None:
     for var in THREAD_VARS:
         os.environ[var] = str(n)
     import cv2
-    import numba
+    import numba.core.config
 
     cv2.setNumThreads(n)
-    numba.set_num_threads(min(n, numba.config.NUMBA_NUM_THREADS))  # loads its threading layer
+    numba.core.config.reload_config()
     if "open3d" in sys.modules:
         sys.modules["open3d"].utility.set_max_threads(n)
-    try:  # last: the runtimes loaded by the lines above are limited too
+    try:  # last: the runtimes loaded above are limited too
         from threadpoolctl import threadpool_limits
 
         threadpool_limits(n)
@@ -51,9 +53,9 @@ def limit_threads(n: int = 1) -> None:
 def thread_settings() -> dict[str, int]:
     """The thread limit of every pool this process has loaded, by library (for tests and run.json)."""
     import cv2
-    import numba
+    import numba.core.config
 
-    out = {"cv2": int(cv2.getNumThreads()), "numba": int(numba.get_num_threads())}
+    out = {"cv2": int(cv2.getNumThreads()), "numba": int(numba.core.config.NUMBA_NUM_THREADS)}
     if "open3d" in sys.modules:
         out["open3d"] = int(sys.modules["open3d"].utility.get_max_threads())
     try:
