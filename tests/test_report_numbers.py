@@ -106,3 +106,15 @@ def test_representatives_are_the_median_and_the_worst():
     g = pd.DataFrame({"dist_err_cm": [5.0, 1.0, np.nan, 3.0, 9.0], "init_dist_err_m": [1.0] * 5,
                       "dataset": ["d"] * 5, "scan_id": list("abcde")})
     assert list(representatives(g)["scan_id"]) == ["a", "c"]  # sorted b, d, a, e, c → index 2 and last
+
+
+def test_resuming_a_run_made_before_cpu_s_keeps_its_columns(tmp_path, test_room, lms200):
+    ds = make_dataset(tmp_path / "ds", test_room, lms200, n=4)
+    config = cfg(ds, tmp_path / "run", MatcherSpec.make("toy_matchers:Stay", label="stay"), jobs=1)
+    out = run(config, progress=False)
+    old = read_estimates(out).drop(columns=["cpu_s"]).iloc[:2]  # an older run, interrupted
+    old.to_csv(out / "estimates.csv", index=False)
+    run(config, progress=False)
+    df = read_estimates(out)
+    assert len(df) == 4 and "cpu_s" not in df.columns and (df["status"] == "ok").all()
+    assert df["runtime_s"].notna().all()
