@@ -119,7 +119,7 @@ def execute_local(tasks: list[Task], jobs: int, timeout_s: float,
         warm = {}
         for t in tasks:  # compile kernels and load data outside the timed, time-limited tasks
             warm.setdefault((t.dataset, t.matcher, t.params_json), t)
-        for f in [pool.schedule(warm_up, args=(t,)) for t in warm.values()]:
+        for f in [pool.schedule(warm_up, args=(t,), timeout=timeout_s) for t in warm.values()]:
             try:
                 f.result()
             except Exception:  # noqa: BLE001 - the task itself will report the failure

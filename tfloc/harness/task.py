@@ -7,7 +7,7 @@ Timing: ``runtime_s`` is the wall time and ``cpu_s`` the CPU time of the worker 
 threads; the workers run one thread each, :mod:`tfloc.harness.threads`) during ``localize``
 alone. Before a process times its first task of a dataset and matcher it warms up, untimed
 (:func:`warm`): the matcher's ``prepare`` builds what depends only on the map, and one ``score``
-loads the numba kernels. A scan-to-scan dataset's map is the reference scan, new for every
+loads numba kernels (the runner's :func:`warm_up` has compiled all of them into numba's cache). A scan-to-scan dataset's map is the reference scan, new for every
 scan, so its build stays in every task's time (the warm-up uses a map of its own).
 """
 
@@ -168,10 +168,14 @@ def run_task(task: Task) -> dict[str, Any]:
 
 
 def warm_up(task: Task) -> None:
-    """Load the dataset and matcher of ``task`` and :func:`warm` them up before timing."""
+    """Before a run: load the dataset and matcher of ``task``, :func:`warm` them up and run one
+    untimed ``localize``, which compiles every numba kernel the matcher uses into numba's on-disk
+    cache (other workers then only load them). The caller gives it the task's time limit."""
     scenario, scans = load_dataset(task.dataset)
     scan = scans[task.scan_id]
     try:
-        _warm_once(task, load_matcher(task.matcher, task.params_json), scenario, scan)
+        matcher = load_matcher(task.matcher, task.params_json)
+        _warm_once(task, matcher, scenario, scan)
+        matcher.localize(problem_of(scenario, scan))
     except Exception:  # noqa: BLE001 - the real run will report it
         pass
