@@ -7,8 +7,9 @@ Timing: ``runtime_s`` is the wall time and ``cpu_s`` the CPU time of the worker 
 threads; the workers run one thread each, :mod:`tfloc.harness.threads`) during ``localize``
 alone. Before a process times its first task of a dataset and matcher it warms up, untimed
 (:func:`warm`): the matcher's ``prepare`` builds what depends only on the map, and one ``score``
-loads numba kernels (the runner's :func:`warm_up` has compiled all of them into numba's cache). A scan-to-scan dataset's map is the reference scan, new for every
-scan, so its build stays in every task's time (the warm-up uses a map of its own).
+loads numba kernels (the runner's :func:`warm_up` has compiled all of them into numba's
+cache). A scan-to-scan dataset's map is the reference scan, new for every scan, so its build
+stays in every task's time (the warm-up uses a map of its own).
 """
 
 from __future__ import annotations
