@@ -29,6 +29,8 @@ _BUILTIN = {
     "kiss-icp": "baselines.kiss_icp:KissIcpMatcher",
     "cv-corners": "baselines.cv_corners:CvCornersMatcher",
     "csm-corr": "baselines.csm_corr:CorrelativeMatcher",
+    "gicp": "baselines.gicp:GicpMatcher",
+    "karto": "baselines.karto:KartoMatcher",
 }
 
 
