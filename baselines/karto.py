@@ -12,8 +12,8 @@ matches against a grid.
 
 Configuration choices and why, measured on the development split (office-pool scans 100–139 of
 each of the nine offset cells, 360 scans, disjoint from the benchmark's scans 0–19; success
-≤ 10 cm and ≤ 2°, by offset bin 0–1 / 1–2 / 2–3 m; CPU ms = ``time.process_time`` per ``localize``).
-This configuration: 94.4 % (95.8 / 96.7 / 90.8), median 0.58 cm / 0.064° when successful,
+≤ 10 cm and ≤ 2°, by offset bin 0–1 / 1–2 / 2–3 m; CPU ms = ``time.process_time`` per ``localize``;
+the variants' table: ``python benchmarks/peers_dev.py karto``). This configuration: 94.4 % (95.8 / 96.7 / 90.8), median 0.58 cm / 0.064° when successful,
 10.5 ms median CPU.
 
 * **The map is handed over as scans**, Karto's documented use: ``MatchScan`` correlates a scan
@@ -40,7 +40,8 @@ This configuration: 94.4 % (95.8 / 96.7 / 90.8), median 0.58 cm / 0.064° when s
   alone: 79.4 %, only 32.8 % within 5 cm / 1° (its 0.1 m grid leaves 5.0 cm median error); one
   stage over 7 m at 0.02 m: 95.8 % at 144 ms; a coarse stage at 0.05 m / 0.03 m smear: 94.7 % at
   26.5 ms; coarse smear 0.15 m: 95.0 % (two scans more: noise, not kept). Windows of 1 m and 3 m
-  in one stage reached 17.8 % and 62.2 % (45-scan subset): the window must cover the offsets.
+  in one stage at 0.02 m reached 17.8 % and 62.2 % (45-scan subset, one virtual scan from the
+  initial pose as base; 7 m: 84.4 %): the window must cover the offsets.
 * **Angular search: Karto's defaults**, ±``coarse_angle_offset_deg`` = 20° (covers the protocol's
   15°) in ``coarse_angle_resolution_deg`` = 2° steps, refined in ``fine_angle_resolution_deg`` =
   0.2° steps; ``use_response_expansion`` (Karto's +20° retries when nothing responds). 1° coarse
