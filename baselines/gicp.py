@@ -6,8 +6,9 @@ covariances small_gicp estimates itself; small_gicp's internals are not rewritte
 3D only. Configuration choices and why, measured on the development split (office-pool scans
 100–139 of each of the nine offset cells, 360 scans, disjoint from the benchmark's scans 0–19;
 success ≤ 10 cm and ≤ 2°; success by offset bin 0–1 / 1–2 / 2–3 m; CPU ms = ``time.process_time``
-per ``localize``; the variants' table: ``python benchmarks/peers_dev.py gicp``). This configuration: 48.1 % (92.5 / 44.2 / 7.5), median 0.14 cm / 0.024° when
-successful, 3.7 ms median CPU.
+per ``localize``; the variants' table: ``python benchmarks/peers_dev.py gicp``). This
+configuration: 48.1 % (92.5 / 44.2 / 7.5), median 0.14 cm / 0.024° when successful, 3.7 ms
+median CPU.
 
 * **The 2D points are stacked in three layers** ``layers`` = z −0.05, 0, +0.05 m (scan and map alike).
   small_gicp regularises each covariance to eigenvalues (1e-3, 1, 1) along its eigenvectors,

@@ -13,8 +13,8 @@ matches against a grid.
 Configuration choices and why, measured on the development split (office-pool scans 100–139 of
 each of the nine offset cells, 360 scans, disjoint from the benchmark's scans 0–19; success
 ≤ 10 cm and ≤ 2°, by offset bin 0–1 / 1–2 / 2–3 m; CPU ms = ``time.process_time`` per ``localize``;
-the variants' table: ``python benchmarks/peers_dev.py karto``). This configuration: 94.4 % (95.8 / 96.7 / 90.8), median 0.58 cm / 0.064° when successful,
-10.5 ms median CPU.
+the variants' table: ``python benchmarks/peers_dev.py karto``). This configuration: 94.4 %
+(95.8 / 96.7 / 90.8), median 0.58 cm / 0.064° when successful, 10.5 ms median CPU.
 
 * **The map is handed over as scans**, Karto's documented use: ``MatchScan`` correlates a scan
   with a set of *base scans* (in OpenKarto's Mapper the running scans and the near chains of the
