@@ -34,7 +34,7 @@ from .task import Task, failure_row, run_task, warm_up
 THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS",
                "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")
 PACKAGES = ("tfloc", "numpy", "scipy", "shapely", "numba", "pandas", "open3d", "kiss-icp",
-            "opencv-python-headless", "pebble", "matplotlib")
+            "opencv-python-headless", "small-gicp", "karto-scanmatcher", "pebble", "matplotlib")
 
 
 def make_tasks(config: RunConfig) -> list[Task]:
