@@ -5,6 +5,7 @@ Run: ``PYTHONPATH=$PWD pytest benchmarks/test_baselines_timing.py --benchmark-on
 
 from __future__ import annotations
 
+import importlib.util
 import math
 import sys
 from pathlib import Path
@@ -27,7 +28,13 @@ def problem() -> Problem:
     return Problem(m, laser, ranges, true.compose(Pose(0.3, 0.0, math.radians(5.0))))
 
 
-@pytest.mark.parametrize("name", ["o3d-icp", "kiss-icp", "csm-corr", "cv-corners"])
+def _needs(module: str) -> pytest.MarkDecorator:
+    return pytest.mark.skipif(importlib.util.find_spec(module) is None, reason=f"{module} is not installed")
+
+
+@pytest.mark.parametrize("name", ["o3d-icp", "kiss-icp", "csm-corr", "cv-corners",
+                                  pytest.param("gicp", marks=_needs("small_gicp")),
+                                  pytest.param("karto", marks=_needs("karto_scanmatcher"))])
 def test_localize_time(benchmark, problem: Problem, name: str) -> None:  # noqa: ANN001
     matcher = tfloc.get_matcher(name)
     matcher.localize(problem)  # build the per-map caches outside the timing

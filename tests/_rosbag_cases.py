@@ -19,6 +19,7 @@ ROOM = ROOT / "data" / "maps" / "test-room.geojson"
 T0 = 1_700_000_000.0  # s
 LASER = LaserSpec(10.0, math.pi, math.radians(1.0), -math.pi / 2)  # 181 beams, like an LMS200
 KINDS = ("ros1", "sqlite3", "mcap")
+POSE_T = T0 + 0.02 * np.arange(120)  # reference poses at 50 Hz over the whole path (2.4 s)
 
 
 def path_pose(t: np.ndarray) -> np.ndarray:
@@ -179,3 +180,9 @@ def write_bag(path: Path, kind: str, items: list) -> Path:
 
 def bag_path(tmp: Path, kind: str, stem: str = "run") -> Path:
     return tmp / (f"{stem}.bag" if kind == "ros1" else f"{stem}-{kind}")
+
+
+def gt_bag(path: Path, kind: str, t: np.ndarray, ranges: np.ndarray, extra: list = ()) -> Path:
+    """A bag with scans on /scan and PoseStamped reference poses on /gt (plus ``extra`` items)."""
+    return write_bag(path, kind, scan_items("/scan", t, ranges) + pose_items("/gt", "PoseStamped", POSE_T)
+                     + list(extra))

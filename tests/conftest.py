@@ -19,3 +19,13 @@ def test_room() -> tfloc.VectorMap:
 @pytest.fixture(scope="session")
 def lms200() -> tfloc.LaserSpec:
     return tfloc.LaserSpec.lms200()
+
+
+@pytest.fixture(scope="module")
+def map_yaml(tmp_path_factory) -> Path:
+    """The test room as a ROS map (YAML + PGM), for the bag tests."""
+    from _rosbag_cases import room_grid
+
+    from tfloc.io.rosmap import write_ros_map
+
+    return write_ros_map(room_grid(), tmp_path_factory.mktemp("maps") / "room.yaml")

@@ -15,12 +15,23 @@ BASELINES = {
     "kiss-icp": "tfloc.baselines.kiss_icp:KissIcpMatcher",
     "cv-corners": "tfloc.baselines.cv_corners:CvCornersMatcher",
     "csm-corr": "tfloc.baselines.csm_corr:CorrelativeMatcher",
+    "gicp": "tfloc.baselines.gicp:GicpMatcher",
+    "karto": "tfloc.baselines.karto:KartoMatcher",
 }
+#: Optional libraries: a baseline whose library is not installed is skipped here (the registry
+#: tests check that it then fails with one line and the others still run).
+OPTIONAL = {"gicp": "small_gicp", "karto": "karto_scanmatcher"}
+
+
+def _needs(name: str) -> None:
+    if name in OPTIONAL:
+        pytest.importorskip(OPTIONAL[name])
 
 
 @pytest.mark.parametrize("name", BASELINES)
 @pytest.mark.parametrize(("direction", "sign"), OFFSETS)
 def test_recovers_known_offset(name: str, direction: float, sign: float) -> None:
+    _needs(name)
     problem, true = make_problem(direction, sign)
     est = tfloc.get_matcher(name).localize(problem)
     dist, orient = errors(est.pose, true)
@@ -30,6 +41,7 @@ def test_recovers_known_offset(name: str, direction: float, sign: float) -> None
 
 @pytest.mark.parametrize("name", BASELINES)
 def test_score_prefers_truth(name: str) -> None:
+    _needs(name)
     problem, true = make_problem()
     matcher = tfloc.get_matcher(name)
     assert matcher.score(problem, true) < matcher.score(problem, problem.initial)
@@ -37,6 +49,7 @@ def test_score_prefers_truth(name: str) -> None:
 
 @pytest.mark.parametrize("name", BASELINES)
 def test_registered_name_and_parameters(name: str) -> None:
+    _needs(name)
     matcher = tfloc.get_matcher(name)
     module, _, cls = BASELINES[name].partition(":")
     assert type(matcher).__module__ == module and type(matcher).__name__ == cls

@@ -12,6 +12,7 @@ import pytest
 
 from tfloc.core.pose import angdiff
 from tfloc.datasets.real import INTEL_LASER, build_all, clean_ranges
+from tfloc.datasets.relations import build_relations, overlap
 from tfloc.io.carmen import read_carmen
 from tfloc.io.scenario import map_for, read_scans, read_scenario
 
@@ -47,12 +48,15 @@ def test_intel_spacing_decision_recomputed_on_a_subset() -> None:
 @pytest.fixture(scope="module")
 def rebuilt(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("real")
+    build_relations(DATA / "real", out)
     build_all(DATA / "real", out)
     return out
 
 
 @pytest.mark.parametrize("rel", [
     "scenarios/real-csail-relations/scans.csv", "scenarios/real-csail-relations/scenario.json",
+    "scenarios/real-csail-relations-perturbed/scans.csv",
+    "scenarios/real-csail-relations-perturbed/scenario.json",
     "scenarios/real-intel-scan-to-map/scans.csv", "scenarios/real-intel-scan-to-map/scenario.json",
     "scenarios/real-csail-scan-to-map/scans.csv", "scenarios/real-csail-scan-to-map/scenario.json",
     "maps/real-intel.yaml", "maps/real-intel.pgm", "maps/real-csail.yaml", "maps/real-csail.pgm",
@@ -71,11 +75,13 @@ def test_relations_dataset_matches_the_log() -> None:
     scans = read_scans(sc)
     assert len(scans) == 1172 and sc.laser.n_beams == 361
     assert all(s.ref_ranges is not None for s in scans)
-    assert {s.group for s in scans} == {"local", "loop"}
+    assert {s.group for s in scans} == {"local", "loop", "local-no-overlap", "loop-no-overlap"}
+    no_overlap = np.array([s.group.endswith("no-overlap") for s in scans])
+    assert 40 <= no_overlap.sum() <= 80  # revisits seen from elsewhere; 2 consecutive pairs
     T = np.array([s.true.as_array() for s in scans])
     I0 = np.array([s.initial.as_array() for s in scans])
     de = np.hypot(*(T[:, :2] - I0[:, :2]).T)
-    local = np.array([s.group == "local" for s in scans])
+    local = np.array([s.group.startswith("local") for s in scans])
     # odometry is a good guess between nearby scans and a poor one across loops
     assert np.median(de[local]) < 0.06 and np.median(de[~local]) > 1.0
     # the reference scan drawn as a polyline agrees with the current scan at the true relation
@@ -114,3 +120,35 @@ def test_scan_to_map_dataset(name: str, n: int) -> None:
         assert i - 1 <= di < i and 5 * (j - 1) <= ai < 5 * j, s.scan_id
     counts = np.unique([s.group for s in scans], return_counts=True)[1]
     assert len(counts) == 9 and counts.max() - counts.min() <= 1
+
+
+def test_perturbed_relations_are_in_the_protocol_bins_and_in_the_reference_area() -> None:
+    sc = read_scenario(SCEN / "real-csail-relations-perturbed")
+    odo = {s.scan_id: s for s in read_scans(read_scenario(SCEN / "real-csail-relations"))}
+    scans = read_scans(sc)
+    assert [s.scan_id for s in scans] == list(odo) and all(s.true == odo[s.scan_id].true for s in scans)
+    T = np.array([s.true.as_array() for s in scans])
+    I0 = np.array([s.initial.as_array() for s in scans])
+    d = np.hypot(*(T[:, :2] - I0[:, :2]).T)
+    a = np.degrees(np.abs(angdiff(I0[:, 2], T[:, 2])))
+    cells = np.floor(d).astype(int) * 3 + np.floor(a / 5).astype(int)
+    assert cells.min() == 0 and cells.max() == 8
+    assert np.bincount(cells).min() >= 1172 // 9 - 1   # balanced
+    for s in scans[:50]:
+        m = map_for(sc, s)
+        assert m.in_bounds(s.initial.xy[None])[0]
+
+
+def test_overlap_of_a_scan_with_itself_and_with_a_distant_view(lms200) -> None:
+    from tfloc.core.pose import Pose
+
+    room = tfloc_room()
+    a = room.raycast(Pose(2.0, 2.0, 0.0), lms200)
+    assert overlap(a, a, Pose(), lms200) == 1.0
+    assert overlap(a, a, Pose(30.0, 0.0, 0.0), lms200) == 0.0
+
+
+def tfloc_room():
+    from tfloc.io.maps import load_map
+
+    return load_map(DATA / "maps" / "test-room.geojson")

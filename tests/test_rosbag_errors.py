@@ -11,9 +11,11 @@ import numpy as np
 import pytest
 from _rosbag_cases import (
     KINDS,
+    POSE_T,
     T0,
     GridItem,
     bag_path,
+    gt_bag,
     pose_items,
     room_grid,
     scan_items,
@@ -25,21 +27,14 @@ from tfloc.cli import main
 from tfloc.datasets.from_bag import BagImport, import_bag
 from tfloc.errors import BagError, DatasetError, TflocError
 from tfloc.io.rosbag import Bag
-from tfloc.io.rosmap import write_ros_map
 
 pytest.importorskip("rosbags")  # the optional extra tfloc[ros]
 
-POSE_T = T0 + 0.02 * np.arange(120)
 
 
 @pytest.fixture(scope="module")
 def sim():
     return simulate(12)
-
-
-@pytest.fixture(scope="module")
-def map_yaml(tmp_path_factory) -> Path:
-    return write_ros_map(room_grid(), tmp_path_factory.mktemp("maps") / "room.yaml")
 
 
 def _import(bag: Path, out: Path, map_yaml: Path, **kw) -> None:
@@ -57,8 +52,7 @@ def _cli_error(capsys, argv: list[str]) -> str:
 @pytest.mark.parametrize("frac", [0.5, 0.999])
 def test_truncated_bag(tmp_path, sim, map_yaml, capsys, kind, frac) -> None:
     t, P, R = sim
-    good = write_bag(bag_path(tmp_path, kind, "good"), kind,
-                     scan_items("/scan", t, R) + pose_items("/gt", "PoseStamped", POSE_T))
+    good = gt_bag(bag_path(tmp_path, kind, "good"), kind, t, R)
     bad = bag_path(tmp_path, kind, "cut")
     if kind == "ros1":
         data = good.read_bytes()
@@ -99,8 +93,7 @@ def test_corrupt_message_names_topic_and_index(tmp_path, sim, map_yaml) -> None:
 @pytest.mark.parametrize("kind", ["ros1", "sqlite3"])
 def test_missing_topic(tmp_path, sim, map_yaml, capsys, kind) -> None:
     t, P, R = sim
-    bag = write_bag(bag_path(tmp_path, kind), kind,
-                    scan_items("/scan", t, R) + pose_items("/gt", "PoseStamped", POSE_T))
+    bag = gt_bag(bag_path(tmp_path, kind), kind, t, R)
     with pytest.raises(BagError, match=r"no topic /ground_truth in the bag \(topics: /gt "):
         _import(bag, tmp_path / "ds", map_yaml, pose="/ground_truth")
     err = _cli_error(capsys, ["import-bag", str(bag), "--scan-topic", "/laser", "--pose-topic", "/gt",
@@ -110,8 +103,7 @@ def test_missing_topic(tmp_path, sim, map_yaml, capsys, kind) -> None:
 
 def test_wrong_message_type(tmp_path, sim, map_yaml) -> None:
     t, P, R = sim
-    bag = write_bag(bag_path(tmp_path, "ros1"), "ros1",
-                    scan_items("/scan", t, R) + pose_items("/gt", "PoseStamped", POSE_T))
+    bag = gt_bag(bag_path(tmp_path, "ros1"), "ros1", t, R)
     with pytest.raises(BagError, match=r"topic /gt has type geometry_msgs/msg/PoseStamped, expected "
                                        r"sensor_msgs/msg/LaserScan"):
         _import(bag, tmp_path / "ds", map_yaml, scan="/gt")
@@ -200,8 +192,7 @@ def test_bad_occupancy_grid(tmp_path, sim) -> None:
 
 def test_existing_dataset_is_not_overwritten(tmp_path, sim, map_yaml) -> None:
     t, P, R = sim
-    bag = write_bag(bag_path(tmp_path, "ros1"), "ros1",
-                    scan_items("/scan", t, R) + pose_items("/gt", "PoseStamped", POSE_T))
+    bag = gt_bag(bag_path(tmp_path, "ros1"), "ros1", t, R)
     _import(bag, tmp_path / "ds", map_yaml)
     with pytest.raises(DatasetError, match="a dataset exists there already"):
         _import(bag, tmp_path / "ds", map_yaml)
@@ -235,8 +226,7 @@ def test_missing_bag_and_missing_rosbags(tmp_path, map_yaml, monkeypatch) -> Non
 
 def test_frame_pair_on_a_pose_topic(tmp_path, sim, map_yaml) -> None:
     t, P, R = sim
-    bag = write_bag(bag_path(tmp_path, "ros1"), "ros1",
-                    scan_items("/scan", t, R) + pose_items("/gt", "PoseStamped", POSE_T))
+    bag = gt_bag(bag_path(tmp_path, "ros1"), "ros1", t, R)
     with pytest.raises(BagError, match=r"/gt has type geometry_msgs/msg/PoseStamped; a frame pair applies "
                                        r"to tf topics only"):
         _import(bag, tmp_path / "ds", map_yaml, pose_frames=("map", "base_link"))

@@ -13,6 +13,7 @@ import pytest
 from _rosbag_cases import (
     KINDS,
     LASER,
+    POSE_T,
     ROOM,
     T0,
     GridItem,
@@ -31,23 +32,16 @@ from tfloc.cli import main
 from tfloc.core.pose import Pose, angdiff
 from tfloc.datasets.from_bag import BagImport, import_bag
 from tfloc.io.rosbag import Bag
-from tfloc.io.rosmap import write_ros_map
 from tfloc.io.scenario import read_scans, read_scenario
 
 pytest.importorskip("rosbags")  # the optional extra tfloc[ros]
 
-POSE_T = T0 + 0.02 * np.arange(120)  # 50 Hz over the whole path (2.4 s)
 POSE_TYPES = ("PoseStamped", "PoseWithCovarianceStamped", "Odometry")
 
 
 @pytest.fixture(scope="module")
 def sim():
     return simulate(20)
-
-
-@pytest.fixture(scope="module")
-def map_yaml(tmp_path_factory) -> Path:
-    return write_ros_map(room_grid(), tmp_path_factory.mktemp("maps") / "room.yaml")
 
 
 def _check_dataset(out: Path, sim, tol_xy: float = 2e-4) -> list:

@@ -45,32 +45,41 @@ class ThreadsInfo(Stay):
                                                       "numba_threads": os.environ.get("NUMBA_NUM_THREADS")})
 
 
-class Raises(Stay):
+class _EveryNth(Stay):
+    """:class:`Stay` that misbehaves (:meth:`act`) on every ``every``-th call in a worker."""
+
+    def __init__(self, every: int = 2) -> None:
+        super().__init__()
+        self.every, self.calls = every, 0
+
+    def act(self) -> None:
+        raise NotImplementedError
+
+    def localize(self, problem: Problem) -> Estimate:
+        self.calls += 1
+        if self.calls % self.every == 0:
+            self.act()
+        return super().localize(problem)
+
+
+class Raises(_EveryNth):
     """Raises on every ``fail_every``-th call in a worker (a data-dependent crash)."""
 
     def __init__(self, fail_every: int = 2) -> None:
-        super().__init__()
-        self.fail_every, self.calls = fail_every, 0
+        super().__init__(fail_every)
 
-    def localize(self, problem: Problem) -> Estimate:
-        self.calls += 1
-        if self.calls % self.fail_every == 0:
-            raise ValueError("toy failure\nwith a second line")
-        return super().localize(problem)
+    def act(self) -> None:
+        raise ValueError("toy failure\nwith a second line")
 
 
-class Hangs(Stay):
+class Hangs(_EveryNth):
     """Hangs (sleeps far past any time limit) on every ``hang_every``-th call in a worker."""
 
     def __init__(self, hang_every: int = 2) -> None:
-        super().__init__()
-        self.hang_every, self.calls = hang_every, 0
+        super().__init__(hang_every)
 
-    def localize(self, problem: Problem) -> Estimate:
-        self.calls += 1
-        if self.calls % self.hang_every == 0:
-            time.sleep(3600)
-        return super().localize(problem)
+    def act(self) -> None:
+        time.sleep(3600)
 
 
 class TwoMinima:

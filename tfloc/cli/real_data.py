@@ -1,6 +1,7 @@
 """Build the real-data scenario datasets from the logs in data/real/ (deterministic for a seed).
 
-Writes OUT/scenarios/real-csail-relations/ (scan-to-scan, 1172 MIT CSAIL relations),
+Writes OUT/scenarios/real-csail-relations/ and real-csail-relations-perturbed/ (scan-to-scan, the
+1172 MIT CSAIL relations from the odometry guess and from perturbed guesses),
 OUT/scenarios/real-intel-scan-to-map/ and OUT/scenarios/real-csail-scan-to-map/ (scan-to-map),
 and their grid maps OUT/maps/real-intel.yaml|.pgm and OUT/maps/real-csail.yaml|.pgm.
 """
@@ -28,7 +29,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from tfloc.datasets.real import build_all
+    from tfloc.datasets.relations import build_relations
 
-    for root in build_all(args.real, args.out, args.seed, args.resolution):
+    for root in [*build_relations(args.real, args.out, args.seed),
+                 *build_all(args.real, args.out, args.seed, args.resolution)]:
         print(root)
     return 0

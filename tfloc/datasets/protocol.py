@@ -13,7 +13,7 @@ bags (:mod:`tfloc.datasets.from_bag`); the reports bin by the same edges
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -75,24 +75,29 @@ class Perturbation:
     max_draws: int = 10_000
 
 
-def perturb(truths: np.ndarray, map_: Map, cfg: Perturbation = Perturbation()) -> tuple[np.ndarray, list[str]]:
+def perturb(truths: np.ndarray, map_: Map | Sequence[Map],
+            cfg: Perturbation = Perturbation()) -> tuple[np.ndarray, list[str]]:
     """Initial poses ``(N, 3)`` and cell labels for given true poses ``(N, 3)`` (metres, radians).
 
     Scan k gets cell ``perm[k] mod 9`` (a seeded, balanced assignment) and an
     :func:`initial_pose` in it, inside the map's bounds and at least ``clearance_m`` from its
-    geometry, drawn again until one is accepted (at most ``max_draws`` candidates, else a
-    :class:`~tfloc.errors.DatasetError`)."""
-    def accept(xy: np.ndarray) -> np.ndarray:
-        ok = map_.in_bounds(xy)
-        ok[ok] = map_.is_free(xy[ok], cfg.clearance_m)
-        return ok
+    geometry (``map_`` is one map for all, or one map per scan), drawn again until one is
+    accepted (at most ``max_draws`` candidates, else a :class:`~tfloc.errors.DatasetError`)."""
+    maps = [map_] * len(truths) if isinstance(map_, Map) else list(map_)
+
+    def acceptor(m: Map) -> Accept:
+        def accept(xy: np.ndarray) -> np.ndarray:
+            ok = m.in_bounds(xy)
+            ok[ok] = m.is_free(xy[ok], cfg.clearance_m)
+            return ok
+        return accept
 
     rng = np.random.default_rng(cfg.seed)
     cells = strata()
     assign = rng.permutation(len(truths)) % len(cells)
     init = np.empty((len(truths), 3))
     for k, c in enumerate(assign):
-        cell, truth = cells[int(c)], Pose.from_array(truths[k])
+        cell, truth, accept = cells[int(c)], Pose.from_array(truths[k]), acceptor(maps[k])
         for _ in range(max(1, cfg.max_draws // 64)):
             pose = initial_pose(truth, cell, rng, accept)
             if pose is not None:

@@ -1,8 +1,6 @@
 """Scenario datasets built from the real logs in ``data/real/`` (deterministic for a given seed).
 
-* ``real-csail-relations``: scan-to-scan on the MIT CSAIL log and the 1172 relations of
-  Kümmerle et al. (2009): the scan at t2 (``ranges``) against the scan at t1 (``ref_ranges``),
-  ``true`` = the relation, ``init`` = the raw odometry between the two scans.
+* the MIT CSAIL relations datasets: :mod:`tfloc.datasets.relations`.
 * ``real-intel-scan-to-map`` and ``real-csail-scan-to-map``: every scan of a SLAM-corrected log
   localized in a grid map built from all corrected scans, from an initial pose perturbed in the
   paper's 3 × 3 offset bins.
@@ -18,7 +16,6 @@ from tfloc.core.laser import LaserSpec
 from tfloc.core.pose import Pose
 from tfloc.errors import DatasetError
 from tfloc.io.carmen import CarmenLog, read_carmen
-from tfloc.io.relations import join_relations, read_relations
 from tfloc.io.rosmap import write_ros_map
 from tfloc.io.scenario import Scan, write_scenario
 from tfloc.maps.build import grid_from_scans
@@ -44,7 +41,8 @@ def clean_ranges(ranges: np.ndarray) -> np.ndarray:
     return r
 
 
-def _front(log: CarmenLog, laser: LaserSpec) -> list:
+def front_scans(log: CarmenLog, laser: LaserSpec) -> list:
+    """The front-laser (FLASER) records of a log, all of ``laser``'s beam count."""
     scans = [s for s in log.lasers if s.kind == "FLASER"]
     bad = [s for s in scans if len(s.ranges) != laser.n_beams]
     if bad:
@@ -52,31 +50,12 @@ def _front(log: CarmenLog, laser: LaserSpec) -> list:
     return scans
 
 
-def relations_scans(clf: Path, relations: Path, laser: LaserSpec = CSAIL_LASER,
-                    loop_gap_s: float = 5.0) -> list[Scan]:
-    """One scan-to-scan row per relation (in file order); ``scan_id`` = ``rel<line>``.
-
-    ``group`` is ``local`` if t2 − t1 ≤ ``loop_gap_s`` seconds, else ``loop`` (a revisit: the
-    odometry between the scans has drifted, often by metres)."""
-    log = read_carmen(clf)
-    scans = _front(log, laser)
-    rels = read_relations(relations)
-    idx = join_relations(rels, scans, relations)
-    rows = []
-    for rel, (i, j) in zip(rels, idx, strict=True):
-        a, b = scans[i], scans[j]
-        rows.append(Scan(f"rel{rel.line:04d}", "local" if abs(rel.t2 - rel.t1) <= loop_gap_s else "loop",
-                         clean_ranges(b.ranges), a.odom.between(b.odom), rel.delta,
-                         ref_ranges=clean_ranges(a.ranges)))
-    return rows
-
-
 def scan_to_map(log_path: Path, laser: LaserSpec, resolution: float = 0.05,
                 cfg: Perturbation | None = None) -> tuple[GridMap, list[Scan]]:
     """The grid map of a corrected log and its scans with perturbed initial poses."""
     cfg = cfg or Perturbation()
     log = read_carmen(log_path)
-    scans = _front(log, laser)
+    scans = front_scans(log, laser)
     R = np.vstack([clean_ranges(s.ranges) for s in scans])
     P = np.array([s.pose.as_array() for s in scans])
     grid = grid_from_scans(R, P, laser, resolution, name=log_path.name.split(".")[0])
@@ -91,25 +70,10 @@ def _source(real: Path, *files: str) -> dict:
 
 
 def build_all(real: Path, out: Path, seed: int = DEFAULT_SEED, resolution: float = 0.05) -> list[Path]:
-    """(Re)build the three real datasets under ``out/scenarios`` and their maps under ``out/maps``."""
+    """(Re)build the real scan-to-map datasets under ``out/scenarios`` and their maps under
+    ``out/maps`` (the relations datasets: :func:`tfloc.datasets.relations.build_relations`)."""
     real, out = Path(real), Path(out)
     made = []
-    csail = real / "mit-csail"
-    rel_root = out / "scenarios" / "real-csail-relations"
-    rows = relations_scans(csail / "mit-csail.clf.gz", csail / "mit-csail.relations")
-    made.append(write_scenario(
-        rel_root, "real-csail-relations", real / "mit-csail" / "mit-csail.clf.gz", CSAIL_LASER, rows,
-        description=(
-            "Scan-to-scan on MIT CSAIL (Stata Center) with the 1172 ground-truth relations of Kümmerle "
-            "et al. 2009. Row = one relation (scan_id rel<line of mit-csail.relations>): ranges = FLASER "
-            "scan at t2, ref_ranges = scan at t1, true = relation (pose at t2 in the frame at t1), init = "
-            "raw odometry between the two scans. The map is the reference scan (tfloc.io.scenario."
-            "map_for); the 'map' field names the source log only. group: local (t2-t1 <= 5 s) or loop "
-            "(revisit, odometry drifted). No-return 81.91 m -> inf; max_range 50 m (PARAM "
-            "robot_front_laser_max 50; largest real return 42.40 m). Note: in 534 relations the "
-            "translation equals the odometry's to < 0.1 mm; most others differ from it by 5, 7.1 or "
-            "11.2 cm (5 cm x sqrt(k)), so the ground truth looks quantised at about 5 cm."),
-        scan_to_scan=True, source=_source(real, "mit-csail/mit-csail.clf.gz", "mit-csail/mit-csail.relations")))
     cfg = Perturbation(seed=seed)
     for key, log_rel, laser, note in (
             ("intel", "intel/intel-corrected.log.gz", INTEL_LASER,

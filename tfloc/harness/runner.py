@@ -34,7 +34,7 @@ from .task import Task, failure_row, run_task, warm_up
 from .threads import limit_threads
 
 PACKAGES = ("tfloc", "numpy", "scipy", "shapely", "numba", "pandas", "open3d", "kiss-icp",
-            "opencv-python-headless", "pebble", "matplotlib")
+            "opencv-python-headless", "small-gicp", "karto-scanmatcher", "pebble", "matplotlib")
 
 
 def make_tasks(config: RunConfig) -> list[Task]:

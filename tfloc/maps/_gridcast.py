@@ -11,22 +11,22 @@ from numba import njit
 
 
 @njit(cache=True, nogil=True)
+def _slab(p0: float, d: float, size: int, t0: float, t1: float) -> tuple[float, float]:
+    """``[t0, t1]`` narrowed to the ray parameters with ``0 ≤ p0 + t·d < size`` on one axis
+    (empty, ``(inf, -inf)``, when a ray parallel to the axis lies outside)."""
+    if d == 0.0:
+        if p0 < 0.0 or p0 >= size:
+            return np.inf, -np.inf
+        return t0, t1
+    a, b = -p0 / d, (size - p0) / d
+    return max(t0, min(a, b)), min(t1, max(a, b))
+
+
+@njit(cache=True, nogil=True)
 def _entry(x0: float, y0: float, dx: float, dy: float, W: int, H: int) -> tuple[float, float]:
     """Ray parameter interval ``[t0, t1]`` (cell units) inside the box ``[0, W] × [0, H]``."""
-    t0, t1 = 0.0, np.inf
-    if dx == 0.0:
-        if x0 < 0.0 or x0 >= W:
-            return np.inf, -np.inf
-    else:
-        a, b = -x0 / dx, (W - x0) / dx
-        t0, t1 = max(t0, min(a, b)), min(t1, max(a, b))
-    if dy == 0.0:
-        if y0 < 0.0 or y0 >= H:
-            return np.inf, -np.inf
-    else:
-        a, b = -y0 / dy, (H - y0) / dy
-        t0, t1 = max(t0, min(a, b)), min(t1, max(a, b))
-    return t0, t1
+    t0, t1 = _slab(x0, dx, W, 0.0, np.inf)
+    return _slab(y0, dy, H, t0, t1)  # an empty interval stays empty
 
 
 @njit(cache=True, nogil=True)
