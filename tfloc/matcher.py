@@ -24,6 +24,7 @@ GROUP = "tfloc.matchers"
 # Fallback when the package metadata is missing (running from a source tree without install).
 _BUILTIN = {
     "tf": "tfloc.tf:TurningFunctionMatcher",
+    "tf-best": "tfloc.tf_best:TurningFunctionBestMatcher",
     "tf-plus": "tfloc.tf_plus:TurningFunctionPlusMatcher",
     "o3d-icp": "baselines.o3d_icp:Open3dIcpMatcher",
     "kiss-icp": "baselines.kiss_icp:KissIcpMatcher",
