@@ -207,18 +207,20 @@ class _Cost:
     cache: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        n = self.config.n_orientations
-        self._offsets = (np.arange(n) - (n - 1) / 2) * self.config.orientation_step
+        cfg, laser = self.config, self.problem.laser
+        n = cfg.n_orientations
+        self._offsets = (np.arange(n) - (n - 1) / 2) * cfg.orientation_step
+        self._kernel_args = (  # everything scan_errors needs after the scans, converted once
+            laser.directions, float(laser.max_range), float(cfg.spacing), int(cfg.window),
+            float(cfg.straw_t), float(cfg.line_threshold), bool(cfg.close_through_origin),
+            cfg.resampling == "path", cfg.err_norm == "l1", self.real.breaks, self.real.angles,
+            float(cfg.penalty))
 
     def _scan_errors(self, scans: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Err and rotation offset (radians, in [-π, π)) of each virtual scan ``(P, n_beams)``."""
-        cfg, laser = self.config, self.problem.laser
         if _FUSED:
-            return scan_errors(
-                scans, laser.directions, float(laser.max_range), float(cfg.spacing), int(cfg.window),
-                float(cfg.straw_t), float(cfg.line_threshold), bool(cfg.close_through_origin),
-                cfg.resampling == "path", cfg.err_norm == "l1", self.real.breaks, self.real.angles,
-                float(cfg.penalty))
+            return scan_errors(scans, *self._kernel_args)
+        cfg, laser = self.config, self.problem.laser
         errs, rots = np.full(len(scans), cfg.penalty), np.zeros(len(scans))
         distance = _match(cfg)
         for j, ranges in enumerate(scans):

@@ -206,6 +206,7 @@ def raycast_segments(poses: np.ndarray, rel_angles: np.ndarray, segs: np.ndarray
     ex = np.empty(M)
     ey = np.empty(M)
     k = 0
+    wrap_up = two_pi / res <= B - 1.0   # can an arc one turn up reach a beam (360° scanners)?
     for p in range(P):
         ox, oy, th = poses[p, 0], poses[p, 1], poses[p, 2]
         for b in range(B):
@@ -225,6 +226,8 @@ def raycast_segments(poses: np.ndarray, rel_angles: np.ndarray, segs: np.ndarray
             rel = rel - two_pi * np.floor(rel / two_pi)        # in [0, 2π)
             top = rel + width[jj] + 2.0 * margin[jj]
             for wrap in range(-1, 2):                          # beams i·res ≡ arc (mod 2π)
+                if (wrap == -1 and top < two_pi) or (wrap == 1 and not wrap_up):
+                    continue                                   # (the tests below would skip it)
                 lo_f = np.ceil((rel + wrap * two_pi) / res)
                 hi_f = np.floor((top + wrap * two_pi) / res)
                 if hi_f < 0.0 or lo_f > B - 1.0:
