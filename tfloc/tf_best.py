@@ -32,9 +32,9 @@ group, 360 scans; 56 % success against the literal reading's 28 %):
   than the last.
 
 Each reading matters on the development split: with one of them back at its literal value the
-success rate drops from 56 % to 48 % (L2), 43 % (S = 1 m), 55 % (w = 1), 53 % (1° step), 52 %
-(1 m simplex), 52 % (last answer), and 56 % with the heading unbounded, whose mean orientation
-error however grows from 3.7° to 16°. Other simplex seeds: 56 %, 53 %.
+success rate drops from 56.4 % to 47.8 % (L2), 42.5 % (S = 1 m), 55.8 % (w = 1), 53.3 % (1°
+step), 51.9 % (1 m simplex), 51.7 % (last answer), and 55.6 % with the heading unbounded, whose
+mean orientation error however grows from 3.7° to 16°. Other simplex seeds: 55.6 %, 53.3 %.
 
 Readings kept literal because the alternative measured worse: the scan polygon closed through
 the sensor (Alg. 4's direct closure: 14 % vs 28 %), Alg. 1's chord walk (the path walk: 11 %), the
