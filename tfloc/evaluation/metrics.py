@@ -35,7 +35,16 @@ import pandas as pd
 
 from tfloc.datasets.protocol import ANGLE_BINS_DEG, DIST_BINS_M
 
-from .outcome import NO_ANSWER, OUTCOMES, SUCCESS, Thresholds, failure_kind
+from .outcome import (
+    DIVERGED,
+    NEAR,
+    NO_ANSWER,
+    OUTCOMES,
+    SUCCESS,
+    Thresholds,
+    failure_kind,
+    search_outcome,
+)
 from .stats import bootstrap_median, wilson
 
 #: The protocol's offset bins (:mod:`tfloc.datasets.protocol`) as report bins, plus an open last bin.
@@ -60,6 +69,7 @@ METRIC_COLUMNS = (
     "success_rate_pct", "success_lo_pct", "success_hi_pct",
     *(f"n_{o.replace('-', '_')}" for o in (*OUTCOMES, UNSCORED)),
     *(f"share_{o.replace('-', '_')}_pct" for o in OUTCOMES),
+    "n_near", "n_diverged",
     "runtime_median_ms", "runtime_p95_ms", "n_timed",
     "cpu_median_ms", "cpu_median_lo_ms", "cpu_median_hi_ms", "cpu_p95_ms", "n_cpu", "wall_per_cpu_median")
 
@@ -135,6 +145,8 @@ def prepare(df: pd.DataFrame, thr: Thresholds) -> pd.DataFrame:
     out["dist_impr_pct"] = di.where(out["estimate"] & (num["init_dist_err_m"] > 0))
     out["orient_impr_pct"] = oi.where(out["estimate"] & (num["init_orient_err_rad"] > 0))
     out["outcome_eval"] = classify(out, thr)
+    out["search_eval"] = np.where(out["estimate"], search_outcome(
+        num["dist_err_m"], num["orient_err_rad"], num["init_dist_err_m"], thr), None)
     timed = out["status"].isin(["ok", "failed"]) & num["runtime_s"].notna()
     out["runtime_ms"] = (num["runtime_s"] * 1000.0).where(timed)
     out["cpu_ms"] = (num["cpu_s"] * 1000.0).where(timed)
@@ -175,6 +187,8 @@ def group_metrics(g: pd.DataFrame) -> dict[str, float]:
     for o in OUTCOMES:
         m[f"share_{o.replace('-', '_')}_pct"] = 100.0 * counts.get(o, 0) / n_truth if n_truth else np.nan
     m["success_rate_pct"] = m["share_success_pct"]
+    searches = g["search_eval"].value_counts()
+    m.update(n_near=int(searches.get(NEAR, 0)), n_diverged=int(searches.get(DIVERGED, 0)))
     lo, hi = wilson(int(counts.get(SUCCESS, 0)), n_truth)
     m.update(success_lo_pct=100.0 * lo, success_hi_pct=100.0 * hi)
     m["dist_median_lo_cm"], m["dist_median_hi_cm"] = bootstrap_median(g["dist_err_cm"])

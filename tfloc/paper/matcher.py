@@ -33,11 +33,21 @@ Readings (the text is ambiguous or wrong; each choice is the one that works):
   and two points ``simplex_size`` metres away at a seeded random direction, 60° apart.
 * **Invalid candidates** (inside a wall/obstacle, off the map, fewer than 2 corners in the
   virtual scan) cost ``penalty`` instead of raising.
+
+Ambiguous readings are switches of :class:`TfConfig` (each quotes the sentence it reads); the
+defaults are the literal reading above, and ``tf-best`` (:mod:`tfloc.paper.best`) is the same
+search with the best-measured reading of each.
+
+Speed: one Function1 call is one batched raycast plus one compiled call
+(:func:`tfloc.paper.kernels.scan_errors`) for the corners, turning functions and matching of all
+its orientations; it runs the same kernels as the step-by-step functions of this module, so the
+answers are identical.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -46,28 +56,73 @@ from tfloc.core.laser import LaserSpec
 from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose, wrap_angle
 from tfloc.core.problem import Estimate, Problem
+from tfloc.errors import ParameterError
 
 from .corners import shortstraw
-from .turning import TurningFunction, match, turning_function
+from .kernels import scan_errors
+from .turning import Match, TurningFunction, match, match_l1, turning_function
 
 _ORIGIN = np.zeros((1, 2))
 
 
+_NORMS = ("l2", "l1")
+_RESAMPLINGS = ("chord", "path")
+
+
 @dataclass(frozen=True)
 class TfConfig:
-    """Parameters of the ``tf`` matcher; defaults follow the paper where it gives a value.
+    """Parameters of the ``tf`` matcher; defaults follow the paper where it gives a value and are
+    otherwise the literal reading of ``main`` (the switches below name the alternatives).
 
     Attributes:
-        spacing: S of Alg. 1, resampling distance (metres). The paper writes S = 1 without a
-            unit; see the module notes of :mod:`tfloc.paper.corners` and the README for the choice.
-        window: w of Alg. 2 (the paper's w = 1; ShortStraw's authors use 3).
+        spacing: S of Alg. 1, the resampling distance, in **metres**. Alg. 1 sets "S ← 1" without
+            a unit, and "P3 is located exactly S Euclidian distance away from the P1"; the data
+            are in metres (the LMS200's "range of 10 m"), so the literal value is 1 m. Algs. 1
+            and 3 square their distances, which is self-consistent only at S = 1 (see
+            :mod:`tfloc.paper.corners` for how the squares are read), so other values are a reading.
+        window: w of Alg. 2 ("ω is a static window with a length of one (ω=1)"; ShortStraw's
+            authors use 3).
         straw_t: t of Alg. 2 (0.99).
         line_threshold: Is-Line threshold of Alg. 3 (0.95).
-        close_through_origin: close the scan polygon through the sensor origin.
-        n_orientations: orientations checked per simplex vertex (7).
-        orientation_step: spacing of those orientations (radians).
-        simplex_size: initial simplex size (metres); should cover the largest position offset.
-        err_threshold: Eq. 13's threshold on Err (radians).
+        resampling: how Alg. 1 steps: ``"chord"`` (its formula ``P3 ← P1 + (P2 − P1)/D·S``, from
+            the last emitted point towards the next input point; default) or ``"path"`` (its
+            sentence "P3 is located exactly S Euclidian distance away from the P1 in the slop
+            direction of the straight line from P(i−1) to P(i)", read as the original
+            ShortStraw's walk along the path through P(i−1), P(i)).
+        close_through_origin: how the scan polygon is closed. Alg. 4 closes it from the last
+            corner to the first ("if i = Corners then Vector(i) ← Corners(1) − Corners(i)",
+            ``False``); ``True`` (default) closes it through the sensor origin, which keeps the
+            polygon of a 180° scan simple and counter-clockwise ("Vectors are create in
+            counterclockwise direction").
+        err_norm: Err. ``"l2"`` (default): Eq. 13, "Err = (∫₀¹ |Θ_R(L) − Θ_V(L)|² dL)^½";
+            ``"l1"``: Sec. 4.3, "The area between the two graphs is then computed. Rectangles are
+            created between two graphs because they are in the form of histograms. Each
+            rectangle's area is determined, and the area between the two graphs is calculated by
+            adding the total areas together." (∫|Θ_R − Θ_V − θ|, best θ = weighted median).
+        n_orientations: orientations checked per simplex vertex (7: "the angle of each of these
+            three vertices is examined locally in seven orientations").
+        orientation_step: spacing of those orientations (radians). The paper gives none; the
+            literal default is 1°, the scanner's "angular resolution of 1 degree" (the seven
+            cover ±3°). 5° makes them cover ±15°, the protocol's largest angle offset ("The
+            angle difference in this scenario ranges from 0 to 15 degrees").
+        rotation_correction: after a simplex run, correct the heading by the histogram's rotation
+            offset (Sec. 4.3's transfer "to the same coordinate system"; default ``True``) or
+            keep the best of the seven orientations only (``False``).
+        heading_clamp: the largest heading change (radians) from the initial heading the outer
+            iterations may make. Default ``inf`` (unbounded, as written: Eq. 2's Δθ = Σ δθ_k has
+            no bound). A finite value reads "the angle of each of these three vertices is
+            examined locally" as a bound; the protocol's largest initial angle offset is 15°.
+        simplex_size: initial simplex size (metres). "Three points are chosen at random in an
+            arbitrary interval in the beginning. The maximum value of the robot position
+            difference should be covered by this interval." Literal default: a fixed 1 m; the
+            covering reading is the protocol's largest offset, 3 m ("The difference in the
+            position ... ranges from 0 to 300 cm").
+        keep_best: across outer iterations, return the pose of lowest Err (``True``) or the last
+            pose (``False``, default). Alg. 5 keeps the best within one run ("B ← find the point
+            among B, NB and W with minimum error"); of the repetition the text says only "This
+            operation is iterated by the algorithm until a suitable fixation between the two
+            positions is found", which leaves the answer of the last iteration.
+        err_threshold: Eq. 13's threshold on Err (radians; radians × unit length for ``l1``).
         xy_tol: simplex size (metres) and outer-iteration move below which the search stops.
         theta_tol: outer-iteration heading change (radians) below which the search stops.
         max_iterations: simplex iterations per outer iteration.
@@ -91,6 +146,21 @@ class TfConfig:
     max_outer: int = 8
     penalty: float = 1e3
     seed: int = 0
+    err_norm: str = "l2"
+    resampling: str = "chord"
+    rotation_correction: bool = True
+    heading_clamp: float = math.inf
+    keep_best: bool = False
+
+    def __post_init__(self) -> None:
+        if self.err_norm not in _NORMS:
+            raise ParameterError(f"tf: err_norm must be one of {_NORMS}, not {self.err_norm!r}")
+        if self.resampling not in _RESAMPLINGS:
+            raise ParameterError(f"tf: resampling must be one of {_RESAMPLINGS}, not {self.resampling!r}")
+        if not self.spacing > 0:
+            raise ParameterError(f"tf: spacing must be > 0 metres, not {self.spacing!r}")
+        if not self.heading_clamp > 0:
+            raise ParameterError(f"tf: heading_clamp must be > 0 radians (inf = unbounded), not {self.heading_clamp!r}")
 
 
 def scan_corners(ranges: np.ndarray, laser: LaserSpec, config: TfConfig = TfConfig()) -> np.ndarray:
@@ -99,6 +169,9 @@ def scan_corners(ranges: np.ndarray, laser: LaserSpec, config: TfConfig = TfConf
     No-return beams are dropped and their neighbours joined (see module notes).
     """
     pts = laser.to_points(ranges)
+    if config.resampling == "path":
+        return shortstraw(pts, config.spacing, config.window, config.straw_t, config.line_threshold,
+                          along_path=True)
     return shortstraw(pts, config.spacing, config.window, config.straw_t, config.line_threshold)
 
 
@@ -118,6 +191,13 @@ def scan_turning_function(ranges: np.ndarray, laser: LaserSpec,
         return None
 
 
+def _match(config: TfConfig) -> Callable[[TurningFunction, TurningFunction], Match]:
+    return match_l1 if config.err_norm == "l1" else match
+
+
+_FUSED = True  # one compiled call per batch (tests switch it off to compare with the oracles)
+
+
 @dataclass
 class _Cost:
     """Cost evaluations of one problem (Eq. 13 with the seven-orientation check), cached by position."""
@@ -127,6 +207,30 @@ class _Cost:
     real: TurningFunction
     evaluations: int = 0
     cache: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        cfg, laser = self.config, self.problem.laser
+        n = cfg.n_orientations
+        self._offsets = (np.arange(n) - (n - 1) / 2) * cfg.orientation_step
+        self._kernel_args = (  # everything scan_errors needs after the scans, converted once
+            laser.directions, float(laser.max_range), float(cfg.spacing), int(cfg.window),
+            float(cfg.straw_t), float(cfg.line_threshold), bool(cfg.close_through_origin),
+            cfg.resampling == "path", cfg.err_norm == "l1", self.real.breaks, self.real.angles,
+            float(cfg.penalty))
+
+    def _scan_errors(self, scans: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Err and rotation offset (radians, in [-π, π)) of each virtual scan ``(P, n_beams)``."""
+        if _FUSED:
+            return scan_errors(scans, *self._kernel_args)
+        cfg, laser = self.config, self.problem.laser
+        errs, rots = np.full(len(scans), cfg.penalty), np.zeros(len(scans))
+        distance = _match(cfg)
+        for j, ranges in enumerate(scans):
+            tf_v = scan_turning_function(ranges, laser, cfg)
+            if tf_v is not None:
+                m = distance(self.real, tf_v)
+                errs[j], rots[j] = m.distance, m.rotation
+        return errs, rots
 
     def errors(self, poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Err and rotation offset (radians) at each of ``(N, 3)`` poses (one batched raycast)."""
@@ -139,12 +243,7 @@ class _Cost:
         else:
             free = prob.map.is_free(xy)
         if free.any():
-            scans = prob.map.raycast(poses[free], prob.laser)
-            for j, ranges in zip(np.flatnonzero(free), scans, strict=True):
-                tf_v = scan_turning_function(ranges, prob.laser, cfg)
-                if tf_v is not None:
-                    m = match(self.real, tf_v)
-                    errs[j], rots[j] = m.distance, m.rotation
+            errs[free], rots[free] = self._scan_errors(prob.map.raycast(poses[free], prob.laser))
         self.evaluations += len(poses)
         return errs, rots
 
@@ -153,14 +252,21 @@ class _Cost:
 
         Returns (Err, heading of the best orientation, its rotation offset)."""
         key = (float(xy[0]), float(xy[1]))
-        if key not in self.cache:
-            k = np.arange(self.config.n_orientations) - (self.config.n_orientations - 1) / 2
-            th = theta_v + k * self.config.orientation_step
-            poses = np.column_stack((np.full_like(th, xy[0]), np.full_like(th, xy[1]), th))
-            errs, rots = self.errors(poses)
-            b = int(np.argmin(errs))
-            self.cache[key] = (float(errs[b]), float(th[b]), float(rots[b]))
-        return self.cache[key]
+        hit = self.cache.get(key)
+        if hit is None:
+            th = theta_v + self._offsets
+            poses = np.empty((len(th), 3))
+            poses[:, 0], poses[:, 1], poses[:, 2] = key[0], key[1], th
+            prob = self.problem
+            if prob.map.is_free(poses[:1, :2])[0]:  # the orientations share one position
+                errs, rots = self._scan_errors(prob.map.raycast(poses, prob.laser))
+                b = int(np.argmin(errs))
+                hit = (float(errs[b]), float(th[b]), float(rots[b]))
+            else:
+                hit = (float(self.config.penalty), float(th[0]), 0.0)
+            self.evaluations += len(th)
+            self.cache[key] = hit
+        return hit
 
 
 def simplex(cost: _Cost, start: Pose, size: float, rng: np.random.Generator) -> tuple[np.ndarray, int]:
@@ -204,6 +310,17 @@ class TurningFunctionMatcher:
     def __init__(self, config: TfConfig | None = None, **overrides) -> None:
         self.config = resolve_params(TfConfig, config, overrides)
 
+    def heading(self, best: float, rot: float, initial: float) -> float:
+        """The heading after an outer iteration (radians): the best of the seven orientations,
+        corrected by the rotation offset ``rot`` (if ``rotation_correction``), kept within
+        ``heading_clamp`` of the ``initial`` heading."""
+        cfg = self.config
+        theta = float(wrap_angle(best - rot)) if cfg.rotation_correction else best
+        if math.isfinite(cfg.heading_clamp):
+            change = min(max(float(wrap_angle(theta - initial)), -cfg.heading_clamp), cfg.heading_clamp)
+            theta = float(wrap_angle(initial + change))
+        return theta
+
     def localize(self, problem: Problem) -> Estimate:
         cfg = self.config
         real = scan_turning_function(problem.ranges, problem.laser, cfg)
@@ -214,18 +331,23 @@ class TurningFunctionMatcher:
         rng = np.random.default_rng(cfg.seed)
         pose, size, iters, converged = problem.initial, cfg.simplex_size, 0, False
         err, outer = cost.function1(pose.xy, pose.theta)[0], 0
+        best: tuple[float, Pose] | None = None
         while outer < cfg.max_outer:
             outer += 1
             xy, n = simplex(cost, pose, size, rng)
             iters += n
             err, heading, rot = cost.function1(xy, pose.theta)
-            new = Pose(float(xy[0]), float(xy[1]), float(wrap_angle(heading - rot)))
+            new = Pose(float(xy[0]), float(xy[1]), self.heading(heading, rot, problem.initial.theta))
+            if best is None or err < best[0]:
+                best = (err, new)
             moved, turned = new.distance_to(pose), abs(wrap_angle(new.theta - pose.theta))
             pose, size = new, max(size / 2.0, 10 * cfg.xy_tol)
             cost.cache.clear()
             if err <= cfg.err_threshold or (moved < cfg.xy_tol and turned < cfg.theta_tol):
                 converged = True
                 break
+        if cfg.keep_best and best is not None:
+            err, pose = best
         return Estimate(pose, converged, iters, cost.evaluations,
                         {"err": float(err), "outer": outer, "corners": int(real.n_edges)})
 

@@ -159,14 +159,17 @@ def success_by(p: pd.DataFrame, col: str, unit: str) -> str:
 
 
 def outcomes(g: pd.DataFrame) -> str:
-    """Outcome counts and shares per matcher."""
+    """Outcome counts and shares per matcher, and where failed searches ended: near the truth
+    (≤ 30 cm, ≤ 5°: a stall in the basin) or farther from it than they started (diverged)."""
     extra = int(g["n_unscored"].sum()) > 0
     rows = []
     for _, m in g.iterrows():
         cells = [f"{int(m['n_' + o.replace('-', '_')])} ({num(m['share_' + o.replace('-', '_') + '_pct'], 1)} %)"
                  for o in OUTCOMES]
-        rows.append([f"`{m['matcher']}`", int(m["n_truth"]), *cells] + ([int(m["n_unscored"])] if extra else []))
-    return table(["Matcher", "n", *OUTCOMES] + (["unscored"] if extra else []), rows)
+        rows.append([f"`{m['matcher']}`", int(m["n_truth"]), *cells] + ([int(m["n_unscored"])] if extra else [])
+                    + [int(m["n_near"]), int(m["n_diverged"])])
+    return table(["Matcher", "n", *OUTCOMES] + (["unscored"] if extra else [])
+                 + ["failed near the truth", "diverged"], rows)
 
 
 def scan_to_scan(g: pd.DataFrame) -> str:
