@@ -7,6 +7,7 @@ import pytest
 from _baseline_cases import OFFSETS, errors, make_problem
 
 import tfloc
+from baselines._corner_kernels import inlier_counts
 from baselines._corner_match import best_hypothesis, pair_hypotheses
 from baselines._corner_refine import refine_corners
 from baselines.cv_corners import CvCornersMatcher
@@ -68,3 +69,53 @@ def test_refine_corners_moves_a_corner_onto_the_wall_intersection() -> None:
     fine = refine_corners(rough, pts)
     assert np.linalg.norm(fine[1] - (2.0, 0.0)) < 0.01 < np.linalg.norm(rough[1] - (2.0, 0.0))
     assert np.allclose(fine[[0, 2]], rough[[0, 2]])
+
+
+def _all_pairs_reference(a: np.ndarray, b: np.ndarray, tol: float, min_len: float, max_angle: float,
+                         max_shift: float) -> set[tuple[float, float, float]]:
+    """The former all-ordered-pairs search, written plainly: every hypothesis, rounded to 1e-9."""
+    out = set()
+    for i in range(len(a)):
+        for j in range(len(a)):
+            for k in range(len(b)):
+                for m in range(len(b)):
+                    if i == j or k == m:
+                        continue
+                    va, vb = a[j] - a[i], b[m] - b[k]
+                    la, lb = np.hypot(*va), np.hypot(*vb)
+                    if la < min_len or lb < min_len or abs(la - lb) > tol:
+                        continue
+                    th = (np.arctan2(vb[1], vb[0]) - np.arctan2(va[1], va[0]) + np.pi) % (2 * np.pi) - np.pi
+                    c, s = np.cos(th), np.sin(th)
+                    ma, mb = a[i] + 0.5 * va, b[k] + 0.5 * vb
+                    t = mb - np.array([c * ma[0] - s * ma[1], s * ma[0] + c * ma[1]])
+                    if abs(th) <= max_angle and np.hypot(*t) <= max_shift:
+                        out.add((round(th, 9), round(t[0], 9), round(t[1], 9)))
+    return out
+
+
+def test_pair_hypotheses_are_the_distinct_all_pairs_hypotheses() -> None:
+    """Taking each pair of ``a`` once loses no hypothesis: the reversed pair onto the reversed
+    pair of ``b`` is the same transform. The set equals the former ordered × ordered search's."""
+    rng = np.random.default_rng(11)
+    a = rng.uniform(-3, 3, (9, 2))
+    b = np.vstack((a[:7] @ np.array([[0.98, -0.2], [0.2, 0.98]]).T + (0.3, -0.2), rng.uniform(-3, 3, (3, 2))))
+    hyp = pair_hypotheses(a, b, 0.15, 0.5, np.radians(25), 4.0)
+    got = {(round(th, 9), round(x, 9), round(y, 9)) for th, (x, y) in zip(hyp.theta, hyp.t, strict=True)}
+    assert len(got) == hyp.theta.size > 10  # no duplicates left
+    assert got == _all_pairs_reference(a, b, 0.15, 0.5, np.radians(25), 4.0)
+
+
+def test_best_hypothesis_counts_match_a_dense_reference() -> None:
+    """The numba inlier count equals mutual nearest neighbours on the full distance matrix."""
+    rng = np.random.default_rng(4)
+    a, b = rng.uniform(-3, 3, (12, 2)), rng.uniform(-3, 3, (10, 2))
+    hyp = pair_hypotheses(a, b, 0.3, 0.5, np.radians(25), 4.0)
+    count, _ = inlier_counts(hyp.theta, hyp.t, a, b, 0.4)
+    for h in range(hyp.theta.size):
+        c, s = np.cos(hyp.theta[h]), np.sin(hyp.theta[h])
+        moved = a @ np.array([[c, -s], [s, c]]).T + hyp.t[h]
+        d = np.linalg.norm(moved[:, None] - b[None], axis=-1)
+        ref = sum(d[i].argmin() == k and d[:, k].argmin() == i and d[i, k] <= 0.4
+                  for i in range(len(a)) for k in [d[i].argmin()])
+        assert count[h] == ref
