@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._corner_kernels import inlier_counts, pair_transforms
+from ._corner_kernels import adaptive_search, inlier_counts, pair_transforms
 
 
 @dataclass(frozen=True)
@@ -91,3 +91,39 @@ def best_hypothesis(a: np.ndarray, b: np.ndarray, hyp: Hypotheses, tol: float) -
     h = int(np.lexsort((resid, -count))[0])
     partner, dist = mutual_inliers(hyp.theta[h:h + 1], hyp.t[h:h + 1], a, b, tol)
     return h, partner[0], dist[0]
+
+
+@dataclass(frozen=True)
+class Search:
+    """The best rigid transform ``b ≈ R(theta) a + t`` of :func:`search_hypotheses` (radians,
+    metres), its one-to-one inliers, and what the search cost: transforms scored, pairs of ``a``
+    drawn, of ``pairs`` in all."""
+
+    theta: float
+    t: np.ndarray
+    inliers: int
+    scored: int
+    drawn: int
+    pairs: int
+
+
+def search_hypotheses(a: np.ndarray, b: np.ndarray, length_tol: float, min_length: float, max_angle: float,
+                      max_shift: float, tol: float, confidence: float, max_hypotheses: int,
+                      seed: int = 0) -> Search | None:
+    """The hypotheses of :func:`pair_hypotheses`, scored as :func:`best_hypothesis` does, but
+    drawn pair by pair of ``a`` in a seeded random order and stopped as adaptive RANSAC does: once
+    a pair supporting the best match so far would have been drawn with probability
+    ``confidence`` (``confidence`` = 1: every pair), or after ``max_hypotheses`` scored transforms.
+    ``None`` when no transform lies in the window."""
+    a, b = np.ascontiguousarray(a, dtype=float), np.ascontiguousarray(b, dtype=float)
+    la, anga, ma = _pairs(a, False, min_length)
+    lb, angb, mb = _pairs(b, True, min_length)
+    order = np.argsort(lb, kind="stable")
+    draw = np.random.default_rng(seed).permutation(la.size)
+    theta, tx, ty, inliers, scored, drawn = adaptive_search(
+        a, b, la, anga, np.ascontiguousarray(ma), draw, lb[order], angb[order], np.ascontiguousarray(mb[order]),
+        float(min_length), float(length_tol), float(max_angle), float(max_shift), float(tol),
+        float(confidence), int(max_hypotheses))
+    if scored == 0:
+        return None
+    return Search(float(theta), np.array([tx, ty]), int(inliers), int(scored), int(drawn), int(la.size))

@@ -62,8 +62,9 @@ from tfloc.problem import Estimate, Problem
 from tfloc.tf import TfConfig, scan_corners
 
 from ._config import resolve_config
-from ._corner_match import best_hypothesis, mutual_inliers, pair_hypotheses
+from ._corner_match import mutual_inliers, search_hypotheses
 from ._corner_refine import refine_corners
+from ._corner_thin import drop_straight_corners
 
 
 @dataclass(frozen=True)
@@ -71,12 +72,16 @@ class Config:
     """Parameters of :class:`CvCornersMatcher` (metres, degrees where named)."""
 
     corner_spacing: float = 0.02
+    corner_window: int = 1
+    straight_tol: float = 0.0
     refine_corners: bool = True
     length_tol: float = 0.15
     min_pair_length: float = 0.5
     max_angle_deg: float = 25.0
     max_shift: float = 4.0
     max_hypotheses: int = 5000
+    confidence: float = 1.0
+    seed: int = 0
     inlier_tol: float = 0.20
     fine_tol: float = 0.03
     ransac_max_iters: int = 2000
@@ -98,15 +103,18 @@ class CvCornersMatcher:
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
         self.config = resolve_config(Config, config, overrides)
-        self._tf_config = TfConfig(spacing=self.config.corner_spacing)
+        self._tf_config = TfConfig(spacing=self.config.corner_spacing, window=self.config.corner_window)
 
     def _corners(self, ranges: np.ndarray, problem: Problem) -> np.ndarray:
         if int(problem.laser.valid(ranges).sum()) < 2:
             return np.empty((0, 2))
         with np.errstate(invalid="ignore"):  # LaserSpec.to_points computes inf·cos(±90°) before masking
             corners = np.asarray(scan_corners(ranges, problem.laser, self._tf_config), dtype=float).reshape(-1, 2)
+            points = problem.laser.to_points(ranges)
+            if self.config.straight_tol > 0:
+                corners = drop_straight_corners(corners, points, self.config.straight_tol)
             if self.config.refine_corners:
-                corners = refine_corners(corners, problem.laser.to_points(ranges))
+                corners = refine_corners(corners, points)
         return corners
 
     def _step(self, real: np.ndarray, problem: Problem, pose: Pose, first: bool) -> tuple[Pose, dict]:
@@ -116,11 +124,11 @@ class CvCornersMatcher:
         if len(real) < 2 or len(virtual) < 2:
             raise _NoAnswer(f"too few corners (real {len(real)}, virtual {len(virtual)})")
         # The window bounds the correction of this step, relative to ``pose``.
-        hyp = pair_hypotheses(real, virtual, c.length_tol, c.min_pair_length,
-                              math.radians(c.max_angle_deg), c.max_shift, c.max_hypotheses)
-        if hyp.theta.size == 0:
+        found = search_hypotheses(real, virtual, c.length_tol, c.min_pair_length, math.radians(c.max_angle_deg),
+                                  c.max_shift, c.inlier_tol, c.confidence, c.max_hypotheses, c.seed)
+        if found is None:
             raise _NoAnswer("no corner pairs of agreeing length")
-        _, partner, _ = best_hypothesis(real, virtual, hyp, c.inlier_tol)
+        partner = mutual_inliers(np.array([found.theta]), found.t[None], real, virtual, c.inlier_tol)[0][0]
         src = real[partner >= 0]
         dst = virtual[partner[partner >= 0]]
         if len(src) < 2:
@@ -138,7 +146,8 @@ class CvCornersMatcher:
         # Real sensor frame → virtual sensor frame (at ``pose``): the robot is at pose ⊕ that.
         new = pose.compose(Pose(float(m[0, 2]), float(m[1, 2]), theta))
         return new, {"corners_real": int(len(real)), "corners_virtual": int(len(virtual)),
-                     "hypotheses": int(hyp.theta.size), "inliers": int(mask.sum()), "scale": float(scale)}
+                     "hypotheses": found.scored, "pairs_drawn": found.drawn, "pairs": found.pairs,
+                     "inliers": int(mask.sum()), "scale": float(scale)}
 
     def localize(self, problem: Problem) -> Estimate:
         """Match corners, refine with OpenCV, re-simulate at the estimate and repeat."""

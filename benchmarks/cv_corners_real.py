@@ -28,12 +28,23 @@ import numpy as np
 
 import tfloc
 from tfloc import Problem, angdiff
+from tfloc.errors import TflocError
 from tfloc.harness.dataset import map_for, read_scans, read_scenario
 
 
 def _rows(spec: str) -> slice:
     lo, _, hi = spec.partition(":")
     return slice(int(lo) if lo else None, int(hi) if hi else None)
+
+
+def _summary(rows: list[dict]) -> str:
+    """n, success rate, CPU ms median / p95 / max over the timed rows (invalid problems are failures, untimed)."""
+    ms = np.array([r["cpu_ms"] for r in rows if not math.isnan(r["cpu_ms"])])
+    invalid = sum(r["status"] == "invalid" for r in rows)
+    cpu = (f"cpu ms median={np.median(ms):8.1f} p95={np.percentile(ms, 95):8.1f} max={ms.max():8.1f}"
+           if ms.size else "cpu ms -")
+    return (f"n={len(rows):3d} success={np.mean([r['success'] for r in rows]):6.1%} {cpu}"
+            + (f" ({invalid} invalid)" if invalid else ""))
 
 
 def main() -> None:
@@ -65,7 +76,13 @@ def main() -> None:
                 continue
             chosen = scans[sl][:: args.step]
             for scan in chosen:
-                problem = Problem(map_for(scenario, scan, cache), scenario.laser, scan.ranges, scan.initial)
+                try:
+                    problem = Problem(map_for(scenario, scan, cache), scenario.laser, scan.ranges, scan.initial)
+                except TflocError as exc:  # e.g. an odometry guess outside the reference scan's area
+                    out_rows.append({"dataset": scenario.name, "group": group, "scan_id": scan.scan_id,
+                                     "cpu_ms": math.nan, "dist_err_m": math.nan, "orient_err_deg": math.nan,
+                                     "success": 0, "status": "invalid", "iterations": 0, "info": str(exc)})
+                    continue
                 t0 = time.process_time()
                 est = matcher.localize(problem)
                 cpu_ms = 1e3 * (time.process_time() - t0)
@@ -79,13 +96,8 @@ def main() -> None:
                                  "info": json.dumps(est.info, default=str, separators=(",", ":"))})
             rows = [r for r in out_rows if r["dataset"] == scenario.name and r["group"] == group]
             if rows:
-                ms = np.array([r["cpu_ms"] for r in rows])
-                print(f"{scenario.name:24s} {group:6s} n={len(rows):3d} success={np.mean([r['success'] for r in rows]):6.1%} "
-                      f"cpu ms median={np.median(ms):8.1f} p95={np.percentile(ms, 95):8.1f} max={ms.max():8.1f}",
-                      flush=True)
-    ms = np.array([r["cpu_ms"] for r in out_rows])
-    print(f"{'all':31s} n={len(out_rows):3d} success={np.mean([r['success'] for r in out_rows]):6.1%} "
-          f"cpu ms median={np.median(ms):8.1f} p95={np.percentile(ms, 95):8.1f} max={ms.max():8.1f}")
+                print(f"{scenario.name:24s} {group:6s} {_summary(rows)}", flush=True)
+    print(f"{'all':31s} {_summary(out_rows)}")
     if args.out:
         with args.out.open("w", newline="") as fh:
             w = csv.DictWriter(fh, fieldnames=list(out_rows[0]))

@@ -8,7 +8,7 @@ from _baseline_cases import OFFSETS, errors, make_problem
 
 import tfloc
 from baselines._corner_kernels import inlier_counts
-from baselines._corner_match import best_hypothesis, pair_hypotheses
+from baselines._corner_match import best_hypothesis, pair_hypotheses, search_hypotheses
 from baselines._corner_refine import refine_corners
 from baselines.cv_corners import CvCornersMatcher
 from tfloc import Problem
@@ -106,16 +106,37 @@ def test_pair_hypotheses_are_the_distinct_all_pairs_hypotheses() -> None:
     assert got == _all_pairs_reference(a, b, 0.15, 0.5, np.radians(25), 4.0)
 
 
-def test_best_hypothesis_counts_match_a_dense_reference() -> None:
-    """The numba inlier count equals mutual nearest neighbours on the full distance matrix."""
-    rng = np.random.default_rng(4)
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("tol", [0.05, 0.4, 1.5])
+def test_inlier_counts_match_a_dense_reference(seed: int, tol: float) -> None:
+    """The grid-based numba count equals mutual nearest neighbours on the full distance matrix,
+    also for moved corners beyond the virtual corners' extent."""
+    rng = np.random.default_rng(seed)
     a, b = rng.uniform(-3, 3, (12, 2)), rng.uniform(-3, 3, (10, 2))
     hyp = pair_hypotheses(a, b, 0.3, 0.5, np.radians(25), 4.0)
-    count, _ = inlier_counts(hyp.theta, hyp.t, a, b, 0.4)
+    count, resid = inlier_counts(hyp.theta, hyp.t, a, b, tol)
     for h in range(hyp.theta.size):
         c, s = np.cos(hyp.theta[h]), np.sin(hyp.theta[h])
         moved = a @ np.array([[c, -s], [s, c]]).T + hyp.t[h]
         d = np.linalg.norm(moved[:, None] - b[None], axis=-1)
-        ref = sum(d[i].argmin() == k and d[:, k].argmin() == i and d[i, k] <= 0.4
-                  for i in range(len(a)) for k in [d[i].argmin()])
-        assert count[h] == ref
+        pairs = [(i, k) for i in range(len(a)) for k in [d[i].argmin()] if d[:, k].argmin() == i and d[i, k] <= tol]
+        assert count[h] == len(pairs)
+        assert resid[h] == pytest.approx(sum(d[i, k] for i, k in pairs))
+
+
+def test_adaptive_search_finds_the_best_match_of_the_exhaustive_search() -> None:
+    """Drawing pairs in random order with the adaptive stop (and without it) ends on a match with
+    as many inliers as scoring every hypothesis, and scores fewer hypotheses with the stop."""
+    rng = np.random.default_rng(8)
+    a = rng.uniform(-5, 5, (40, 2))
+    theta, t = 0.15, np.array([0.6, -0.3])
+    c, s = np.cos(theta), np.sin(theta)
+    b = np.vstack((a[:30] @ np.array([[c, -s], [s, c]]).T + t + rng.normal(0, 0.01, (30, 2)),
+                   rng.uniform(-5, 5, (15, 2))))
+    hyp = pair_hypotheses(a, b, 0.15, 0.5, np.radians(25), 4.0, max_hypotheses=10**9)
+    _, partner, _ = best_hypothesis(a, b, hyp, 0.2)
+    full = search_hypotheses(a, b, 0.15, 0.5, np.radians(25), 4.0, 0.2, 1.0, 10**9)
+    fast = search_hypotheses(a, b, 0.15, 0.5, np.radians(25), 4.0, 0.2, 0.999, 10**9)
+    assert full.scored == hyp.theta.size and full.inliers == (partner >= 0).sum() >= 30
+    assert fast.inliers == full.inliers and fast.scored < hyp.theta.size / 10
+    assert abs(fast.theta - theta) < 0.01 and np.linalg.norm(fast.t - t) < 0.05
