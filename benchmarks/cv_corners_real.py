@@ -97,6 +97,9 @@ def main() -> None:
             rows = [r for r in out_rows if r["dataset"] == scenario.name and r["group"] == group]
             if rows:
                 print(f"{scenario.name:24s} {group:6s} {_summary(rows)}", flush=True)
+        rows = [r for r in out_rows if r["dataset"] == scenario.name]
+        if rows:
+            print(f"{scenario.name:24s} {'(all)':6s} {_summary(rows)}", flush=True)
     print(f"{'all':31s} {_summary(out_rows)}")
     if args.out:
         with args.out.open("w", newline="") as fh:
