@@ -118,6 +118,8 @@ def search_hypotheses(a: np.ndarray, b: np.ndarray, length_tol: float, min_lengt
     a, b = np.ascontiguousarray(a, dtype=float), np.ascontiguousarray(b, dtype=float)
     la, anga, ma = _pairs(a, False, min_length)
     lb, angb, mb = _pairs(b, True, min_length)
+    if la.size == 0 or lb.size == 0:
+        return None
     order = np.argsort(lb, kind="stable")
     draw = np.random.default_rng(seed).permutation(la.size)
     theta, tx, ty, inliers, scored, drawn = adaptive_search(
