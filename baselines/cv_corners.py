@@ -3,7 +3,7 @@
 Inputs are the map, the laser spec, the real scan and the initial pose (never the truth).
 Configuration choices and why:
 
-* **Corners by the same code path as** ``tf``: ``tfloc.paper.matcher.scan_corners`` (ShortStraw, Alg. 1–3)
+* **Corners by the same code path as** ``tf``: ``tfloc.paper.shape.scan_corners`` (ShortStraw, Alg. 1–3)
   on the real scan and on the virtual scan ray-cast from the current pose estimate (at first the
   initial pose). The virtual scan, not the map's vertices, so that both corner sets come from the
   same detector and see the same occlusions; it works for any map (vector or grid). The one
@@ -115,7 +115,7 @@ import numpy as np
 from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose, angdiff, wrap_angle
 from tfloc.core.problem import Estimate, Problem
-from tfloc.paper.matcher import TfConfig, scan_corners
+from tfloc.paper.shape import ShapeConfig, scan_corners
 
 from ._corner_match import mutual_inliers, search_hypotheses
 from ._corner_refine import refine_corners
@@ -157,13 +157,13 @@ class CvCornersMatcher:
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
         self.config = resolve_params(Config, config, overrides)
-        self._tf_config = TfConfig(spacing=self.config.corner_spacing)
+        self._shape = ShapeConfig(spacing=self.config.corner_spacing)
 
     def _corners(self, ranges: np.ndarray, problem: Problem) -> np.ndarray:
         if int(problem.laser.valid(ranges).sum()) < 2:
             return np.empty((0, 2))
         with np.errstate(invalid="ignore"):  # LaserSpec.to_points computes inf·cos(±90°) before masking
-            corners = np.asarray(scan_corners(ranges, problem.laser, self._tf_config), dtype=float).reshape(-1, 2)
+            corners = np.asarray(scan_corners(ranges, problem.laser, self._shape), dtype=float).reshape(-1, 2)
             points = problem.laser.to_points(ranges)
             if self.config.straight_tol > 0:
                 corners = drop_straight_corners(corners, points, self.config.straight_tol)

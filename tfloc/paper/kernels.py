@@ -4,7 +4,7 @@ One call takes the virtual scans of a batch of poses (the seven orientations of 
 Function1) and returns Err and the rotation offset for each: ranges → points (Eq. 4) →
 ShortStraw corners (Algs. 1–3) → closed scan polygon → turning function (Alg. 4) → matching
 against the real scan's turning function (Sec. 4.3 / Eq. 13). It runs exactly the compiled
-kernels that the step-by-step path (:func:`tfloc.paper.matcher.scan_turning_function`, :func:`tfloc.paper.turning.match`)
+kernels that the step-by-step path (:func:`tfloc.paper.shape.scan_turning_function`, :func:`tfloc.paper.turning.match`)
 calls one by one from Python, in the same order with the same arithmetic, so both give identical
 results (tests/test_perf_tf_equivalence.py); only the Python overhead per pose is gone.
 """

@@ -16,7 +16,8 @@ import numpy as np
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Problem
 
-from .matcher import TfConfig, _Cost, scan_turning_function
+from .matcher import TfConfig, _Cost
+from .shape import scan_turning_function
 
 
 @dataclass(frozen=True, eq=False)
@@ -41,7 +42,7 @@ def err_landscape(problem: Problem, centre: Pose, half_width_m: float = 1.0, n: 
     around ``centre``, all at ``centre.theta``. Raises ``ValueError`` if the real scan's polygon
     is degenerate. ``config`` defaults to the literal ``TfConfig()``."""
     config = config or TfConfig()
-    real = scan_turning_function(problem.ranges, problem.laser, config)
+    real = scan_turning_function(problem.ranges, problem.laser, config.shape)
     if real is None:
         raise ValueError("the real scan's polygon has fewer than 3 edges")
     xs = centre.x + np.linspace(-half_width_m, half_width_m, n)

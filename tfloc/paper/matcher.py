@@ -52,21 +52,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tfloc.core.laser import LaserSpec
 from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose, wrap_angle
 from tfloc.core.problem import Estimate, Problem
 from tfloc.errors import ParameterError
 
-from .corners import shortstraw
 from .kernels import scan_errors
-from .turning import Match, TurningFunction, match, match_l1, turning_function
-
-_ORIGIN = np.zeros((1, 2))
-
+from .shape import ShapeConfig, scan_turning_function
+from .turning import Match, TurningFunction, match, match_l1
 
 _NORMS = ("l2", "l1")
-_RESAMPLINGS = ("chord", "path")
 
 
 @dataclass(frozen=True)
@@ -75,25 +70,9 @@ class TfConfig:
     otherwise the literal reading of ``main`` (the switches below name the alternatives).
 
     Attributes:
-        spacing: S of Alg. 1, the resampling distance, in **metres**. Alg. 1 sets "S ← 1" without
-            a unit, and "P3 is located exactly S Euclidian distance away from the P1"; the data
-            are in metres (the LMS200's "range of 10 m"), so the literal value is 1 m. Algs. 1
-            and 3 square their distances, which is self-consistent only at S = 1 (see
-            :mod:`tfloc.paper.corners` for how the squares are read), so other values are a reading.
-        window: w of Alg. 2 ("ω is a static window with a length of one (ω=1)"; ShortStraw's
-            authors use 3).
-        straw_t: t of Alg. 2 (0.99).
-        line_threshold: Is-Line threshold of Alg. 3 (0.95).
-        resampling: how Alg. 1 steps: ``"chord"`` (its formula ``P3 ← P1 + (P2 − P1)/D·S``, from
-            the last emitted point towards the next input point; default) or ``"path"`` (its
-            sentence "P3 is located exactly S Euclidian distance away from the P1 in the slop
-            direction of the straight line from P(i−1) to P(i)", read as the original
-            ShortStraw's walk along the path through P(i−1), P(i)).
-        close_through_origin: how the scan polygon is closed. Alg. 4 closes it from the last
-            corner to the first ("if i = Corners then Vector(i) ← Corners(1) − Corners(i)",
-            ``False``); ``True`` (default) closes it through the sensor origin, which keeps the
-            polygon of a 180° scan simple and counter-clockwise ("Vectors are create in
-            counterclockwise direction").
+        spacing, window, straw_t, line_threshold, resampling, close_through_origin: how a scan
+            becomes a polygon (Algs. 1–4), :class:`tfloc.paper.shape.ShapeConfig` (the readings
+            of the text, quoted there); :attr:`shape` collects them.
         err_norm: Err. ``"l2"`` (default): Eq. 13, "Err = (∫₀¹ |Θ_R(L) − Θ_V(L)|² dL)^½";
             ``"l1"``: Sec. 4.3, "The area between the two graphs is then computed. Rectangles are
             created between two graphs because they are in the form of histograms. Each
@@ -152,43 +131,18 @@ class TfConfig:
     heading_clamp: float = math.inf
     keep_best: bool = False
 
+    @property
+    def shape(self) -> ShapeConfig:
+        """The parameters of the scan's shape (Algs. 1–4)."""
+        return ShapeConfig(self.spacing, self.window, self.straw_t, self.line_threshold,
+                           self.resampling, self.close_through_origin)
+
     def __post_init__(self) -> None:
         if self.err_norm not in _NORMS:
             raise ParameterError(f"tf: err_norm must be one of {_NORMS}, not {self.err_norm!r}")
-        if self.resampling not in _RESAMPLINGS:
-            raise ParameterError(f"tf: resampling must be one of {_RESAMPLINGS}, not {self.resampling!r}")
-        if not self.spacing > 0:
-            raise ParameterError(f"tf: spacing must be > 0 metres, not {self.spacing!r}")
+        self.shape  # noqa: B018 - validates the shape parameters
         if not self.heading_clamp > 0:
             raise ParameterError(f"tf: heading_clamp must be > 0 radians (inf = unbounded), not {self.heading_clamp!r}")
-
-
-def scan_corners(ranges: np.ndarray, laser: LaserSpec, config: TfConfig = TfConfig()) -> np.ndarray:
-    """ShortStraw corners of one scan, ``(K, 2)`` in the sensor frame (metres).
-
-    No-return beams are dropped and their neighbours joined (see module notes).
-    """
-    pts = laser.to_points(ranges)
-    if config.resampling == "path":
-        return shortstraw(pts, config.spacing, config.window, config.straw_t, config.line_threshold,
-                          along_path=True)
-    return shortstraw(pts, config.spacing, config.window, config.straw_t, config.line_threshold)
-
-
-def scan_polygon(corners: np.ndarray, config: TfConfig = TfConfig()) -> np.ndarray:
-    """The closed scan polygon of a scan's corners (through the sensor origin if configured)."""
-    if config.close_through_origin:
-        return np.concatenate((_ORIGIN, corners))
-    return corners
-
-
-def scan_turning_function(ranges: np.ndarray, laser: LaserSpec,
-                          config: TfConfig = TfConfig()) -> TurningFunction | None:
-    """Turning function of a scan, or ``None`` if its polygon is degenerate (< 3 edges)."""
-    try:
-        return turning_function(scan_polygon(scan_corners(ranges, laser, config), config))
-    except ValueError:
-        return None
 
 
 def _match(config: TfConfig) -> Callable[[TurningFunction, TurningFunction], Match]:
@@ -226,7 +180,7 @@ class _Cost:
         errs, rots = np.full(len(scans), cfg.penalty), np.zeros(len(scans))
         distance = _match(cfg)
         for j, ranges in enumerate(scans):
-            tf_v = scan_turning_function(ranges, laser, cfg)
+            tf_v = scan_turning_function(ranges, laser, cfg.shape)
             if tf_v is not None:
                 m = distance(self.real, tf_v)
                 errs[j], rots[j] = m.distance, m.rotation
@@ -323,7 +277,7 @@ class TurningFunctionMatcher:
 
     def localize(self, problem: Problem) -> Estimate:
         cfg = self.config
-        real = scan_turning_function(problem.ranges, problem.laser, cfg)
+        real = scan_turning_function(problem.ranges, problem.laser, cfg.shape)
         if real is None:
             return Estimate(problem.initial, False, 0, 0, {"status": "no-answer",
                                                            "reason": "real scan has < 3 polygon edges"})
@@ -353,7 +307,7 @@ class TurningFunctionMatcher:
 
     def score(self, problem: Problem, pose: Pose) -> float:
         """Eq. 13's Err at exactly ``pose`` (no orientation search); ``penalty`` if degenerate."""
-        real = scan_turning_function(problem.ranges, problem.laser, self.config)
+        real = scan_turning_function(problem.ranges, problem.laser, self.config.shape)
         if real is None:
             return float(self.config.penalty)
         return float(_Cost(problem, self.config, real).errors(pose.as_array()[None, :])[0][0])
