@@ -32,17 +32,34 @@ from numba import njit
 
 
 @njit(cache=True, nogil=True)
+def _emit(out: np.ndarray, m: int, x: float, y: float) -> int:
+    """Write point ``m`` into ``out`` (unless ``out`` only counts, shape ``(0, 2)``); the new
+    count, or -1 if ``out`` is full."""
+    if out.shape[0] > 0:
+        if m >= out.shape[0]:
+            return -1
+        out[m, 0], out[m, 1] = x, y
+    return m + 1
+
+
+@njit(cache=True, nogil=True)
+def _emit_last(points: np.ndarray, out: np.ndarray, m: int, lx: float, ly: float, spacing: float) -> int:
+    """Alg. 1's end: the last input point is appended when it lies more than ``spacing/2`` beyond
+    the last emitted point ``(lx, ly)``."""
+    n = points.shape[0]
+    ex, ey = points[n - 1, 0] - lx, points[n - 1, 1] - ly
+    if np.sqrt(ex * ex + ey * ey) > 0.5 * spacing:
+        return _emit(out, m, points[n - 1, 0], points[n - 1, 1])
+    return m
+
+
+@njit(cache=True, nogil=True)
 def _resample_into(points: np.ndarray, spacing: float, out: np.ndarray) -> int:
     """Algorithm 1 written into ``out``; returns the number of points, or -1 if ``out`` is too
     small (``out`` of shape ``(0, 2)`` just counts)."""
     n = points.shape[0]
-    cap = out.shape[0]
-    count_only = cap == 0
-    m = 0
     p1x, p1y = points[0, 0], points[0, 1]
-    if not count_only:
-        out[0, 0], out[0, 1] = p1x, p1y
-    m += 1
+    m = _emit(out, 0, p1x, p1y)
     i = 1
     surely_inside = spacing * spacing * (1.0 - 1e-9)   # d² below this ⇒ d ≤ spacing, no sqrt
     while i < n:
@@ -54,21 +71,12 @@ def _resample_into(points: np.ndarray, spacing: float, out: np.ndarray) -> int:
         d = np.sqrt(d2)
         if d > spacing:
             p1x, p1y = p1x + dx / d * spacing, p1y + dy / d * spacing
-            if not count_only:
-                if m >= cap:
-                    return -1
-                out[m, 0], out[m, 1] = p1x, p1y
-            m += 1
+            m = _emit(out, m, p1x, p1y)
+            if m < 0:
+                return -1
         else:
             i += 1
-    lx, ly = points[n - 1, 0] - p1x, points[n - 1, 1] - p1y
-    if np.sqrt(lx * lx + ly * ly) > 0.5 * spacing:
-        if not count_only:
-            if m >= cap:
-                return -1
-            out[m, 0], out[m, 1] = points[n - 1, 0], points[n - 1, 1]
-        m += 1
-    return m
+    return _emit_last(points, out, m, p1x, p1y, spacing)
 
 
 @njit(cache=True, nogil=True)
@@ -103,13 +111,9 @@ def _resample_path_into(points: np.ndarray, spacing: float, out: np.ndarray) -> 
     """The path walk of :func:`resample_path` written into ``out``; returns the number of points,
     or -1 if ``out`` is too small (``out`` of shape ``(0, 2)`` just counts)."""
     n = points.shape[0]
-    cap = out.shape[0]
-    count_only = cap == 0
     px, py = points[0, 0], points[0, 1]       # where the walk stands (last emitted or input point)
     lx, ly = px, py                           # last emitted point
-    if not count_only:
-        out[0, 0], out[0, 1] = px, py
-    m = 1
+    m = _emit(out, 0, px, py)
     walked = 0.0                              # path length since the last emitted point
     i = 1
     while i < n:
@@ -119,24 +123,15 @@ def _resample_path_into(points: np.ndarray, spacing: float, out: np.ndarray) -> 
             f = (spacing - walked) / d
             px, py = px + f * dx, py + f * dy
             lx, ly = px, py
-            if not count_only:
-                if m >= cap:
-                    return -1
-                out[m, 0], out[m, 1] = px, py
-            m += 1
+            m = _emit(out, m, px, py)
+            if m < 0:
+                return -1
             walked = 0.0
         else:
             walked += d
             px, py = points[i, 0], points[i, 1]
             i += 1
-    ex, ey = points[n - 1, 0] - lx, points[n - 1, 1] - ly
-    if np.sqrt(ex * ex + ey * ey) > 0.5 * spacing:
-        if not count_only:
-            if m >= cap:
-                return -1
-            out[m, 0], out[m, 1] = points[n - 1, 0], points[n - 1, 1]
-        m += 1
-    return m
+    return _emit_last(points, out, m, lx, ly, spacing)
 
 
 @njit(cache=True, nogil=True)
