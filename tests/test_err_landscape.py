@@ -36,3 +36,20 @@ def test_local_minima_on_a_hand_made_grid():
                   [3.0, 2.0, 3.0, 0.5],
                   [np.nan, 3.0, 4.0, 1.0]])
     np.testing.assert_array_equal(np.argwhere(local_minima(e)), [[1, 1], [2, 3]])
+
+
+def test_report_draws_tf_objective_around_the_truth(tmp_path):
+    """A run with tf gets the landscape section: a figure and one row per drawn scan."""
+    from tfloc.harness.config import MatcherSpec, RunConfig
+    from tfloc.harness.runner import run
+    from tfloc.report.report import write_report
+
+    root = __import__("pathlib").Path(__file__).resolve().parents[1]
+    cfg = RunConfig("t", tmp_path / "run", (root / "data" / "scenarios" / "office-pool",),
+                    (MatcherSpec.make("tf"),), jobs=1, limit_per_group=1)
+    out = run(cfg, progress=False)
+    write_report(out)
+    text = (out / "report.md").read_text()
+    assert "## Why `tf` fails: its objective around the truth" in text
+    assert (out / "figures" / "err_landscape.png").is_file()
+    assert text.count("| office-pool/d") >= 3

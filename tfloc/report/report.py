@@ -33,6 +33,7 @@ from tfloc.io.estimates import COLUMNS, read_estimates
 from . import figures as F
 from . import sections as S
 from .failures import draw_failures, failures_section
+from .landscape import draw_landscapes, landscape_section
 from .mdtable import num
 
 CONTENTION = 1.5  # median wall / CPU time above this: other processes competed for the cores
@@ -230,7 +231,7 @@ def _paired_section(pt: pd.DataFrame) -> list[str]:
 
 
 def render(run_dir: Path, run: dict, p: pd.DataFrame, thr: Thresholds, s2s: set[str],
-           figs: list[Path], pt: pd.DataFrame | None = None, failures: str = "") -> str:
+           figs: list[Path], pt: pd.DataFrame | None = None, failures: str = "", landscape: str = "") -> str:
     """The whole report.md text."""
     parts = [header(run_dir, run, p, thr, s2s), definitions(thr)]
     truth = p[p["truth"]]
@@ -261,6 +262,8 @@ def render(run_dir: Path, run: dict, p: pd.DataFrame, thr: Thresholds, s2s: set[
     if (run_dir / "timing.md").is_file():
         parts.append("## Quiet re-timing\n\nA side-by-side timing pass of a stratified sample of this "
                      "run's scans in one pinned process: [timing.md](timing.md).\n")
+    if landscape:
+        parts.append(landscape)
     parts.append("## Tasks without an answer (timeouts, errors)\n")
     parts.append(S.failures(p))
     if failures:
@@ -284,7 +287,7 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
     pt = paired_table(p, s2s)
     pt.to_csv(run_dir / "paired.csv", index=False, float_format="%.6g")
     figs: list[Path] = []
-    failures = ""
+    failures = landscape = ""
     if with_figures:
         fd = run_dir / "figures"
         sc = scenario_summary(p[p["truth"]])
@@ -293,7 +296,8 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
                 F.fig_runtime(p, fd / "runtime.png"), F.fig_outcomes(p, fd / "outcomes.png", s2s)]
         figs = [f for f in made if f is not None]
         failures = failures_section(draw_failures(run_dir, p, run.get("datasets", {})))
+        landscape = landscape_section(*draw_landscapes(run_dir, p, run.get("datasets", {})))
     report = run_dir / "report.md"
-    report.write_text(render(run_dir, run, p, thr, s2s, figs, pt, failures))
+    report.write_text(render(run_dir, run, p, thr, s2s, figs, pt, failures, landscape))
     return ReportFiles(report, summary, tuple(figs))
 
