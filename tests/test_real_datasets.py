@@ -13,7 +13,7 @@ import pytest
 from tfloc.harness.dataset import map_for, read_scans, read_scenario
 from tfloc.io.carmen import read_carmen
 from tfloc.pose import angdiff
-from tfloc.real.datasets import INTEL_LASER, build_all, clean_ranges
+from tfloc.real.datasets import ACES_LASER, ACES_NO_RETURN_M, INTEL_LASER, build_all, clean_ranges
 from tfloc.real.spacing import compare, intel_candidates
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -32,6 +32,17 @@ def test_intel_spacing_decision_recomputed_on_a_subset() -> None:
     assert scores[0].mean_clipped < 0.97 * scores[1].mean_clipped
 
 
+def test_aces_spacing_decision_recomputed_on_a_subset() -> None:
+    """data/real/aces/SPACING.md: 1° from -90° lines the corrected ACES scans up best too."""
+    log = read_carmen(DATA / "real" / "aces" / "aces-corrected.log.gz")
+    R = np.vstack([clean_ranges(s.ranges, ACES_NO_RETURN_M) for s in log.lasers[:300]])
+    P = log.poses()[:300]
+    scores = compare(R, P, intel_candidates(50.0))
+    assert scores[0].label == "1deg-from-90"
+    assert scores[0].laser == ACES_LASER
+    assert scores[0].mean_clipped < 0.97 * scores[1].mean_clipped
+
+
 @pytest.fixture(scope="module")
 def rebuilt(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("real")
@@ -43,7 +54,9 @@ def rebuilt(tmp_path_factory) -> Path:
     "scenarios/real-csail-relations/scans.csv", "scenarios/real-csail-relations/scenario.json",
     "scenarios/real-intel-scan-to-map/scans.csv", "scenarios/real-intel-scan-to-map/scenario.json",
     "scenarios/real-csail-scan-to-map/scans.csv", "scenarios/real-csail-scan-to-map/scenario.json",
+    "scenarios/real-aces-scan-to-map/scans.csv", "scenarios/real-aces-scan-to-map/scenario.json",
     "maps/real-intel.yaml", "maps/real-intel.pgm", "maps/real-csail.yaml", "maps/real-csail.pgm",
+    "maps/real-aces.yaml", "maps/real-aces.pgm",
 ])
 def test_committed_datasets_are_reproducible(rebuilt: Path, rel: str) -> None:
     if rel.endswith("scenario.json"):  # the map path is relative to where it was written
@@ -80,7 +93,8 @@ def test_relations_dataset_matches_the_log() -> None:
     assert np.median(gain) > 0.0
 
 
-@pytest.mark.parametrize("name, n", [("real-intel-scan-to-map", 910), ("real-csail-scan-to-map", 406)])
+@pytest.mark.parametrize("name, n", [("real-intel-scan-to-map", 910), ("real-csail-scan-to-map", 406),
+                                     ("real-aces-scan-to-map", 440)])
 def test_scan_to_map_dataset(name: str, n: int) -> None:
     sc = read_scenario(SCEN / name)
     scans = read_scans(sc)

@@ -1,8 +1,8 @@
 """Build the real-data scenario datasets from the logs in data/real/ (deterministic for a seed).
 
 Writes OUT/scenarios/real-csail-relations/ (scan-to-scan, 1172 MIT CSAIL relations),
-OUT/scenarios/real-intel-scan-to-map/ and OUT/scenarios/real-csail-scan-to-map/ (scan-to-map),
-and their grid maps OUT/maps/real-intel.yaml|.pgm and OUT/maps/real-csail.yaml|.pgm.
+OUT/scenarios/real-{intel,csail,aces}-scan-to-map/ (scan-to-map), and their grid maps
+OUT/maps/real-{intel,csail,aces}.yaml|.pgm.
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-HELP = "build the real-log scenario datasets (MIT CSAIL relations, Intel/CSAIL scan-to-map)"
+HELP = "build the real-log scenario datasets (MIT CSAIL relations, Intel/CSAIL/ACES scan-to-map)"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

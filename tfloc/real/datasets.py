@@ -3,9 +3,9 @@
 * ``real-csail-relations``: scan-to-scan on the MIT CSAIL log and the 1172 relations of
   Kümmerle et al. (2009): the scan at t2 (``ranges``) against the scan at t1 (``ref_ranges``),
   ``true`` = the relation, ``init`` = the raw odometry between the two scans.
-* ``real-intel-scan-to-map`` and ``real-csail-scan-to-map``: every scan of a SLAM-corrected log
-  localized in a grid map built from all corrected scans, from an initial pose perturbed in the
-  paper's 3 × 3 offset bins.
+* ``real-intel-scan-to-map``, ``real-csail-scan-to-map`` and ``real-aces-scan-to-map``: every scan
+  of a SLAM-corrected log localized in a grid map built from all corrected scans, from an initial
+  pose perturbed in the paper's 3 × 3 offset bins.
 """
 
 from __future__ import annotations
@@ -39,12 +39,17 @@ DEFAULT_SEED = 20091122
 CSAIL_LASER = LaserSpec.from_degrees(MAX_RANGE_M, 180.0, 0.5, -90.0)
 #: Intel: 180 beams at 1° from -90° (-90°…+89°), settled by measurement (data/real/intel/SPACING.md).
 INTEL_LASER = LaserSpec.from_degrees(MAX_RANGE_M, 179.0, 1.0, -90.0)
+#: ACES: 180 beams at 1° from -90°, settled by the same measurement (data/real/aces/SPACING.md).
+ACES_LASER = LaserSpec.from_degrees(MAX_RANGE_M, 179.0, 1.0, -90.0)
+#: The ACES log caps its ranges at 50 m: exactly 50 m is its no-return code (620 beams; the
+#: largest real return is 49.91 m).
+ACES_NO_RETURN_M = 50.0
 
 
-def clean_ranges(ranges: np.ndarray) -> np.ndarray:
-    """The no-return code (≥ 80 m) → ``inf``; metres."""
+def clean_ranges(ranges: np.ndarray, no_return: float = NO_RETURN_M) -> np.ndarray:
+    """The no-return code (ranges ≥ ``no_return`` metres) → ``inf``; metres."""
     r = np.array(ranges, dtype=float)
-    r[r >= NO_RETURN_M] = np.inf
+    r[r >= no_return] = np.inf
     return r
 
 
@@ -111,11 +116,13 @@ def perturb(truth: np.ndarray, grid: GridMap, cfg: Perturbation) -> tuple[np.nda
 
 
 def scan_to_map(log_path: Path, laser: LaserSpec, resolution: float = 0.05,
-                cfg: Perturbation = Perturbation()) -> tuple[GridMap, list[Scan]]:
-    """The grid map of a corrected log and its scans with perturbed initial poses."""
+                cfg: Perturbation = Perturbation(),
+                no_return: float = NO_RETURN_M) -> tuple[GridMap, list[Scan]]:
+    """The grid map of a corrected log and its scans with perturbed initial poses (ranges ≥
+    ``no_return`` metres are the log's no-return code)."""
     log = read_carmen(log_path)
     scans = _front(log, laser)
-    R = np.vstack([clean_ranges(s.ranges) for s in scans])
+    R = np.vstack([clean_ranges(s.ranges, no_return) for s in scans])
     P = np.array([s.pose.as_array() for s in scans])
     grid = grid_from_scans(R, P, laser, resolution, name=log_path.name.split(".")[0])
     init, groups = perturb(P, grid, cfg)
@@ -129,7 +136,10 @@ def _source(real: Path, *files: str) -> dict:
 
 
 def build_all(real: Path, out: Path, seed: int = DEFAULT_SEED, resolution: float = 0.05) -> list[Path]:
-    """(Re)build the three real datasets under ``out/scenarios`` and their maps under ``out/maps``."""
+    """(Re)build the four real datasets under ``out/scenarios`` and their maps under ``out/maps``.
+
+    Each scan-to-map set draws its initial poses from its own generator seeded with ``seed``, so
+    adding a log leaves the others' datasets byte-identical."""
     real, out = Path(real), Path(out)
     made = []
     csail = real / "mit-csail"
@@ -149,12 +159,17 @@ def build_all(real: Path, out: Path, seed: int = DEFAULT_SEED, resolution: float
             "11.2 cm (5 cm x sqrt(k)), so the ground truth looks quantised at about 5 cm."),
         scan_to_scan=True, source=_source(real, "mit-csail/mit-csail.clf.gz", "mit-csail/mit-csail.relations")))
     cfg = Perturbation(seed=seed)
-    for key, log_rel, laser, note in (
+    aces_note = (
+        "ACES building, UT Austin (440 scans, 180 beams at 1 deg from -90 deg: see "
+        "data/real/aces/SPACING.md; the log caps ranges at 50 m, and 50 m is its no-return code)")
+    for key, log_rel, laser, note, no_return in (
             ("intel", "intel/intel-corrected.log.gz", INTEL_LASER,
-             "Intel Research Lab (910 scans, 180 beams at 1 deg from -90 deg: see data/real/intel/SPACING.md)"),
+             "Intel Research Lab (910 scans, 180 beams at 1 deg from -90 deg: see data/real/intel/SPACING.md)",
+             NO_RETURN_M),
             ("csail", "mit-csail/csail-corrected.log.gz", CSAIL_LASER,
-             "MIT CSAIL corrected log (406 scans, 361 beams at 0.5 deg)")):
-        grid, rows = scan_to_map(real / log_rel, laser, resolution, cfg)
+             "MIT CSAIL corrected log (406 scans, 361 beams at 0.5 deg)", NO_RETURN_M),
+            ("aces", "aces/aces-corrected.log.gz", ACES_LASER, aces_note, ACES_NO_RETURN_M)):
+        grid, rows = scan_to_map(real / log_rel, laser, resolution, cfg, no_return)
         map_yaml = write_ros_map(grid, out / "maps" / f"real-{key}.yaml")
         root = out / "scenarios" / f"real-{key}-scan-to-map"
         made.append(write_scenario(
@@ -166,7 +181,8 @@ def build_all(real: Path, out: Path, seed: int = DEFAULT_SEED, resolution: float
                 "carving, occupied if > 25 % of the beams reaching a cell end there. init = true pose "
                 "perturbed in the paper's 3x3 bins (0-1/1-2/2-3 m x 0-5/5-10/10-15 deg, groups d{i}-a{j}, "
                 f"balanced), in free space >= {cfg.clearance_m:g} m from occupied cells, seed {seed}. "
-                "No-return ~81.9 m -> inf; max_range 50 m."),
+                + ("No-return ~81.9 m -> inf; max_range 50 m." if no_return == NO_RETURN_M else
+                   f"No-return {no_return:g} m (the log's cap) -> inf; max_range 50 m.")),
             generator={"command": "tfloc real-data", "seed": seed, "resolution_m": resolution,
                        "clearance_m": cfg.clearance_m},
             source=_source(real, log_rel)))
