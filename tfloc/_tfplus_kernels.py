@@ -87,3 +87,73 @@ def pairs_kernel(points: np.ndarray, delta: np.ndarray, q: np.ndarray, normal: n
                 for b in range(3):
                     hh[k, a, b] += jac[a] * jac[b]
     return hh, gg, res
+
+
+@njit(cache=True, nogil=True)
+def field_pairs_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, resolution: float,
+                       map_points: np.ndarray, map_normals: np.ndarray, face_plus: np.ndarray,
+                       face_minus: np.ndarray, points: np.ndarray, poses: np.ndarray,
+                       offsets: np.ndarray, gate: float, slack: float, use_faces: bool,
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Point-to-line pairs of scan points with their nearest map points, and one Gauss–Newton system.
+
+    ``nearest`` ``(ny, nx)``: index into the map points ``(N, 2)``, their unit normals ``(N, 2)``
+    and the distances ``face_plus``/``face_minus`` ``(N,)`` from each point to its wall's surface
+    along ``±normal`` of each cell's nearest map point (a
+    :class:`~tfloc.distance_field.DistanceField`). ``points`` ``(M, 2)``: the scan (sensor frame);
+    ``poses`` ``(K, 3)`` world poses, ``offsets`` ``(K,)`` how far (metres) the returns lie behind
+    the walls' surfaces. Each world point ``w`` is paired with the map point ``q`` of its cell if
+    ``|w − q| ≤ gate``. Its residual is ``n·(w − q)`` (metres), or with ``use_faces``, with ``n``
+    turned to face the sensor, ``n·(w − q) − face + offset`` (``face`` the distance to the
+    surface on the sensor's side).
+
+    Returns, per pose, the normal equations ``H`` ``(K, 4, 4)`` and ``g`` ``(K, 4)`` in the
+    additive parameters ``(x, y, θ, offset)`` (the offset's column is zero without faces), the
+    residuals ``(K, M)`` (NaN: unpaired), and the ranking residual ``max(|n·(w − q)|, |w − q| −
+    slack)`` ``(K, M)`` of every point, paired or not (the second term keeps a point beyond the
+    end of a wall, on the wall's line, from counting as on it).
+    """
+    ny, nx = nearest.shape
+    k_n, m = poses.shape[0], points.shape[0]
+    hh = np.zeros((k_n, 4, 4))
+    gg = np.zeros((k_n, 4))
+    res = np.full((k_n, m), np.nan)
+    rank = np.empty((k_n, m))
+    inv = 1.0 / resolution
+    jac = np.zeros(4)
+    for k in range(k_n):
+        px, py = poses[k, 0], poses[k, 1]
+        c, s = math.cos(poses[k, 2]), math.sin(poses[k, 2])
+        for i in range(m):
+            ox = c * points[i, 0] - s * points[i, 1]
+            oy = s * points[i, 0] + c * points[i, 1]
+            wx, wy = px + ox, py + oy
+            ix = min(max(int(math.floor((wx - origin_x) * inv)), 0), nx - 1)
+            iy = min(max(int(math.floor((wy - origin_y) * inv)), 0), ny - 1)
+            j = nearest[iy, ix]
+            if j < 0:
+                rank[k, i] = np.inf
+                continue
+            dx, dy = wx - map_points[j, 0], wy - map_points[j, 1]
+            nxj, nyj = map_normals[j, 0], map_normals[j, 1]
+            r = nxj * dx + nyj * dy
+            dist = math.sqrt(dx * dx + dy * dy)
+            rank[k, i] = max(abs(r), dist - slack)
+            if dist > gate:
+                continue
+            jac[3] = 0.0
+            if use_faces:
+                if nxj * ox + nyj * oy > 0.0:          # the normal faces away from the sensor
+                    nxj, nyj, r = -nxj, -nyj, -r
+                    r -= face_minus[j]
+                else:
+                    r -= face_plus[j]
+                r += offsets[k]
+                jac[3] = 1.0
+            res[k, i] = r
+            jac[0], jac[1], jac[2] = nxj, nyj, -nxj * oy + nyj * ox
+            for a in range(4):
+                gg[k, a] += jac[a] * r
+                for b in range(4):
+                    hh[k, a, b] += jac[a] * jac[b]
+    return hh, gg, res, rank

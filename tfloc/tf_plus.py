@@ -45,7 +45,7 @@ from .heading_histogram import rotation_candidates
 from .maps.base import Map
 from .pose import Pose
 from .problem import Estimate, Problem
-from .refine import RefineConfig, refine
+from .refine import RefineConfig, refine, refine_to_field
 from .scan_cost import scan_cost
 from .tf import TfConfig, scan_turning_function
 from .turning import match
@@ -60,8 +60,13 @@ class TfPlusConfig:
         heading_sweep: sweep the headings θ_VP ± ``heading_span``.
         grid: run the coarse grid search over positions (else only the VP's position).
         refine: run the point-to-line refinement.
+        refine_to: what the refinement fits the scan to: ``"field"``, the map's own points
+            (nearest point of each scan point's cell, :func:`tfloc.refine.refine_to_field`), or
+            ``"virtual"``, ray-cast virtual scans (:func:`tfloc.refine.refine`; biased short on
+            grid maps with thick walls).
         select: how the final answer is picked among refined candidates: ``"residual"``
-            (truncated point-to-line residual) or ``"tf"`` (turning-function Err, Eq. 13).
+            (truncated point-to-line residual to the map's points), ``"virtual"`` (the same to
+            the virtual scans) or ``"tf"`` (turning-function Err, Eq. 13).
         search_radius: radius of the coarse search around the VP.
         grid_step: lattice spacing of the coarse search.
         clearance: minimum distance of a lattice position from walls.
@@ -73,6 +78,8 @@ class TfPlusConfig:
         heading_step: ... at this spacing.
         field_resolution: cell size of the distance field.
         field_truncation: truncation of the distance field.
+        wall_thickness: on a grid map, walls up to this thick (metres) are replaced by their
+            centre lines (:mod:`tfloc.wall_centres`); 0: the occupied cells as they are.
         scan_stride: every ``scan_stride``-th real point is used by the first coarse level ...
         shortlist: ... and this many of its best poses are rescored on all points.
         candidates: candidates refined.
@@ -92,6 +99,7 @@ class TfPlusConfig:
     heading_sweep: bool = True
     grid: bool = True
     refine: bool = True
+    refine_to: str = "field"
     select: str = "residual"
     search_radius: float = 3.3
     grid_step: float = 0.2
@@ -103,6 +111,7 @@ class TfPlusConfig:
     heading_step: float = math.radians(3.0)
     field_resolution: float = 0.05
     field_truncation: float = 0.3
+    wall_thickness: float = 0.3
     scan_stride: int = 9
     shortlist: int = 64
     candidates: int = 4
@@ -114,18 +123,19 @@ class TfPlusConfig:
     tf: TfConfig = TfConfig(spacing=0.05)
 
 
-_FIELDS: dict[int, tuple[Map, float, float, DistanceField]] = {}
+_FIELDS: dict[int, tuple[Map, tuple, DistanceField]] = {}
 
 
 def _field(map_: Map, cfg: TfPlusConfig) -> DistanceField:
     """The map's distance field, built once per map object and configuration."""
+    key = (cfg.field_resolution, cfg.field_truncation, cfg.wall_thickness)
     hit = _FIELDS.get(id(map_))
-    if hit is not None and hit[0] is map_ and hit[1:3] == (cfg.field_resolution, cfg.field_truncation):
-        return hit[3]
+    if hit is not None and hit[0] is map_ and hit[1] == key:
+        return hit[2]
     if len(_FIELDS) > 16:
         _FIELDS.clear()
-    f = distance_field(map_, cfg.field_resolution, cfg.field_truncation)
-    _FIELDS[id(map_)] = (map_, cfg.field_resolution, cfg.field_truncation, f)
+    f = distance_field(map_, *key)
+    _FIELDS[id(map_)] = (map_, key, f)
     return f
 
 
@@ -185,8 +195,10 @@ class TurningFunctionPlusMatcher:
 
     def __init__(self, config: TfPlusConfig | None = None, **overrides) -> None:
         self.config = replace(config or TfPlusConfig(), **overrides)
-        if self.config.select not in ("residual", "tf"):
-            raise ValueError(f"select must be 'residual' or 'tf', not {self.config.select!r}")
+        if self.config.select not in ("residual", "virtual", "tf"):
+            raise ValueError(f"select must be 'residual', 'virtual' or 'tf', not {self.config.select!r}")
+        if self.config.refine_to not in ("field", "virtual"):
+            raise ValueError(f"refine_to must be 'field' or 'virtual', not {self.config.refine_to!r}")
 
     def localize(self, problem: Problem) -> Estimate:
         cfg = self.config
@@ -211,13 +223,15 @@ class TurningFunctionPlusMatcher:
                 cands = cands[np.argsort(pose_scores(_field(problem.map, cfg), points, cands))[:1]]
             evaluations = len(heads)
         if cfg.refine:
-            cands = refine(problem.map, problem.laser, points, cands, cfg.refinement)
+            if cfg.refine_to == "field":
+                cands = refine_to_field(_field(problem.map, cfg), points, cands, cfg.refinement)
+            else:
+                cands = refine(problem.map, problem.laser, points, cands, cfg.refinement)
             evaluations += len(cands) * cfg.refinement.iterations
         if cfg.select == "tf":
             cost = tf_errs(problem, cands, cfg)
         else:
-            cost = scan_cost(problem.map, problem.laser, problem.ranges, cands,
-                             cfg.refinement.window, cfg.refinement.inlier_distance, cfg.beam_check)
+            cost = self._cost(problem, cands)
         b = pick(cost, cands, vp, cfg.tie_tolerance)
         pose = Pose.from_array(cands[b])
         info.update({"status": "ok", "candidates": len(cands), "cost": float(cost[b])})
@@ -226,7 +240,11 @@ class TurningFunctionPlusMatcher:
     def score(self, problem: Problem, pose: Pose) -> float:
         """The selection objective at ``pose`` (:func:`tfloc.scan_cost.scan_cost`), as its root
         (metres): the root mean square of the truncated per-beam residuals."""
+        return float(np.sqrt(self._cost(problem, pose.as_array()[None, :])[0]))
+
+    def _cost(self, problem: Problem, poses: np.ndarray) -> np.ndarray:
+        """The selection cost (metres²) at ``(K, 3)`` poses (:func:`tfloc.scan_cost.scan_cost`)."""
         cfg = self.config
-        cost = scan_cost(problem.map, problem.laser, problem.ranges, pose.as_array()[None, :],
-                         cfg.refinement.window, cfg.refinement.inlier_distance, cfg.beam_check)
-        return float(np.sqrt(cost[0]))
+        field = _field(problem.map, cfg) if cfg.select != "virtual" else None
+        return scan_cost(problem.map, problem.laser, problem.ranges, poses, cfg.refinement.window,
+                         cfg.refinement.inlier_distance, cfg.beam_check, field)
