@@ -120,12 +120,19 @@ def main() -> None:
     ap.add_argument("--limit-per-group", type=int, default=0, help="first N scans per offset cell (0: all)")
     ap.add_argument("--only", nargs="*", help="run only these variant labels")
     ap.add_argument("--set", nargs="*", default=[], metavar="KEY=VALUE",
-                    help="extra tf-plus parameters for every variant (Python literals)")
+                    help="extra tf-plus parameters for every variant (Python literals; "
+                         "refinement.NAME=VALUE for the refinement's)")
     ap.add_argument("--out", type=Path, default=ROOT / "results/tf-plus-ablation-real")
     args = ap.parse_args()
     variants = {k: v for k, v in VARIANTS.items() if not args.only or k in args.only}
     import ast
+    from dataclasses import replace
+
+    from tfloc.refine import RefineConfig
     extra = {k: ast.literal_eval(v) for k, v in (s.split("=", 1) for s in args.set)}
+    sub = {k.split(".", 1)[1]: extra.pop(k) for k in list(extra) if k.startswith("refinement.")}
+    if sub:
+        extra["refinement"] = replace(RefineConfig(), **sub)
     variants = {k: {**extra, **v} for k, v in variants.items()}
     df = run(args.datasets, variants, args.limit_per_group)
     summary = summarise(df)

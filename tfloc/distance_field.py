@@ -20,10 +20,10 @@ On a vector map the nearest sample point lies on the wall's line and its normal 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.ndimage import distance_transform_edt
+from scipy.ndimage import distance_transform_edt, minimum_filter
 
 from .maps.base import Map
 from .maps.grid import GridMap
@@ -110,3 +110,14 @@ def distance_field(map_: Map, resolution: float = 0.05, truncation: float = 0.5,
                          np.ascontiguousarray(nearest, dtype=np.int32),
                          np.ascontiguousarray(plus, dtype=float), np.ascontiguousarray(minus, dtype=float),
                          bool(faces))
+
+
+def pooled(field: DistanceField, half_width: float) -> DistanceField:
+    """``field`` with every cell's distance replaced by the smallest within ``± half_width`` metres
+    (in x and y): a lower bound of the distance at any point that far from where it is looked up,
+    so a pose's score on it bounds from below the score of every translation within that square
+    (Olson's low-resolution table, for distances)."""
+    k = int(round(half_width / field.resolution))
+    if k < 1:
+        return field
+    return replace(field, table=minimum_filter(field.table, size=2 * k + 1, mode="nearest"))

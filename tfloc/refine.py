@@ -71,6 +71,7 @@ class RefineConfig:
     faces: bool = True
     offset_prior: float = 0.025
     offset_weight: float = 1.0
+    offset_gate: float = 0.1
 
 
 def _virtual_geometry(ranges: np.ndarray, laser: LaserSpec) -> tuple[np.ndarray, np.ndarray]:
@@ -203,6 +204,9 @@ def refine_to_field(field: DistanceField, points: np.ndarray, poses: np.ndarray,
                 h = h[enough] + cfg.damping * np.eye(4) + prior
                 g = g[enough]
                 g[:, 3] += cfg.offset_weight * (offsets[enough] - cfg.offset_prior)
+                if gates[it] > cfg.offset_gate:       # the offset waits for clean pairs
+                    h[:, 3, :3] = h[:, :3, 3] = 0.0
+                    g[:, 3] = 0.0
                 step = np.linalg.solve(h, g[..., None])[..., 0]
                 poses[enough] -= step[:, :3]
                 offsets[enough] -= step[:, 3]

@@ -40,7 +40,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .coarse import best_candidates, lattice, pose_scores, search
-from .distance_field import DistanceField, distance_field
+from .distance_field import DistanceField, distance_field, pooled
 from .heading_histogram import rotation_candidates
 from .maps.base import Map
 from .pose import Pose
@@ -78,9 +78,15 @@ class TfPlusConfig:
         heading_step: ... at this spacing.
         field_resolution: cell size of the distance field.
         field_truncation: truncation of the distance field.
-        wall_thickness: on a grid map, walls up to this thick (metres) are replaced by their
-            centre lines (:mod:`tfloc.wall_centres`); 0: the occupied cells as they are.
+        wall_thickness: on a grid map, walls are followed this far (metres) across to find their
+            surfaces (:mod:`tfloc.wall_centres`).
         scan_stride: every ``scan_stride``-th real point is used by the first coarse level ...
+            (if ``coarse_points`` is 0; else about ``coarse_points`` points, evenly spread,
+            whatever the scanner's beam count)
+        coarse_points: see ``scan_stride``.
+        coarse_bound: score the coarse search on the distance field pooled over ± half a
+            lattice step (a lower bound over each lattice cell), so that the cell holding the
+            true pose is not outscored because its lattice point is a few cm off a wall.
         shortlist: ... and this many of its best poses are rescored on all points.
         candidates: candidates refined.
         separation: minimum distance between candidates.
@@ -113,6 +119,8 @@ class TfPlusConfig:
     field_truncation: float = 0.3
     wall_thickness: float = 0.3
     scan_stride: int = 9
+    coarse_points: int = 20
+    coarse_bound: bool = True
     shortlist: int = 64
     candidates: int = 4
     separation: float = 0.3
@@ -137,6 +145,26 @@ def _field(map_: Map, cfg: TfPlusConfig) -> DistanceField:
     f = distance_field(map_, *key)
     _FIELDS[id(map_)] = (map_, key, f)
     return f
+
+
+_POOLED: dict[int, tuple[DistanceField, float, DistanceField]] = {}
+
+
+def _coarse_field(map_: Map, cfg: TfPlusConfig) -> DistanceField:
+    """The field the coarse search scores on: pooled over ± half a lattice step
+    (``coarse_bound``), else the field itself."""
+    f = _field(map_, cfg)
+    if not cfg.coarse_bound:
+        return f
+    half = cfg.grid_step / 2.0
+    hit = _POOLED.get(id(f))
+    if hit is not None and hit[0] is f and hit[1] == half:
+        return hit[2]
+    if len(_POOLED) > 16:
+        _POOLED.clear()
+    p = pooled(f, half)
+    _POOLED[id(f)] = (f, half, p)
+    return p
 
 
 def heading_seeds(problem: Problem, cfg: TfPlusConfig) -> tuple[np.ndarray, dict]:
@@ -214,7 +242,9 @@ class TurningFunctionPlusMatcher:
                                 cfg.clearance)
             if len(positions) == 0:
                 positions = vp.xy[None, :]
-            poses, scores = search(field, points, positions, heads, cfg.scan_stride, cfg.shortlist)
+            stride = max(1, len(points) // cfg.coarse_points) if cfg.coarse_points else cfg.scan_stride
+            poses, scores = search(_coarse_field(problem.map, cfg), points, positions, heads, stride,
+                                   cfg.shortlist)
             cands = best_candidates(poses, scores, cfg.candidates, cfg.separation)
             evaluations = len(positions) * len(heads) + len(poses)
         else:
