@@ -93,7 +93,8 @@ def pairs_kernel(points: np.ndarray, delta: np.ndarray, q: np.ndarray, normal: n
 def field_pairs_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, resolution: float,
                        map_points: np.ndarray, map_normals: np.ndarray, face_plus: np.ndarray,
                        face_minus: np.ndarray, points: np.ndarray, poses: np.ndarray,
-                       offsets: np.ndarray, gate: float, slack: float, use_faces: bool,
+                       offsets: np.ndarray, gate: float, slack: float, cell_weight: float,
+                       face_weight: float,
                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Point-to-line pairs of scan points with their nearest map points, and one Gauss–Newton system.
 
@@ -141,19 +142,56 @@ def field_pairs_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, re
             rank[k, i] = max(abs(r), dist - slack)
             if dist > gate:
                 continue
-            jac[3] = 0.0
-            if use_faces:
-                if nxj * ox + nyj * oy > 0.0:          # the normal faces away from the sensor
-                    nxj, nyj, r = -nxj, -nyj, -r
-                    r -= face_minus[j]
-                else:
-                    r -= face_plus[j]
-                r += offsets[k]
-                jac[3] = 1.0
             res[k, i] = r
-            jac[0], jac[1], jac[2] = nxj, nyj, -nxj * oy + nyj * ox
-            for a in range(4):
-                gg[k, a] += jac[a] * r
-                for b in range(4):
-                    hh[k, a, b] += jac[a] * jac[b]
+            jac[0], jac[1], jac[2], jac[3] = nxj, nyj, -nxj * oy + nyj * ox, 0.0
+            for a in range(3):
+                gg[k, a] += cell_weight * jac[a] * r
+                for b in range(3):
+                    hh[k, a, b] += cell_weight * jac[a] * jac[b]
+            if face_weight > 0.0:
+                if nxj * ox + nyj * oy > 0.0:          # the normal faces away from the sensor
+                    nxj, nyj, rf = -nxj, -nyj, -r - face_minus[j]
+                else:
+                    rf = r - face_plus[j]
+                rf += offsets[k]
+                jac[0], jac[1], jac[2], jac[3] = nxj, nyj, -nxj * oy + nyj * ox, 1.0
+                for a in range(4):
+                    gg[k, a] += face_weight * jac[a] * rf
+                    for b in range(4):
+                        hh[k, a, b] += face_weight * jac[a] * jac[b]
     return hh, gg, res, rank
+
+
+@njit(cache=True, nogil=True)
+def face_depths_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, resolution: float,
+                       map_points: np.ndarray, map_normals: np.ndarray, face_plus: np.ndarray,
+                       face_minus: np.ndarray, points: np.ndarray, poses: np.ndarray,
+                       gate: float) -> np.ndarray:
+    """How deep (metres) each scan point lies behind its wall's surface on the sensor's side
+    (``(K, M)``; NaN if its nearest map point is farther than ``gate``); see
+    :func:`field_pairs_kernel` for the arguments."""
+    ny, nx = nearest.shape
+    k_n, m = poses.shape[0], points.shape[0]
+    out = np.full((k_n, m), np.nan)
+    inv = 1.0 / resolution
+    for k in range(k_n):
+        px, py = poses[k, 0], poses[k, 1]
+        c, s = math.cos(poses[k, 2]), math.sin(poses[k, 2])
+        for i in range(m):
+            ox = c * points[i, 0] - s * points[i, 1]
+            oy = s * points[i, 0] + c * points[i, 1]
+            wx, wy = px + ox, py + oy
+            ix = min(max(int(math.floor((wx - origin_x) * inv)), 0), nx - 1)
+            iy = min(max(int(math.floor((wy - origin_y) * inv)), 0), ny - 1)
+            j = nearest[iy, ix]
+            if j < 0:
+                continue
+            dx, dy = wx - map_points[j, 0], wy - map_points[j, 1]
+            if dx * dx + dy * dy > gate * gate:
+                continue
+            r = map_normals[j, 0] * dx + map_normals[j, 1] * dy
+            if map_normals[j, 0] * ox + map_normals[j, 1] * oy > 0.0:
+                out[k, i] = r + face_minus[j]
+            else:
+                out[k, i] = face_plus[j] - r
+    return out

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._tfplus_kernels import field_pairs_kernel, pairs_kernel
+from ._tfplus_kernels import face_depths_kernel, field_pairs_kernel, pairs_kernel
 from .distance_field import DistanceField
 from .laser import LaserSpec
 from .maps.base import Map
@@ -72,6 +72,9 @@ class RefineConfig:
     offset_prior: float = 0.025
     offset_weight: float = 1.0
     offset_gate: float = 0.1
+    max_depth: float = 0.3
+    face_weight: float = 1.0
+    cell_weight: float = 1.0
 
 
 def _virtual_geometry(ranges: np.ndarray, laser: LaserSpec) -> tuple[np.ndarray, np.ndarray]:
@@ -169,50 +172,78 @@ def _prune_index(poses: np.ndarray, cost: np.ndarray, keep: int, same: float = 0
 
 
 def field_pairs(field: DistanceField, points: np.ndarray, poses: np.ndarray, gate: float,
-                offsets: np.ndarray | None = None, use_faces: bool = False,
-                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+                offsets: np.ndarray | None = None, face_weight: float = 0.0,
+                cell_weight: float = 1.0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """:func:`~tfloc._tfplus_kernels.field_pairs_kernel` on a field: ``H`` ``(K, 4, 4)``, ``g``
-    ``(K, 4)``, residuals ``(K, M)`` (NaN: farther than ``gate`` from the map) and ranking
-    residuals ``(K, M)`` (metres) of scan ``points`` ``(M, 2)`` at world ``poses`` ``(K, 3)``, the
-    returns lying ``offsets`` ``(K,)`` metres behind the walls' surfaces (with ``use_faces``)."""
+    ``(K, 4)``, residuals ``(K, M)`` to the nearest map points (NaN: farther than ``gate``) and
+    ranking residuals ``(K, M)`` (metres) of scan ``points`` ``(M, 2)`` at world ``poses``
+    ``(K, 3)``. On a grid map the system weighs the residuals to the walls' surfaces by
+    ``face_weight`` (the returns lying ``offsets`` ``(K,)`` metres behind them) and those to the
+    occupied cells' centres by ``cell_weight``; otherwise it holds the latter alone."""
     poses = np.ascontiguousarray(np.reshape(poses, (-1, 3)), dtype=float)
     offsets = np.zeros(len(poses)) if offsets is None else np.ascontiguousarray(offsets, dtype=float)
+    faces = field.faces and face_weight > 0
     return field_pairs_kernel(field.nearest, float(field.origin[0]), float(field.origin[1]),
                               field.resolution, field.points, field.normals, field.face_plus,
                               field.face_minus, np.ascontiguousarray(points, dtype=float), poses,
-                              offsets, gate, field.resolution, use_faces and field.faces)
+                              offsets, gate, field.resolution, cell_weight if faces else 1.0,
+                              face_weight if faces else 0.0)
+
+
+def face_depths(field: DistanceField, points: np.ndarray, poses: np.ndarray,
+                gate: float) -> np.ndarray:
+    """How deep (metres) each scan point lies behind its wall's surface on the sensor's side,
+    ``(K, M)`` at ``(K, 3)`` poses; NaN where the nearest map point is farther than ``gate``."""
+    return face_depths_kernel(field.nearest, float(field.origin[0]), float(field.origin[1]),
+                              field.resolution, field.points, field.normals, field.face_plus,
+                              field.face_minus, np.ascontiguousarray(points, dtype=float),
+                              np.ascontiguousarray(np.reshape(poses, (-1, 3)), dtype=float), gate)
 
 
 def refine_to_field(field: DistanceField, points: np.ndarray, poses: np.ndarray,
                     config: RefineConfig = RefineConfig()) -> np.ndarray:
     """Refine ``(K, 3)`` world poses so the scan ``points`` ``(M, 2)`` (sensor frame) lie on the
-    map's points (see the module docstring). Returns all ``K`` refined poses, or the ``keep`` best
-    if pruning is on (see :class:`RefineConfig`)."""
+    map (see the module docstring). Returns all ``K`` refined poses, or the ``keep`` best if
+    pruning is on (see :class:`RefineConfig`)."""
     poses = np.array(poses, dtype=float).reshape(-1, 3)
     points = np.ascontiguousarray(points, dtype=float)
     cfg = config
     faces = cfg.faces and field.faces
-    offsets = np.full(len(poses), cfg.offset_prior if faces else 0.0)
+    offsets = np.full(len(poses), cfg.offset_prior)
     prior = np.zeros((4, 4))
     prior[3, 3] = cfg.offset_weight
     gates = np.geomspace(cfg.gate_start, cfg.gate_end, max(cfg.iterations, 1))
+    started = False
     for it in range(cfg.iterations):
+        late = faces and gates[it] <= cfg.offset_gate     # the surfaces wait for clean pairs
+        if late and not started:                           # first guess of the depth: the median
+            started = True
+            offsets = _median_depth(face_depths(field, points, poses, gates[it]), cfg)
+        fw, cw = (cfg.face_weight, cfg.cell_weight) if late else (0.0, 1.0)
         for _ in range(cfg.inner):
-            h, g, r, _ = field_pairs(field, points, poses, gates[it], offsets, faces)
+            h, g, r, _ = field_pairs(field, points, poses, gates[it], offsets, fw, cw)
             enough = (~np.isnan(r)).sum(axis=1) >= 3
             if enough.any():
                 h = h[enough] + cfg.damping * np.eye(4) + prior
                 g = g[enough]
                 g[:, 3] += cfg.offset_weight * (offsets[enough] - cfg.offset_prior)
-                if gates[it] > cfg.offset_gate:       # the offset waits for clean pairs
-                    h[:, 3, :3] = h[:, :3, 3] = 0.0
-                    g[:, 3] = 0.0
                 step = np.linalg.solve(h, g[..., None])[..., 0]
                 poses[enough] -= step[:, :3]
                 offsets[enough] -= step[:, 3]
                 poses[:, 2] = (poses[:, 2] + np.pi) % (2 * np.pi) - np.pi
         if it + 1 == cfg.prune_after and len(poses) > cfg.keep:
-            _, _, r, _ = field_pairs(field, points, poses, gates[it], offsets, faces)
+            _, _, r, _ = field_pairs(field, points, poses, gates[it], offsets, fw, cw)
             keep = _prune_index(poses, truncated_cost(np.abs(r), cfg.inlier_distance), cfg.keep)
             poses, offsets = poses[keep], offsets[keep]
     return poses
+
+
+def _median_depth(depths: np.ndarray, cfg: RefineConfig) -> np.ndarray:
+    """Per pose, the median of ``depths`` ``(K, M)`` (NaN: none), clipped to ``[0, max_depth]``;
+    ``offset_prior`` where there is none."""
+    med = np.full(len(depths), cfg.offset_prior)
+    for k, d in enumerate(depths):
+        d = d[~np.isnan(d)]
+        if d.size:
+            med[k] = min(max(float(np.median(d)), 0.0), cfg.max_depth)
+    return med
