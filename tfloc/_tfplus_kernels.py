@@ -29,18 +29,64 @@ def grid_scores_kernel(table: np.ndarray, origin_x: float, origin_y: float, reso
             rx[j, i] = c * points[i, 0] - s * points[i, 1]
             ry[j, i] = s * points[i, 0] + c * points[i, 1]
     inv = 1.0 / resolution
-    for p in range(n):
-        px, py = positions[p, 0] - origin_x, positions[p, 1] - origin_y
-        for j in range(h):
-            acc = 0.0
-            for i in range(m):
-                ix = int(math.floor((px + rx[j, i]) * inv))
-                iy = int(math.floor((py + ry[j, i]) * inv))
+    out[:, :] = 0.0
+    # point-major, positions innermost: consecutive look-ups walk the lattice, which is local
+    # in the table (cache-friendly), where scan-point-major order jumps across the map
+    for j in range(h):
+        for i in range(m):
+            qx, qy = rx[j, i] - origin_x, ry[j, i] - origin_y
+            for p in range(n):
+                ix = int(math.floor((positions[p, 0] + qx) * inv))
+                iy = int(math.floor((positions[p, 1] + qy) * inv))
                 ix = min(max(ix, 0), nx - 1)
                 iy = min(max(iy, 0), ny - 1)
-                acc += table[iy, ix]
-            out[p, j] = acc / m
+                out[p, j] += table[iy, ix]
+    for p in range(n):
+        for j in range(h):
+            out[p, j] /= m
     return out
+
+
+@njit(cache=True, nogil=True)
+def pose_scores_kernel(table: np.ndarray, origin_x: float, origin_y: float, resolution: float,
+                       points: np.ndarray, poses: np.ndarray) -> np.ndarray:
+    """Mean distance-field value ``(K,)`` of ``points`` ``(M, 2)`` at each of ``(K, 3)`` poses."""
+    ny, nx = table.shape
+    out = np.zeros(poses.shape[0])
+    inv = 1.0 / resolution
+    for k in range(poses.shape[0]):
+        c, s = math.cos(poses[k, 2]), math.sin(poses[k, 2])
+        px, py = poses[k, 0] - origin_x, poses[k, 1] - origin_y
+        acc = 0.0
+        for i in range(points.shape[0]):
+            ix = int(math.floor((px + c * points[i, 0] - s * points[i, 1]) * inv))
+            iy = int(math.floor((py + s * points[i, 0] + c * points[i, 1]) * inv))
+            acc += table[min(max(iy, 0), ny - 1), min(max(ix, 0), nx - 1)]
+        out[k] = acc / points.shape[0]
+    return out
+
+
+@njit(cache=True, nogil=True)
+def separated_kernel(poses: np.ndarray, count: int, separation: float) -> np.ndarray:
+    """Indices of up to ``count`` of the ``(N, 3)`` poses (in the given order) whose positions are
+    at least ``separation`` metres from every earlier kept one."""
+    keep = np.empty(count, dtype=np.int64)
+    n_kept = 0
+    s2 = separation * separation
+    for i in range(poses.shape[0]):
+        ok = True
+        for k in range(n_kept):
+            dx = poses[i, 0] - poses[keep[k], 0]
+            dy = poses[i, 1] - poses[keep[k], 1]
+            if dx * dx + dy * dy < s2:
+                ok = False
+                break
+        if ok:
+            keep[n_kept] = i
+            n_kept += 1
+            if n_kept == count:
+                break
+    return keep[:n_kept]
 
 
 @njit(cache=True, nogil=True)
@@ -195,3 +241,46 @@ def face_depths_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, re
             else:
                 out[k, i] = face_plus[j] - r
     return out
+
+
+@njit(cache=True, nogil=True)
+def refine_field_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, resolution: float,
+                        map_points: np.ndarray, map_normals: np.ndarray, face_plus: np.ndarray,
+                        face_minus: np.ndarray, points: np.ndarray, poses: np.ndarray,
+                        offsets: np.ndarray, gates: np.ndarray, inner: int, offset_gate: float,
+                        faces: bool, face_weight: float, cell_weight: float, damping: float,
+                        offset_weight: float, offset_prior: float, max_depth: float,
+                        started: bool) -> bool:
+    """Gauss–Newton iterations of :func:`tfloc.refine.refine_to_field`, one per gate of ``gates``
+    × ``inner``, on ``poses`` ``(K, 3)`` and ``offsets`` ``(K,)`` in place (see there and
+    :func:`field_pairs_kernel`). Returns whether the depth offsets have been started."""
+    k_n = poses.shape[0]
+    for it in range(gates.shape[0]):
+        gate = gates[it]
+        late = faces and gate <= offset_gate
+        if late and not started:
+            started = True
+            d = face_depths_kernel(nearest, origin_x, origin_y, resolution, map_points, map_normals,
+                                   face_plus, face_minus, points, poses, gate)
+            for k in range(k_n):
+                v = d[k][~np.isnan(d[k])]
+                offsets[k] = min(max(np.median(v), 0.0), max_depth) if v.size else offset_prior
+        fw = face_weight if late else 0.0
+        cw = cell_weight if late else 1.0
+        for _ in range(inner):
+            h, g, r, _ = field_pairs_kernel(nearest, origin_x, origin_y, resolution, map_points,
+                                            map_normals, face_plus, face_minus, points, poses,
+                                            offsets, gate, resolution, cw, fw)
+            for k in range(k_n):
+                if np.sum(~np.isnan(r[k])) < 3:
+                    continue
+                hk = h[k] + damping * np.eye(4)
+                gk = g[k].copy()
+                hk[3, 3] += offset_weight
+                gk[3] += offset_weight * (offsets[k] - offset_prior)
+                step = np.linalg.solve(hk, gk)
+                poses[k, 0] -= step[0]
+                poses[k, 1] -= step[1]
+                poses[k, 2] = (poses[k, 2] - step[2] + np.pi) % (2 * np.pi) - np.pi
+                offsets[k] -= step[3]
+    return started

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._tfplus_kernels import grid_scores_kernel
+from ._tfplus_kernels import grid_scores_kernel, pose_scores_kernel, separated_kernel
 from .distance_field import DistanceField
 from .maps.base import Map
 
@@ -46,10 +46,9 @@ def grid_scores(field: DistanceField, points: np.ndarray, positions: np.ndarray,
 
 def pose_scores(field: DistanceField, points: np.ndarray, poses: np.ndarray) -> np.ndarray:
     """Mean distance-field value ``(N,)`` of ``points`` ``(M, 2)`` at each of ``(N, 3)`` poses."""
-    c, s = np.cos(poses[:, 2])[:, None], np.sin(poses[:, 2])[:, None]
-    wx = poses[:, :1] + c * points[None, :, 0] - s * points[None, :, 1]
-    wy = poses[:, 1:2] + s * points[None, :, 0] + c * points[None, :, 1]
-    return field(np.stack((wx, wy), axis=-1)).mean(axis=-1)
+    return pose_scores_kernel(field.table, float(field.origin[0]), float(field.origin[1]),
+                              field.resolution, np.ascontiguousarray(points, dtype=float),
+                              np.ascontiguousarray(np.reshape(poses, (-1, 3)), dtype=float))
 
 
 def search(field: DistanceField, points: np.ndarray, positions: np.ndarray, headings: np.ndarray,
@@ -68,12 +67,5 @@ def search(field: DistanceField, points: np.ndarray, positions: np.ndarray, head
 def best_candidates(poses: np.ndarray, scores: np.ndarray, count: int,
                     separation: float) -> np.ndarray:
     """Up to ``count`` of ``(N, 3)`` poses of lowest score, positions ≥ ``separation`` apart."""
-    order = poses[np.argsort(scores, kind="stable")]
-    keep = [0]
-    for i in range(1, len(order)):
-        d = np.hypot(*(order[keep, :2] - order[i, :2]).T)
-        if d.min() >= separation:
-            keep.append(i)
-            if len(keep) == count:
-                break
-    return order[keep[:count]].reshape(-1, 3)
+    order = np.ascontiguousarray(poses[np.argsort(scores, kind="stable")], dtype=float)
+    return order[separated_kernel(order, count, separation)].reshape(-1, 3)

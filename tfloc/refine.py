@@ -33,7 +33,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._tfplus_kernels import face_depths_kernel, field_pairs_kernel, pairs_kernel
+from ._tfplus_kernels import (
+    face_depths_kernel,
+    field_pairs_kernel,
+    pairs_kernel,
+    refine_field_kernel,
+)
 from .distance_field import DistanceField
 from .laser import LaserSpec
 from .maps.base import Map
@@ -64,7 +69,7 @@ class RefineConfig:
     window: int = 6
     gate_start: float = 0.5
     gate_end: float = 0.05
-    inlier_distance: float = 0.05
+    inlier_distance: float = 0.1
     damping: float = 1e-6
     prune_after: int = 3
     keep: int = 2
@@ -208,31 +213,24 @@ def refine_to_field(field: DistanceField, points: np.ndarray, poses: np.ndarray,
     poses = np.array(poses, dtype=float).reshape(-1, 3)
     points = np.ascontiguousarray(points, dtype=float)
     cfg = config
-    faces = cfg.faces and field.faces
+    faces = bool(cfg.faces and field.faces)
     offsets = np.full(len(poses), cfg.offset_prior)
-    prior = np.zeros((4, 4))
-    prior[3, 3] = cfg.offset_weight
-    gates = np.geomspace(cfg.gate_start, cfg.gate_end, max(cfg.iterations, 1))
+    gates = np.geomspace(cfg.gate_start, cfg.gate_end, max(cfg.iterations, 1))[:cfg.iterations]
+    cut = cfg.prune_after if 0 < cfg.prune_after < cfg.iterations else cfg.iterations
     started = False
-    for it in range(cfg.iterations):
-        late = faces and gates[it] <= cfg.offset_gate     # the surfaces wait for clean pairs
-        if late and not started:                           # first guess of the depth: the median
-            started = True
-            offsets = _median_depth(face_depths(field, points, poses, gates[it]), cfg)
-        fw, cw = (cfg.face_weight, cfg.cell_weight) if late else (0.0, 1.0)
-        for _ in range(cfg.inner):
-            h, g, r, _ = field_pairs(field, points, poses, gates[it], offsets, fw, cw)
-            enough = (~np.isnan(r)).sum(axis=1) >= 3
-            if enough.any():
-                h = h[enough] + cfg.damping * np.eye(4) + prior
-                g = g[enough]
-                g[:, 3] += cfg.offset_weight * (offsets[enough] - cfg.offset_prior)
-                step = np.linalg.solve(h, g[..., None])[..., 0]
-                poses[enough] -= step[:, :3]
-                offsets[enough] -= step[:, 3]
-                poses[:, 2] = (poses[:, 2] + np.pi) % (2 * np.pi) - np.pi
-        if it + 1 == cfg.prune_after and len(poses) > cfg.keep:
-            _, _, r, _ = field_pairs(field, points, poses, gates[it], offsets, fw, cw)
+    for first, part in ((True, gates[:cut]), (False, gates[cut:])):
+        if len(part) == 0:
+            continue
+        started = refine_field_kernel(
+            field.nearest, float(field.origin[0]), float(field.origin[1]), field.resolution,
+            field.points, field.normals, field.face_plus, field.face_minus, points, poses, offsets,
+            np.ascontiguousarray(part), cfg.inner, cfg.offset_gate, faces, cfg.face_weight,
+            cfg.cell_weight, cfg.damping, cfg.offset_weight, cfg.offset_prior, cfg.max_depth,
+            started)
+        if first and cut < cfg.iterations and len(poses) > cfg.keep:
+            late = faces and part[-1] <= cfg.offset_gate
+            _, _, r, _ = field_pairs(field, points, poses, part[-1], offsets,
+                                     cfg.face_weight if late else 0.0, cfg.cell_weight if late else 1.0)
             keep = _prune_index(poses, truncated_cost(np.abs(r), cfg.inlier_distance), cfg.keep)
             poses, offsets = poses[keep], offsets[keep]
     return poses
