@@ -11,6 +11,8 @@ import math
 import numpy as np
 from numba import njit
 
+from .maps._gridcast import _entry, _start
+
 
 @njit(cache=True, nogil=True)
 def grid_scores_kernel(table: np.ndarray, origin_x: float, origin_y: float, resolution: float,
@@ -284,3 +286,56 @@ def refine_field_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, r
                 poses[k, 2] = (poses[k, 2] - step[2] + np.pi) % (2 * np.pi) - np.pi
                 offsets[k] -= step[3]
     return started
+
+
+@njit(cache=True, nogil=True)
+def see_through_kernel(occ: np.ndarray, origin_x: float, origin_y: float, resolution: float,
+                       poses: np.ndarray, angles: np.ndarray, ranges: np.ndarray,
+                       max_range: float, margin: float) -> np.ndarray:
+    """Which beams ``(K, n)`` of the real scan ``ranges`` ``(n,)`` (metres, ``angles`` relative to
+    the sensor) the occupied grid ``occ`` says cannot be, at each of ``(K, 3)`` poses: a return
+    more than ``margin`` beyond the far side of the first wall the beam meets (where the first
+    run of occupied cells ends: a wall drawn several cells thick holds returns anywhere inside it),
+    or no return (NaN, inf, ≥ ``max_range``) where the beam meets a wall within ``max_range``.
+    Each beam is followed only as far as it needs to be."""
+    H, W = occ.shape
+    k_n, n = poses.shape[0], angles.shape[0]
+    out = np.zeros((k_n, n), dtype=np.bool_)
+    for k in range(k_n):
+        x0, y0 = (poses[k, 0] - origin_x) / resolution, (poses[k, 1] - origin_y) / resolution
+        for b in range(n):
+            r = ranges[b]
+            ret = r > 0.0 and r < max_range            # False for NaN
+            limit = (r - margin) / resolution if ret else max_range / resolution
+            if limit <= 0.0:
+                continue
+            a = poses[k, 2] + angles[b]
+            dx, dy = math.cos(a), math.sin(a)
+            t0, t1 = _entry(x0, y0, dx, dy, W, H)
+            if t0 > t1 or t0 > limit:
+                continue
+            t1 = min(t1, limit)
+            i, j, sx, sy, tdx, tdy, tx, ty = _start(x0, y0, dx, dy, t0, W, H)
+            t = t0
+            inside = False
+            while t <= t1:
+                if occ[j, i]:
+                    if not ret:
+                        out[k, b] = True
+                        break
+                    inside = True
+                elif inside:
+                    out[k, b] = True                 # left the first wall before the return
+                    break
+                t = min(tx, ty)
+                if tx < ty:
+                    tx += tdx
+                    i += sx
+                    if i < 0 or i >= W:
+                        break
+                else:
+                    ty += tdy
+                    j += sy
+                    if j < 0 or j >= H:
+                        break
+    return out

@@ -76,55 +76,6 @@ def _march(occ: np.ndarray, x0: float, y0: float, dx: float, dy: float, tmax: fl
 
 
 @njit(cache=True, nogil=True)
-def _march_far_side(occ: np.ndarray, x0: float, y0: float, dx: float, dy: float, tmax: float) -> float:
-    """Distance (cell units) along the unit ray to where the first run of occupied cells it meets
-    ends (the far side of the first wall: the end of the ray's chord through the last occupied
-    cell of the run), ``inf`` if no occupied cell before ``tmax``."""
-    H, W = occ.shape
-    t0, t1 = _entry(x0, y0, dx, dy, W, H)
-    if t0 > t1 or t0 > tmax:
-        return np.inf
-    t1 = min(t1, tmax)
-    i, j, sx, sy, tdx, tdy, tx, ty = _start(x0, y0, dx, dy, t0, W, H)
-    t = t0
-    inside = False
-    while t <= t1:
-        tn = min(tx, ty)
-        if occ[j, i]:
-            inside = True
-        elif inside:
-            return t
-        t = tn
-        if tx < ty:
-            tx += tdx
-            i += sx
-            if i < 0 or i >= W:
-                break
-        else:
-            ty += tdy
-            j += sy
-            if j < 0 or j >= H:
-                break
-    return t if inside else np.inf
-
-
-@njit(cache=True, nogil=True)
-def raycast_far_side_grid(poses: np.ndarray, rel_angles: np.ndarray, occ: np.ndarray, ox: float,
-                          oy: float, res: float, max_range: float) -> np.ndarray:
-    """Like :func:`raycast_grid`, but to the far side of the first run of occupied cells each beam
-    meets (metres; ``inf`` if it meets none before ``max_range``)."""
-    P, B = poses.shape[0], rel_angles.shape[0]
-    out = np.full((P, B), np.inf)
-    tmax = max_range / res
-    for p in range(P):
-        x0, y0 = (poses[p, 0] - ox) / res, (poses[p, 1] - oy) / res
-        for b in range(B):
-            a = poses[p, 2] + rel_angles[b]
-            out[p, b] = _march_far_side(occ, x0, y0, np.cos(a), np.sin(a), tmax) * res
-    return out
-
-
-@njit(cache=True, nogil=True)
 def raycast_grid(poses: np.ndarray, rel_angles: np.ndarray, occ: np.ndarray, ox: float, oy: float,
                  res: float, max_range: float) -> np.ndarray:
     """Ranges (metres) from each world pose ``(P, 3)`` along each beam ``(B,)`` to the first

@@ -12,7 +12,7 @@ from scipy import ndimage
 from ..errors import MapFormatError
 from ..laser import LaserSpec
 from ..pose import Pose
-from ._gridcast import raycast_far_side_grid, raycast_grid
+from ._gridcast import raycast_grid
 from .base import as_pose_array
 
 
@@ -112,17 +112,6 @@ class GridMap:
         r = raycast_grid(np.ascontiguousarray(arr), np.asarray(laser.angles, dtype=float),
                          self.occupied, self.origin[0], self.origin[1], self.resolution,
                          float(laser.max_range))
-        return r[0] if single else r
-
-    def raycast_far_side(self, poses: Pose | np.ndarray, laser: LaserSpec) -> np.ndarray:
-        """Ranges (metres) to the far side of the first wall each beam meets: where the first run
-        of occupied cells along the beam ends (``inf`` if the beam meets no occupied cell within
-        ``laser.max_range``). A wall drawn several cells thick holds the real returns anywhere
-        inside it; a return beyond its far side went through it. Shapes as :meth:`raycast`."""
-        arr, single = as_pose_array(poses)
-        r = raycast_far_side_grid(np.ascontiguousarray(arr), np.asarray(laser.angles, dtype=float),
-                                  self.occupied, self.origin[0], self.origin[1], self.resolution,
-                                  float(laser.max_range))
         return r[0] if single else r
 
     def in_bounds(self, xy: np.ndarray) -> np.ndarray:
