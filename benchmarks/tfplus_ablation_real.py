@@ -1,10 +1,16 @@
 """Ablation of ``tf-plus``'s stages on the real scan-to-map datasets (``data/scenarios/real-*-scan-to-map``).
 
 Every scan of each dataset is localized in the dataset's grid map from its seeded initial pose
-(the paper's 3 × 3 offset bins), once per variant (one stage switched off, see ``VARIANTS``), in
-this one process, one scan after the other. Success: ≤ 10 cm and ≤ 2° from the corrected pose.
-Times: CPU time of the ``localize`` call (``time.process_time``; run with ``OMP_NUM_THREADS=1``
-so that it is one core's time).
+(the paper's 3 × 3 offset bins), once per variant (one stage switched off or put back as it was
+before the real logs, see ``VARIANTS``), in this one process, one scan after the other. Success:
+≤ 10 cm and ≤ 2° from the corrected pose. Times: CPU time of the ``localize`` call
+(``time.process_time``; run with ``OMP_NUM_THREADS=1`` so that it is one core's time).
+
+``--thicken K ...`` also runs every dataset on its map with the occupied cells dilated by ``K``
+cells (walls ``2K`` cells thicker, grown towards free space on both sides; scans, truths and
+initial poses unchanged): a stress test for grid maps whose walls are drawn thicker than the
+development logs' (the issue's held-back log had its virtual scan biased 11 cm short; one cell
+of dilation biases the Intel grid's by 7.8 cm, two by 14 cm).
 
 Writes ``OUT.csv`` (one row per scan × variant) and ``OUT.md`` (per dataset and variant:
 success, median/mean errors, failure outcomes by the matcher's own ``score``, median and p95 CPU
@@ -26,27 +32,53 @@ import numpy as np
 import pandas as pd
 
 import tfloc
-from tfloc import Problem
+from tfloc import GridMap, Problem
 from tfloc.harness.dataset import map_for, read_scans, read_scenario
+from tfloc.refine import RefineConfig
 
 ROOT = Path(__file__).resolve().parents[1]
 DEV = ("real-intel-scan-to-map", "real-csail-scan-to-map")
+
+#: tf-plus as it was before the real logs (issue 15): refinement and selection against ray-cast
+#: virtual scans, the coarse search on the plain field with every 9th point, 5 cm truncation.
+BEFORE = {"refine_to": "virtual", "select": "virtual", "coarse_bound": False, "coarse_points": 0,
+          "refinement": RefineConfig(inlier_distance=0.05)}
 
 VARIANTS: dict[str, dict] = {
     "tf-plus (all stages)": {},
     "no turning-function seed": {"tf_seed": False},
     "no heading sweep (TF seed only)": {"heading_sweep": False},
     "no grid (refine from VP)": {"grid": False},
+    "no coarse bound (lattice poses as they are)": {"coarse_bound": False},
     "no refinement (grid only)": {"refine": False},
+    "no wall surfaces (refine to occupied cells)": {"refinement": RefineConfig(faces=False)},
+    "refine to virtual scans (before)": {"refine_to": "virtual"},
+    "select by virtual-scan residual (before)": {"select": "virtual"},
     "select by TF Err": {"select": "tf"},
+    "5 cm truncation (before)": {"refinement": RefineConfig(inlier_distance=0.05)},
     "no tie-break by VP distance": {"tie_tolerance": 0.0},
     "no see-through beam check": {"beam_check": False},
+    "tf-plus before issue 15": BEFORE,
 }
 
 
-def problems(name: str, limit_per_group: int = 0) -> list[tuple[str, str, Problem, tfloc.Pose]]:
+def thickened(grid: GridMap, cells: int) -> GridMap:
+    """``grid`` with its occupied cells dilated by ``cells`` cells (occupancy 1 there)."""
+    from scipy.ndimage import binary_dilation
+
+    if cells <= 0:
+        return grid
+    occ = np.array(grid.occupancy, dtype=np.float32)
+    occ[binary_dilation(grid.occupied, iterations=cells)] = 1.0
+    return GridMap(occ, grid.resolution, grid.origin, grid.occupied_thresh, grid.free_thresh,
+                   f"{grid.name}+{cells}")
+
+
+def problems(name: str, limit_per_group: int = 0,
+             thicken: int = 0) -> list[tuple[str, str, Problem, tfloc.Pose]]:
     """(scan id, group, problem, true pose) of a dataset (a name under ``data/scenarios`` or a
-    directory); the first ``limit_per_group`` scans of each group if > 0."""
+    directory); the first ``limit_per_group`` scans of each group if > 0; the map's walls
+    thickened by ``thicken`` cells (:func:`thickened`)."""
     sc = read_scenario(Path(name) if Path(name).is_dir() else ROOT / "data" / "scenarios" / name)
     cache: dict = {}
     seen: dict[str, int] = {}
@@ -55,18 +87,24 @@ def problems(name: str, limit_per_group: int = 0) -> list[tuple[str, str, Proble
         seen[s.group] = seen.get(s.group, 0) + 1
         if limit_per_group and seen[s.group] > limit_per_group:
             continue
-        out.append((s.scan_id, s.group, Problem(map_for(sc, s, cache), sc.laser, s.ranges, s.initial),
-                    s.true))
+        m = map_for(sc, s, cache)
+        if thicken:
+            key = ("thick", sc.map_path, thicken)
+            if key not in cache:
+                cache[key] = thickened(m, thicken)
+            m = cache[key]
+        out.append((s.scan_id, s.group, Problem(m, sc.laser, s.ranges, s.initial), s.true))
     return out
 
 
 def run(datasets: list[str], variants: dict[str, dict], limit_per_group: int = 0,
-        matcher: str = "tf-plus") -> pd.DataFrame:
-    """Every variant on every scan of every dataset (see the module docstring)."""
+        matcher: str = "tf-plus", thicken: tuple[int, ...] = (0,)) -> pd.DataFrame:
+    """Every variant on every scan of every dataset, on its map as built and thickened by each
+    of ``thicken`` cells (see the module docstring)."""
     rows = []
-    for name in datasets:
-        probs = problems(name, limit_per_group)
-        name = Path(name).name
+    for name, k in [(n, k) for n in datasets for k in thicken]:
+        probs = problems(name, limit_per_group, k)
+        name = Path(name).name + (f"+{k}" if k else "")
         for label, kw in variants.items():
             m = tfloc.get_matcher(matcher, **kw)
             m.localize(probs[0][2])                     # warm-up: JIT, the map's caches
@@ -96,7 +134,7 @@ def summarise(df: pd.DataFrame) -> pd.DataFrame:
     out = []
     for (ds, var), d in df.groupby(["dataset", "variant"], sort=False):
         ok = d.outcome == "success"
-        out.append({"dataset": ds.removeprefix("real-").removesuffix("-scan-to-map"), "variant": var,
+        out.append({"dataset": ds.removeprefix("real-").replace("-scan-to-map", ""), "variant": var,
                     "n": len(d), "success %": 100 * ok.mean(),
                     "median dist cm": d.dist_err_cm.median(), "median orient °": d.orient_err_deg.median(),
                     "mean dist cm": d.dist_err_cm.mean(),
@@ -119,6 +157,8 @@ def main() -> None:
     ap.add_argument("--datasets", nargs="+", default=list(DEV))
     ap.add_argument("--limit-per-group", type=int, default=0, help="first N scans per offset cell (0: all)")
     ap.add_argument("--only", nargs="*", help="run only these variant labels")
+    ap.add_argument("--thicken", nargs="*", type=int, default=[0],
+                    help="also on the maps with walls thickened by these many cells (0: as built)")
     ap.add_argument("--set", nargs="*", default=[], metavar="KEY=VALUE",
                     help="extra tf-plus parameters for every variant (Python literals; "
                          "refinement.NAME=VALUE for the refinement's)")
@@ -128,20 +168,20 @@ def main() -> None:
     import ast
     from dataclasses import replace
 
-    from tfloc.refine import RefineConfig
     extra = {k: ast.literal_eval(v) for k, v in (s.split("=", 1) for s in args.set)}
     sub = {k.split(".", 1)[1]: extra.pop(k) for k in list(extra) if k.startswith("refinement.")}
     if sub:
         extra["refinement"] = replace(RefineConfig(), **sub)
     variants = {k: {**extra, **v} for k, v in variants.items()}
-    df = run(args.datasets, variants, args.limit_per_group)
+    df = run(args.datasets, variants, args.limit_per_group, thicken=tuple(args.thicken))
     summary = summarise(df)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     df.to_csv(args.out.with_suffix(".csv"), index=False)
     args.out.with_suffix(".md").write_text(
         "# tf-plus ablation on real scan-to-map logs\n\n"
         f"Command: `OMP_NUM_THREADS=1 PYTHONPATH=$PWD python benchmarks/tfplus_ablation_real.py --datasets "
-        f"{' '.join(args.datasets)}{f' --limit-per-group {args.limit_per_group}' if args.limit_per_group else ''}`. "
+        f"{' '.join(args.datasets)}{f' --limit-per-group {args.limit_per_group}' if args.limit_per_group else ''}"
+        f"{' --thicken ' + ' '.join(map(str, args.thicken)) if args.thicken != [0] else ''}`. "
         "Every scan of each dataset (5 cm grid map built from the corrected log; initial poses in "
         "the paper's 3 × 3 offset bins, 0–3 m × 0–15°), one variant per row (one stage switched off). "
         "Success: ≤ 10 cm and ≤ 2° from the corrected pose. Failures are split by `tf-plus`'s own "

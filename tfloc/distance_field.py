@@ -27,7 +27,7 @@ from scipy.ndimage import distance_transform_edt, minimum_filter
 
 from .maps.base import Map
 from .maps.grid import GridMap
-from .wall_centres import run_extents
+from .wall_faces import run_extents
 
 
 @dataclass(frozen=True, eq=False)
@@ -76,7 +76,7 @@ def distance_field(map_: Map, resolution: float = 0.05, truncation: float = 0.5,
     and each cell's nearest map point (sampled every ``resolution / 2``; on a grid map every
     occupied cell's centre). On a grid map, each point's distances to its wall's two surfaces
     (where the run of occupied cells along its normal ends, followed up to ``wall_thickness``
-    metres, :func:`tfloc.wall_centres.run_extents`); a vector map's walls have no thickness."""
+    metres, :func:`tfloc.wall_faces.run_extents`); a vector map's walls have no thickness."""
     pts, normals = map_.sample_points(resolution / 2.0)
     faces = isinstance(map_, GridMap) and wall_thickness > 0 and len(pts) > 0
     if faces:

@@ -79,7 +79,7 @@ class TfPlusConfig:
         field_resolution: cell size of the distance field.
         field_truncation: truncation of the distance field.
         wall_thickness: on a grid map, walls are followed this far (metres) across to find their
-            surfaces (:mod:`tfloc.wall_centres`).
+            surfaces (:mod:`tfloc.wall_faces`).
         scan_stride: every ``scan_stride``-th real point is used by the first coarse level ...
             (if ``coarse_points`` is 0; else about ``coarse_points`` points, evenly spread,
             whatever the scanner's beam count)
