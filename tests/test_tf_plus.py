@@ -10,7 +10,7 @@ import tfloc
 from tfloc import Pose, Problem, VectorMap
 from tfloc.distance_field import distance_field
 from tfloc.heading_histogram import rotation_candidates
-from tfloc.refine import refine
+from tfloc.refine import RefineConfig, refine
 from tfloc.tf import TfConfig, scan_turning_function
 from tfloc.tf_plus import TfPlusConfig, TurningFunctionPlusMatcher
 
@@ -85,13 +85,17 @@ def test_config_overrides_and_bad_parameters():
         tfloc.get_matcher("tf-plus", no_such_parameter=1)
     with pytest.raises(ValueError):
         TurningFunctionPlusMatcher(select="nearest")
+    with pytest.raises(ValueError):
+        TurningFunctionPlusMatcher(refine_to="scan")
 
 
 def test_ablation_switches_run(test_room, lms200):
     ranges = noisy_scan(test_room, lms200, TRUE)
     init = Pose(TRUE.x + 0.2, TRUE.y - 0.1, TRUE.theta + 0.05)
     for kw in ({"tf_seed": False}, {"heading_sweep": False}, {"grid": False}, {"select": "tf"},
-               {"tie_tolerance": 0.0}, {"beam_check": False}):
+               {"tie_tolerance": 0.0}, {"beam_check": False}, {"refine_to": "virtual"},
+               {"select": "virtual"}, {"coarse_bound": False}, {"coarse_points": 0},
+               {"refinement": RefineConfig(faces=False)}):
         est = TurningFunctionPlusMatcher(**kw).localize(Problem(test_room, lms200, ranges, init))
         assert est.pose.distance_to(TRUE) < 0.02, kw
     # without refinement the answer is a grid pose (0.2 m lattice): near, not exact
