@@ -43,6 +43,7 @@ from .coarse import best_candidates, lattice, pose_scores, search
 from .distance_field import DistanceField, distance_field, pooled
 from .heading_histogram import rotation_candidates
 from .maps.base import Map
+from .maps.grid import GridMap
 from .pose import Pose
 from .problem import Estimate, Problem
 from .refine import RefineConfig, refine, refine_to_field
@@ -60,10 +61,12 @@ class TfPlusConfig:
         heading_sweep: sweep the headings θ_VP ± ``heading_span``.
         grid: run the coarse grid search over positions (else only the VP's position).
         refine: run the point-to-line refinement.
-        refine_to: what the refinement fits the scan to: ``"field"``, the map's own points
-            (nearest point of each scan point's cell, :func:`tfloc.refine.refine_to_field`), or
-            ``"virtual"``, ray-cast virtual scans (:func:`tfloc.refine.refine`; biased short on
-            grid maps with thick walls).
+        refine_to: what the refinement fits the scan to: ``"field"``, the map itself (each
+            scan point's nearest map point; on a grid map also the walls' surfaces and the
+            returns' depth behind them, :func:`tfloc.refine.refine_to_field`); ``"virtual"``,
+            ray-cast virtual scans (:func:`tfloc.refine.refine`: exact on a vector map, whose
+            walls have no thickness, and biased short on a grid whose walls are drawn several
+            cells thick); ``"auto"``: ``"field"`` on a grid map, ``"virtual"`` on any other.
         select: how the final answer is picked among refined candidates: ``"residual"``
             (truncated point-to-line residual to the map's points), ``"virtual"`` (the same to
             the virtual scans) or ``"tf"`` (turning-function Err, Eq. 13).
@@ -105,7 +108,7 @@ class TfPlusConfig:
     heading_sweep: bool = True
     grid: bool = True
     refine: bool = True
-    refine_to: str = "field"
+    refine_to: str = "auto"
     select: str = "residual"
     search_radius: float = 3.3
     grid_step: float = 0.2
@@ -225,8 +228,8 @@ class TurningFunctionPlusMatcher:
         self.config = replace(config or TfPlusConfig(), **overrides)
         if self.config.select not in ("residual", "virtual", "tf"):
             raise ValueError(f"select must be 'residual', 'virtual' or 'tf', not {self.config.select!r}")
-        if self.config.refine_to not in ("field", "virtual"):
-            raise ValueError(f"refine_to must be 'field' or 'virtual', not {self.config.refine_to!r}")
+        if self.config.refine_to not in ("auto", "field", "virtual"):
+            raise ValueError(f"refine_to must be 'auto', 'field' or 'virtual', not {self.config.refine_to!r}")
 
     def localize(self, problem: Problem) -> Estimate:
         cfg = self.config
@@ -253,7 +256,10 @@ class TurningFunctionPlusMatcher:
                 cands = cands[np.argsort(pose_scores(_field(problem.map, cfg), points, cands))[:1]]
             evaluations = len(heads)
         if cfg.refine:
-            if cfg.refine_to == "field":
+            to = cfg.refine_to
+            if to == "auto":
+                to = "field" if isinstance(problem.map, GridMap) else "virtual"
+            if to == "field":
                 cands = refine_to_field(_field(problem.map, cfg), points, cands, cfg.refinement)
             else:
                 cands = refine(problem.map, problem.laser, points, cands, cfg.refinement)
