@@ -1,27 +1,45 @@
-"""Point-to-line refinement of poses (``tf-plus``'s last stage): against the map's own points
-(the default, :func:`refine_to_field`) or against ray-cast virtual scans (:func:`refine`).
+"""Point-to-line refinement of poses (``tf-plus``'s last stage): against the map itself
+(:func:`refine_to_field`, used on grid maps) or against ray-cast virtual scans (:func:`refine`,
+used on vector maps).
 
-**Against the map** (:func:`refine_to_field`): each scan point, placed at the candidate pose, is
-paired with the nearest map point of its cell (:class:`~tfloc.distance_field.DistanceField`,
-built once per map) and that point's normal, and Gauss–Newton steps minimise the point-to-line
-distances of the pairs closer than a gate that shrinks from ``gate_start`` to ``gate_end``. No
-scan is simulated. On a grid map built from real scans this is what removes the bias of the
-virtual scan: walls are several cells thick, a ray stops at the first occupied cell, and a real
-return lies inside the wall (measured on the Intel and CSAIL grids at the true poses: the
-virtual scan is 1.3 cm short at the median, 7.8 cm with walls one cell thicker; refining against
-it moved the answer by that much, and with two cells thicker walls it moved 99 % of the answers
-more than 10 cm away, see ``docs/tf-plus.md``). Pairing by nearest point has no beam window, so
-it does not depend on the scanner's beam count or spacing.
+**Against the map** (:func:`refine_to_field`). Each scan point, placed at the candidate pose,
+takes the nearest map point of its cell and that point's normal
+(:class:`~tfloc.distance_field.DistanceField`, built once per map), and Gauss–Newton steps
+minimise the point-to-line distances of the pairs closer than a gate that shrinks from
+``gate_start`` to ``gate_end``. No scan is simulated, and pairing by nearest point has no beam
+window, so nothing depends on the scanner's beam count or spacing. On a grid map two phases:
 
-**Against virtual scans** (:func:`refine`, ``refine_to="virtual"``, the variant before the real
-logs): each iteration simulates the virtual scan at every candidate pose (one batched
+1. while the gate is wider than ``offset_gate``, the pose alone against the occupied cells'
+   centres: robust, but a wall drawn several cells thick holds a return equally well anywhere
+   inside it, so this alone leaves the scan free to slide across the wall;
+2. then, the pose and a fourth unknown, the **depth** (metres) at which the scan's returns lie
+   behind the walls' surfaces: each point is also measured from the surface of its wall on its
+   sensor's side (:mod:`tfloc.wall_faces`), weighted ``face_weight``, with the cell term kept at
+   ``cell_weight``. The depth starts at the median over the points and has a weak prior
+   (``offset_prior``, ``offset_weight``, in units of one point), so a scan that sees walls from
+   one side only keeps it near the prior.
+
+Why: a grid map built from real scans draws walls several cells thick, and where in that band
+the returns lie is a property of how the map was built. Measured at the true poses (5 cm grids
+built by ``tfloc real-data``; ``benchmarks/tfplus_real_diagnostics.py``): the returns lie 2.7 cm
+(median; interquartile range over scans 2.3–3.2 cm) behind the surface on the Intel grid, 2.9 cm
+on the CSAIL grid, 7.4 and 12.3 cm with the walls thickened by one and two cells, and within a
+map the depth varies little from scan to scan. Started at the truth and at 10 cm / 1° from it,
+the refinement settles 2.2–2.3 cm from the truth on Intel and 1.8–2.3 cm on the thickened Intel
+grids (median), where the refinement against the occupied cells alone settles 5.5 and 8.8 cm
+away from the offsets, and the one against virtual scans 8.7 and 16.3 cm (a ray stops at the
+first occupied cell, so the virtual scan is 1.5 cm short on the Intel grid, 7.9 and 14.3 cm on
+the thickened ones).
+
+**Against virtual scans** (:func:`refine`; ``refine_to="virtual"``; the only refinement before
+the real logs). Each iteration simulates the virtual scan at every candidate pose (one batched
 :meth:`Map.raycast`, so it works for any map), associates each real point with the nearest
-virtual point within a few beams of the same bearing, takes the virtual scan's local line
+virtual point within ``window`` beams of the same bearing, takes the virtual scan's local line
 direction there (from its neighbouring points), and makes Gauss–Newton steps on SE(2) that
-minimise the point-to-line distances of the associated pairs. Pairs farther apart than a gate
-that shrinks from ``gate_start`` to ``gate_end`` are ignored, so walls the map lacks (or the
-map has and the scan misses) do not pull. All candidates are refined together, vectorised.
-
+minimise the point-to-line distances of the associated pairs, gated as above. On a vector map
+the virtual scan is exact (walls have no thickness) and it pairs points only with surfaces the
+sensor can see; there it is what ``tf-plus`` uses (on the simulated paper protocol subset it is
+also more precise than the map-point pairing: 0.13 cm / 0.017° against 0.14 cm / 0.021°).
 The pose update is in the frame of the current virtual scan: with ``δ = (tx, ty, φ)`` mapping
 real points ``p`` (sensor frame) to ``R(φ) p + t`` in the virtual pose's frame, the new pose is
 ``pose ⊕ δ``.
@@ -56,12 +74,25 @@ class RefineConfig:
             against virtual scans).
         gate_start: pair distance gate of the first iteration (metres).
         gate_end: pair distance gate of the last iteration (metres).
-        inlier_distance: truncation of the residual used to rank candidates (metres).
+        inlier_distance: truncation of the residual used to rank candidates (metres). 10 cm:
+            on real grid maps the residuals at the true pose spread over a few cm (the map's own
+            registration error), and 5 cm (chosen on simulated scans with 1 cm noise) cut
+            into them; measured on the development logs, 10 cm gave 2 more successes on Intel
+            (of 910) and none fewer on CSAIL or on the simulated protocol subset.
         damping: Levenberg–Marquardt damping added to the normal equations.
         prune_after: after this many iterations only the ``keep`` candidates with the lowest
             truncated residual go on, duplicates (within 5 cm of a better one) dropped
             (0: never prune).
         keep: see ``prune_after``.
+        faces: on a grid map, measure points from the walls' surfaces too (phase 2 of
+            :func:`refine_to_field`).
+        offset_prior: prior of the returns' depth behind the surfaces (metres): half a cell,
+            where a one-cell wall's returns lie.
+        offset_weight: weight of that prior, in units of one point.
+        offset_gate: phase 2 starts once the gate is at most this (metres).
+        max_depth: the depth is kept within ``[0, max_depth]`` when it starts (metres).
+        face_weight: weight of the surface residuals in phase 2 ...
+        cell_weight: ... and of the cell residuals.
     """
 
     iterations: int = 6
@@ -234,14 +265,3 @@ def refine_to_field(field: DistanceField, points: np.ndarray, poses: np.ndarray,
             keep = _prune_index(poses, truncated_cost(np.abs(r), cfg.inlier_distance), cfg.keep)
             poses, offsets = poses[keep], offsets[keep]
     return poses
-
-
-def _median_depth(depths: np.ndarray, cfg: RefineConfig) -> np.ndarray:
-    """Per pose, the median of ``depths`` ``(K, M)`` (NaN: none), clipped to ``[0, max_depth]``;
-    ``offset_prior`` where there is none."""
-    med = np.full(len(depths), cfg.offset_prior)
-    for k, d in enumerate(depths):
-        d = d[~np.isnan(d)]
-        if d.size:
-            med[k] = min(max(float(np.median(d)), 0.0), cfg.max_depth)
-    return med
