@@ -3,9 +3,11 @@
 Positions lie on a square lattice within ``radius`` metres of the initial guess (only those in
 free space); each is tried with every given heading. A candidate's score is the mean truncated
 distance (metres) of the real scan's points, placed at that pose, to the nearest map point
-(:class:`~tfloc.distance_field.DistanceField`), one table look-up per point: first on a subset
-of the points for every candidate, then on all points for a shortlist. The best few candidates,
-at least ``separation`` metres apart, are returned for refinement.
+(:class:`~tfloc.distance_field.DistanceField`; ``tf-plus`` passes the field pooled over each
+lattice cell, :func:`tfloc.distance_field.pooled`, so a lattice pose's score bounds those of
+the translations around it), one table look-up per point: first on a subset of the points for
+every candidate, then on all points for a shortlist. The best few candidates, at least
+``separation`` metres apart, are returned for refinement.
 """
 
 from __future__ import annotations

@@ -9,13 +9,13 @@ then one table look-up per scan point, so thousands of candidate poses cost a fe
 scan point into a point-to-line pair without simulating a scan (the refinement and the selection
 cost, :mod:`tfloc.refine`, :mod:`tfloc.scan_cost`).
 
-Why the map's own points and not a ray-cast virtual scan: a grid map built from real scans has
-walls several cells thick (the scans' registration error, range noise), and a ray stops at the
-first occupied cell, so a virtual scan is biased short by about half the wall's thickness
-(measured at the true poses: median −1.3 cm on the Intel and CSAIL grids, −7.8 cm on the same
-grids with walls one cell thicker). A return lies *inside* the thick wall it hit, in a cell the
-map marked occupied because such returns ended there, so its nearest occupied cell is unbiased.
-On a vector map the nearest sample point lies on the wall's line and its normal is the wall's.
+Why the map's own points on a grid, and not a ray-cast virtual scan: a grid map built from real
+scans draws walls several cells thick (the scans' registration error, range noise), and a ray
+stops at the first occupied cell, so the virtual scan is short (measured at the true poses:
+median −1.5 cm on the Intel grid, −7.9 and −14.3 cm on it with the walls thickened by one and
+two cells). A return lies *inside* the wall it hit; the grid's walls are also followed across
+(:mod:`tfloc.wall_faces`) so that a return can be measured from the wall's surface. On a vector
+map the nearest sample point lies on the wall's line and its normal is the wall's.
 """
 
 from __future__ import annotations

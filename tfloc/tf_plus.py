@@ -15,21 +15,32 @@ needs ~1800 cost evaluations per scan). Stages:
 2. **Coarse grid over position.** Every free lattice position within ``search_radius`` of the
    VP × those headings is scored on a truncated distance field of the map
    (:mod:`tfloc.coarse`, :mod:`tfloc.distance_field`): smooth, cheap and free of the corner
-   set's discreteness. Two levels: every ``scan_stride``-th point for all candidates, all points
-   for the best ``shortlist``; the best ``candidates`` (at least ``separation`` apart) go on.
-3. **Point-to-line refinement** of every candidate against its own virtual scan
-   (:mod:`tfloc.refine`), batched, with a shrinking outlier gate: centimetre accuracy once the
-   pose is in the basin.
+   set's discreteness. The field is pooled over ± half a lattice step (``coarse_bound``), so a
+   lattice pose scores at least as well as any translation within its cell (Olson's bound): in
+   a corridor on a real grid, the lattice point nearest the truth can lie 10 cm across the
+   corridor and score worse than points aligned across it but metres off along it. Two levels:
+   about ``coarse_points`` points (whatever the beam count) for all candidates, all points for
+   the best ``shortlist``; the best ``candidates`` (at least ``separation`` apart) go on.
+3. **Point-to-line refinement** of every candidate (:mod:`tfloc.refine`), batched, with a
+   shrinking outlier gate: on a grid map against the map itself (nearest occupied cell, then
+   also the walls' surfaces with the returns' depth behind them as a fourth unknown), on a
+   vector map against ray-cast virtual scans (``refine_to="auto"``). A grid drawn from real
+   scans has walls several cells thick, and a ray cast in it stops at the first occupied cell:
+   fitting to that virtual scan biased the answer by the wall's thickness.
 4. **Selection** of the refined candidate with the lowest per-beam cost (truncated point-to-line
-   residual, plus see-through beams, :mod:`tfloc.scan_cost`; ``select="residual"``), or the
-   lowest turning-function Err (``select="tf"``); candidates
+   residual to the map, plus see-through beams judged against the far side of the first wall,
+   :mod:`tfloc.scan_cost`; ``select="residual"``), or the lowest turning-function Err
+   (``select="tf"``); candidates
    within ``tie_tolerance`` of the best (the scan sees the same geometry from both places, e.g.
    a bare corner) are a tie, broken in favour of the one nearest the VP.
 
-Each stage can be switched off (``tf_seed``, ``heading_sweep``, ``grid``, ``refine``,
-``beam_check``, ``tie_tolerance=0``) for the ablation in
-``benchmarks/tfplus_ablation.py``. It uses only the :class:`~tfloc.maps.base.Map` protocol and
-never the true pose.
+Each stage can be switched off or put back as it was before the real logs (``tf_seed``,
+``heading_sweep``, ``grid``, ``coarse_bound``, ``refine``, ``refine_to="virtual"``,
+``select="virtual"``, ``beam_check``, ``tie_tolerance=0``) for the ablations in
+``benchmarks/tfplus_ablation.py`` (simulated) and ``benchmarks/tfplus_ablation_real.py`` (real
+logs); ``docs/tf-plus.md`` has the measurements. It uses the :class:`~tfloc.maps.base.Map`
+protocol, on a :class:`~tfloc.maps.grid.GridMap` also its occupied cells (walls have thickness
+there), and never the true pose.
 """
 
 from __future__ import annotations
