@@ -12,7 +12,7 @@ cost, :mod:`tfloc.refine`, :mod:`tfloc.scan_cost`).
 Why the map's own points on a grid, and not a ray-cast virtual scan: a grid map built from real
 scans draws walls several cells thick (the scans' registration error, range noise), and a ray
 stops at the first occupied cell, so the virtual scan is short (measured at the true poses:
-median −1.5 cm on the Intel grid, −7.9 and −14.3 cm on it with the walls thickened by one and
+median −1.5 cm on the Intel grid, −7.9 and −14.2 cm on it with the walls thickened by one and
 two cells). A return lies *inside* the wall it hit; the grid's walls are also followed across
 (:mod:`tfloc.wall_faces`) so that a return can be measured from the wall's surface. On a vector
 map the nearest sample point lies on the wall's line and its normal is the wall's.

@@ -21,15 +21,14 @@ window, so nothing depends on the scanner's beam count or spacing. On a grid map
 
 Why: a grid map built from real scans draws walls several cells thick, and where in that band
 the returns lie is a property of how the map was built. Measured at the true poses (5 cm grids
-built by ``tfloc real-data``; ``benchmarks/tfplus_real_diagnostics.py``): the returns lie 2.7 cm
-(median; interquartile range over scans 2.3–3.2 cm) behind the surface on the Intel grid, 2.9 cm
-on the CSAIL grid, 7.4 and 12.3 cm with the walls thickened by one and two cells, and within a
-map the depth varies little from scan to scan. Started at the truth and at 10 cm / 1° from it,
-the refinement settles 2.2–2.3 cm from the truth on Intel and 1.8–2.3 cm on the thickened Intel
-grids (median), where the refinement against the occupied cells alone settles 5.5 and 8.8 cm
-away from the offsets, and the one against virtual scans 8.7 and 16.3 cm (a ray stops at the
-first occupied cell, so the virtual scan is 1.5 cm short on the Intel grid, 7.9 and 14.3 cm on
-the thickened ones).
+built by ``tfloc real-data``, 180 scans per log; ``results/tf-plus-real-diagnostics.md``): the
+returns lie 2.7 cm (median; interquartile range over scans 2.3–3.2 cm) behind the surface on the
+Intel grid, 2.8 cm on the CSAIL grid, 7.5 and 12.4 cm on the Intel grid with its walls thickened
+by one and two cells, and within a map the depth varies little from scan to scan. Started at
+10 cm / 1° from the truth, this refinement settles 2.1, 2.0 and 2.2 cm from the truth on those
+three Intel grids (median), the refinement against the occupied cells alone 2.7, 5.6 and 8.8 cm,
+and the one against virtual scans 2.0, 8.7 and 16.1 cm (a ray stops at the first occupied
+cell, so the virtual scan is 1.5, 7.9 and 14.2 cm short there).
 
 **Against virtual scans** (:func:`refine`; ``refine_to="virtual"``; the only refinement before
 the real logs). Each iteration simulates the virtual scan at every candidate pose (one batched
