@@ -3,9 +3,10 @@
 A grid map built from real scans (hit counting with free-space carving as in ``tfloc
 real-data``; GMapping, Cartographer and slam_toolbox alike) draws a wall as a band of occupied
 cells: the scans' registration error and range noise spread the returns from one surface over
-two or more cells across it. Measured on the Intel and MIT CSAIL grids (``tfloc real-data``), a
-band is 2 cells (10 cm) thick at the median across it and 3 or more cells for a quarter of the
-cells. A band carries no information about where inside it a return lies; its *surfaces* (where
+two or more cells across it. Measured across the occupied cells of the Intel and MIT CSAIL grids
+(``tfloc real-data``, ``results/tf-plus-real-diagnostics.md``), a band is about 2 cells (10 and
+8 cm) thick at the median; a map built from scans with larger registration error draws thicker
+bands. A band carries no information about where inside it a return lies; its *surfaces* (where
 free space ends) do. ``tf-plus`` measures a return from the surface on its sensor's side and
 estimates how deep behind it the scan's returns lie (:mod:`tfloc.refine`).
 
