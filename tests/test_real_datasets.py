@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from tfloc.core.pose import angdiff
-from tfloc.datasets.real import INTEL_LASER, build_all, clean_ranges
+from tfloc.datasets.real import ACES_LASER, ACES_NO_RETURN_M, INTEL_LASER, build_all, clean_ranges
 from tfloc.datasets.relations import build_relations, overlap
 from tfloc.io.carmen import read_carmen
 from tfloc.io.scenario import map_for, read_scans, read_scenario
@@ -45,6 +45,18 @@ def test_intel_spacing_decision_recomputed_on_a_subset() -> None:
     assert scores[0].mean_clipped < 0.97 * scores[1].mean_clipped
 
 
+def test_aces_spacing_decision_recomputed_on_a_subset() -> None:
+    """data/real/aces/SPACING.md: 1° from -90° lines the corrected ACES scans up best too."""
+    log = read_carmen(DATA / "real" / "aces" / "aces-corrected.log.gz")
+    R = np.vstack([clean_ranges(s.ranges, ACES_NO_RETURN_M) for s in log.lasers[:300]])
+    P = log.poses()[:300]
+    spacing = _spacing_analysis()
+    scores = spacing.compare(R, P, spacing.intel_candidates(50.0))
+    assert scores[0].label == "1deg-from-90"
+    assert scores[0].laser == ACES_LASER
+    assert scores[0].mean_clipped < 0.97 * scores[1].mean_clipped
+
+
 @pytest.fixture(scope="module")
 def rebuilt(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("real")
@@ -59,7 +71,9 @@ def rebuilt(tmp_path_factory) -> Path:
     "scenarios/real-csail-relations-perturbed/scenario.json",
     "scenarios/real-intel-scan-to-map/scans.csv", "scenarios/real-intel-scan-to-map/scenario.json",
     "scenarios/real-csail-scan-to-map/scans.csv", "scenarios/real-csail-scan-to-map/scenario.json",
+    "scenarios/real-aces-scan-to-map/scans.csv", "scenarios/real-aces-scan-to-map/scenario.json",
     "maps/real-intel.yaml", "maps/real-intel.pgm", "maps/real-csail.yaml", "maps/real-csail.pgm",
+    "maps/real-aces.yaml", "maps/real-aces.pgm",
 ])
 def test_committed_datasets_are_reproducible(rebuilt: Path, rel: str) -> None:
     if rel.endswith("scenario.json"):  # the map path is relative to where it was written
@@ -98,7 +112,8 @@ def test_relations_dataset_matches_the_log() -> None:
     assert np.median(gain) > 0.0
 
 
-@pytest.mark.parametrize("name, n", [("real-intel-scan-to-map", 910), ("real-csail-scan-to-map", 406)])
+@pytest.mark.parametrize("name, n", [("real-intel-scan-to-map", 910), ("real-csail-scan-to-map", 406),
+                                     ("real-aces-scan-to-map", 440)])
 def test_scan_to_map_dataset(name: str, n: int) -> None:
     sc = read_scenario(SCEN / name)
     scans = read_scans(sc)

@@ -9,10 +9,10 @@ from shapely.geometry import box
 import tfloc
 from tfloc import Pose, Problem, VectorMap
 from tfloc.maps.fields import distance_field
-from tfloc.paper.matcher import TfConfig, scan_turning_function
+from tfloc.paper.shape import ShapeConfig, scan_turning_function
 from tfloc.tfplus.headings import rotation_candidates
 from tfloc.tfplus.matcher import TfPlusConfig, TurningFunctionPlusMatcher
-from tfloc.tfplus.refine import refine
+from tfloc.tfplus.refine import RefineConfig, refine
 
 TRUE = Pose(3.0, 3.5, 0.4)
 
@@ -87,13 +87,17 @@ def test_config_overrides_and_bad_parameters():
         TurningFunctionPlusMatcher(select="nearest")
     with pytest.raises(tfloc.errors.ParameterError, match="tf-plus.*select"):
         tfloc.get_matcher("tf-plus", select="nearest")
+    with pytest.raises(tfloc.errors.ParameterError):
+        TurningFunctionPlusMatcher(refine_to="scan")
 
 
 def test_ablation_switches_run(test_room, lms200):
     ranges = noisy_scan(test_room, lms200, TRUE)
     init = Pose(TRUE.x + 0.2, TRUE.y - 0.1, TRUE.theta + 0.05)
     for kw in ({"tf_seed": False}, {"heading_sweep": False}, {"grid": False}, {"select": "tf"},
-               {"tie_tolerance": 0.0}, {"beam_check": False}):
+               {"tie_tolerance": 0.0}, {"beam_check": False}, {"refine_to": "virtual"},
+               {"select": "virtual"}, {"coarse_bound": False}, {"coarse_points": 0},
+               {"refinement": RefineConfig(faces=False)}):
         est = TurningFunctionPlusMatcher(**kw).localize(Problem(test_room, lms200, ranges, init))
         assert est.pose.distance_to(TRUE) < 0.02, kw
     # without refinement the answer is a grid pose (0.2 m lattice): near, not exact
@@ -102,7 +106,7 @@ def test_ablation_switches_run(test_room, lms200):
 
 
 def test_edge_histogram_recovers_a_pure_rotation(test_room, lms200):
-    cfg = TfConfig(spacing=0.05)
+    cfg = ShapeConfig(spacing=0.05)
     real = scan_turning_function(test_room.raycast(TRUE, lms200), lms200, cfg)
     off = Pose(TRUE.x, TRUE.y, TRUE.theta + math.radians(8))
     virtual = scan_turning_function(test_room.raycast(off, lms200), lms200, cfg)

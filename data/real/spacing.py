@@ -55,7 +55,8 @@ def alignment(ranges: np.ndarray, poses: np.ndarray, laser: LaserSpec, label: st
 
 
 def intel_candidates(max_range: float) -> dict[str, LaserSpec]:
-    """The readings of a 180-beam FLASER scan over a 180° field of view (see data/real/README.md)."""
+    """The readings of a 180-beam FLASER scan over a 180° field of view (see data/real/README.md);
+    used for the Intel and the ACES logs (``data/real/{intel,aces}/SPACING.md``)."""
     return {
         "1deg-from-90": LaserSpec.from_degrees(max_range, 179.0, 1.0, -90.0),
         "180/179deg": LaserSpec.from_degrees(max_range, 180.0, 180.0 / 179.0, -90.0),

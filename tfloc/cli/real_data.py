@@ -2,8 +2,8 @@
 
 Writes OUT/scenarios/real-csail-relations/ and real-csail-relations-perturbed/ (scan-to-scan, the
 1172 MIT CSAIL relations from the odometry guess and from perturbed guesses),
-OUT/scenarios/real-intel-scan-to-map/ and OUT/scenarios/real-csail-scan-to-map/ (scan-to-map),
-and their grid maps OUT/maps/real-intel.yaml|.pgm and OUT/maps/real-csail.yaml|.pgm.
+OUT/scenarios/real-{intel,csail,aces}-scan-to-map/ (scan-to-map), and their grid maps
+OUT/maps/real-{intel,csail,aces}.yaml|.pgm.
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-HELP = "build the real-log scenario datasets (MIT CSAIL relations, Intel/CSAIL scan-to-map)"
+HELP = "build the real-log scenario datasets (MIT CSAIL relations, Intel/CSAIL/ACES scan-to-map)"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -1,9 +1,9 @@
 """Scenario datasets built from the real logs in ``data/real/`` (deterministic for a given seed).
 
 * the MIT CSAIL relations datasets: :mod:`tfloc.datasets.relations`.
-* ``real-intel-scan-to-map`` and ``real-csail-scan-to-map``: every scan of a SLAM-corrected log
-  localized in a grid map built from all corrected scans, from an initial pose perturbed in the
-  paper's 3 × 3 offset bins.
+* ``real-intel-scan-to-map``, ``real-csail-scan-to-map`` and ``real-aces-scan-to-map``: every scan
+  of a SLAM-corrected log localized in a grid map built from all corrected scans, from an initial
+  pose perturbed in the paper's 3 × 3 offset bins.
 """
 
 from __future__ import annotations
@@ -32,12 +32,17 @@ MAX_RANGE_M = 50.0
 CSAIL_LASER = LaserSpec.from_degrees(MAX_RANGE_M, 180.0, 0.5, -90.0)
 #: Intel: 180 beams at 1° from -90° (-90°…+89°), settled by measurement (data/real/intel/SPACING.md).
 INTEL_LASER = LaserSpec.from_degrees(MAX_RANGE_M, 179.0, 1.0, -90.0)
+#: ACES: 180 beams at 1° from -90°, settled by the same measurement (data/real/aces/SPACING.md).
+ACES_LASER = LaserSpec.from_degrees(MAX_RANGE_M, 179.0, 1.0, -90.0)
+#: The ACES log caps its ranges at 50 m: exactly 50 m is its no-return code (620 beams; the
+#: largest real return is 49.91 m).
+ACES_NO_RETURN_M = 50.0
 
 
-def clean_ranges(ranges: np.ndarray) -> np.ndarray:
-    """The no-return code (≥ 80 m) → ``inf``; metres."""
+def clean_ranges(ranges: np.ndarray, no_return: float = NO_RETURN_M) -> np.ndarray:
+    """The no-return code (ranges ≥ ``no_return`` metres) → ``inf``; metres."""
     r = np.array(ranges, dtype=float)
-    r[r >= NO_RETURN_M] = np.inf
+    r[r >= no_return] = np.inf
     return r
 
 
@@ -51,12 +56,14 @@ def front_scans(log: CarmenLog, laser: LaserSpec) -> list:
 
 
 def scan_to_map(log_path: Path, laser: LaserSpec, resolution: float = 0.05,
-                cfg: Perturbation | None = None) -> tuple[GridMap, list[Scan]]:
-    """The grid map of a corrected log and its scans with perturbed initial poses."""
+                cfg: Perturbation | None = None,
+                no_return: float = NO_RETURN_M) -> tuple[GridMap, list[Scan]]:
+    """The grid map of a corrected log and its scans with perturbed initial poses (ranges ≥
+    ``no_return`` metres are the log's no-return code)."""
     cfg = cfg or Perturbation()
     log = read_carmen(log_path)
     scans = front_scans(log, laser)
-    R = np.vstack([clean_ranges(s.ranges) for s in scans])
+    R = np.vstack([clean_ranges(s.ranges, no_return) for s in scans])
     P = np.array([s.pose.as_array() for s in scans])
     grid = grid_from_scans(R, P, laser, resolution, name=log_path.name.split(".")[0])
     init, groups = perturb(P, grid, cfg)
@@ -71,16 +78,23 @@ def _source(real: Path, *files: str) -> dict:
 
 def build_all(real: Path, out: Path, seed: int = DEFAULT_SEED, resolution: float = 0.05) -> list[Path]:
     """(Re)build the real scan-to-map datasets under ``out/scenarios`` and their maps under
-    ``out/maps`` (the relations datasets: :func:`tfloc.datasets.relations.build_relations`)."""
+    ``out/maps`` (the relations datasets: :func:`tfloc.datasets.relations.build_relations`).
+    Every log's initial poses are drawn from their own generator seeded with ``seed``, so adding
+    a log leaves the others' datasets byte-identical."""
     real, out = Path(real), Path(out)
     made = []
     cfg = Perturbation(seed=seed)
-    for key, log_rel, laser, note in (
+    aces_note = (
+        "ACES building, UT Austin (440 scans, 180 beams at 1 deg from -90 deg: see "
+        "data/real/aces/SPACING.md; the log caps ranges at 50 m, and 50 m is its no-return code)")
+    for key, log_rel, laser, note, no_return in (
             ("intel", "intel/intel-corrected.log.gz", INTEL_LASER,
-             "Intel Research Lab (910 scans, 180 beams at 1 deg from -90 deg: see data/real/intel/SPACING.md)"),
+             "Intel Research Lab (910 scans, 180 beams at 1 deg from -90 deg: see data/real/intel/SPACING.md)",
+             NO_RETURN_M),
             ("csail", "mit-csail/csail-corrected.log.gz", CSAIL_LASER,
-             "MIT CSAIL corrected log (406 scans, 361 beams at 0.5 deg)")):
-        grid, rows = scan_to_map(real / log_rel, laser, resolution, cfg)
+             "MIT CSAIL corrected log (406 scans, 361 beams at 0.5 deg)", NO_RETURN_M),
+            ("aces", "aces/aces-corrected.log.gz", ACES_LASER, aces_note, ACES_NO_RETURN_M)):
+        grid, rows = scan_to_map(real / log_rel, laser, resolution, cfg, no_return)
         map_yaml = write_ros_map(grid, out / "maps" / f"real-{key}.yaml")
         root = out / "scenarios" / f"real-{key}-scan-to-map"
         made.append(write_scenario(
@@ -92,7 +106,8 @@ def build_all(real: Path, out: Path, seed: int = DEFAULT_SEED, resolution: float
                 "carving, occupied if > 25 % of the beams reaching a cell end there. init = true pose "
                 "perturbed in the paper's 3x3 bins (0-1/1-2/2-3 m x 0-5/5-10/10-15 deg, groups d{i}-a{j}, "
                 f"balanced), in free space >= {cfg.clearance_m:g} m from occupied cells, seed {seed}. "
-                "No-return ~81.9 m -> inf; max_range 50 m."),
+                + ("No-return ~81.9 m -> inf; max_range 50 m." if no_return == NO_RETURN_M else
+                   f"No-return {no_return:g} m (the log's cap) -> inf; max_range 50 m.")),
             generator={"command": "tfloc real-data", "seed": seed, "resolution_m": resolution,
                        "clearance_m": cfg.clearance_m},
             source=_source(real, log_rel)))

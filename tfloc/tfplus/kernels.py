@@ -11,6 +11,8 @@ import math
 import numpy as np
 from numba import njit
 
+from tfloc.maps._gridcast import _entry, _start
+
 
 @njit(cache=True, nogil=True)
 def grid_scores_kernel(table: np.ndarray, origin_x: float, origin_y: float, resolution: float,
@@ -29,18 +31,64 @@ def grid_scores_kernel(table: np.ndarray, origin_x: float, origin_y: float, reso
             rx[j, i] = c * points[i, 0] - s * points[i, 1]
             ry[j, i] = s * points[i, 0] + c * points[i, 1]
     inv = 1.0 / resolution
-    for p in range(n):
-        px, py = positions[p, 0] - origin_x, positions[p, 1] - origin_y
-        for j in range(h):
-            acc = 0.0
-            for i in range(m):
-                ix = int(math.floor((px + rx[j, i]) * inv))
-                iy = int(math.floor((py + ry[j, i]) * inv))
+    out[:, :] = 0.0
+    # point-major, positions innermost: consecutive look-ups walk the lattice, which is local
+    # in the table (cache-friendly), where scan-point-major order jumps across the map
+    for j in range(h):
+        for i in range(m):
+            qx, qy = rx[j, i] - origin_x, ry[j, i] - origin_y
+            for p in range(n):
+                ix = int(math.floor((positions[p, 0] + qx) * inv))
+                iy = int(math.floor((positions[p, 1] + qy) * inv))
                 ix = min(max(ix, 0), nx - 1)
                 iy = min(max(iy, 0), ny - 1)
-                acc += table[iy, ix]
-            out[p, j] = acc / m
+                out[p, j] += table[iy, ix]
+    for p in range(n):
+        for j in range(h):
+            out[p, j] /= m
     return out
+
+
+@njit(cache=True, nogil=True)
+def pose_scores_kernel(table: np.ndarray, origin_x: float, origin_y: float, resolution: float,
+                       points: np.ndarray, poses: np.ndarray) -> np.ndarray:
+    """Mean distance-field value ``(K,)`` of ``points`` ``(M, 2)`` at each of ``(K, 3)`` poses."""
+    ny, nx = table.shape
+    out = np.zeros(poses.shape[0])
+    inv = 1.0 / resolution
+    for k in range(poses.shape[0]):
+        c, s = math.cos(poses[k, 2]), math.sin(poses[k, 2])
+        px, py = poses[k, 0] - origin_x, poses[k, 1] - origin_y
+        acc = 0.0
+        for i in range(points.shape[0]):
+            ix = int(math.floor((px + c * points[i, 0] - s * points[i, 1]) * inv))
+            iy = int(math.floor((py + s * points[i, 0] + c * points[i, 1]) * inv))
+            acc += table[min(max(iy, 0), ny - 1), min(max(ix, 0), nx - 1)]
+        out[k] = acc / points.shape[0]
+    return out
+
+
+@njit(cache=True, nogil=True)
+def separated_kernel(poses: np.ndarray, count: int, separation: float) -> np.ndarray:
+    """Indices of up to ``count`` of the ``(N, 3)`` poses (in the given order) whose positions are
+    at least ``separation`` metres from every earlier kept one."""
+    keep = np.empty(count, dtype=np.int64)
+    n_kept = 0
+    s2 = separation * separation
+    for i in range(poses.shape[0]):
+        ok = True
+        for k in range(n_kept):
+            dx = poses[i, 0] - poses[keep[k], 0]
+            dy = poses[i, 1] - poses[keep[k], 1]
+            if dx * dx + dy * dy < s2:
+                ok = False
+                break
+        if ok:
+            keep[n_kept] = i
+            n_kept += 1
+            if n_kept == count:
+                break
+    return keep[:n_kept]
 
 
 @njit(cache=True, nogil=True)
@@ -87,3 +135,207 @@ def pairs_kernel(points: np.ndarray, delta: np.ndarray, q: np.ndarray, normal: n
                 for b in range(3):
                     hh[k, a, b] += jac[a] * jac[b]
     return hh, gg, res
+
+
+@njit(cache=True, nogil=True)
+def field_pairs_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, resolution: float,
+                       map_points: np.ndarray, map_normals: np.ndarray, face_plus: np.ndarray,
+                       face_minus: np.ndarray, points: np.ndarray, poses: np.ndarray,
+                       offsets: np.ndarray, gate: float, slack: float, cell_weight: float,
+                       face_weight: float,
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Point-to-line pairs of scan points with their nearest map points, and one Gauss–Newton system.
+
+    ``nearest`` ``(ny, nx)``: index into the map points ``(N, 2)``, their unit normals ``(N, 2)``
+    and the distances ``face_plus``/``face_minus`` ``(N,)`` from each point to its wall's surface
+    along ``±normal`` of each cell's nearest map point (a
+    :class:`~tfloc.tfplus.view.DistanceField`). ``points`` ``(M, 2)``: the scan (sensor frame);
+    ``poses`` ``(K, 3)`` world poses, ``offsets`` ``(K,)`` how far (metres) the returns lie behind
+    the walls' surfaces. Each world point ``w`` is paired with the map point ``q`` of its cell if
+    ``|w − q| ≤ gate``. Its residual is ``n·(w − q)`` (metres), or with ``use_faces``, with ``n``
+    turned to face the sensor, ``n·(w − q) − face + offset`` (``face`` the distance to the
+    surface on the sensor's side).
+
+    Returns, per pose, the normal equations ``H`` ``(K, 4, 4)`` and ``g`` ``(K, 4)`` in the
+    additive parameters ``(x, y, θ, offset)`` (the offset's column is zero without faces), the
+    residuals ``(K, M)`` (NaN: unpaired), and the ranking residual ``max(|n·(w − q)|, |w − q| −
+    slack)`` ``(K, M)`` of every point, paired or not (the second term keeps a point beyond the
+    end of a wall, on the wall's line, from counting as on it).
+    """
+    ny, nx = nearest.shape
+    k_n, m = poses.shape[0], points.shape[0]
+    hh = np.zeros((k_n, 4, 4))
+    gg = np.zeros((k_n, 4))
+    res = np.full((k_n, m), np.nan)
+    rank = np.empty((k_n, m))
+    inv = 1.0 / resolution
+    jac = np.zeros(4)
+    for k in range(k_n):
+        px, py = poses[k, 0], poses[k, 1]
+        c, s = math.cos(poses[k, 2]), math.sin(poses[k, 2])
+        for i in range(m):
+            ox = c * points[i, 0] - s * points[i, 1]
+            oy = s * points[i, 0] + c * points[i, 1]
+            wx, wy = px + ox, py + oy
+            ix = min(max(int(math.floor((wx - origin_x) * inv)), 0), nx - 1)
+            iy = min(max(int(math.floor((wy - origin_y) * inv)), 0), ny - 1)
+            j = nearest[iy, ix]
+            if j < 0:
+                rank[k, i] = np.inf
+                continue
+            dx, dy = wx - map_points[j, 0], wy - map_points[j, 1]
+            nxj, nyj = map_normals[j, 0], map_normals[j, 1]
+            r = nxj * dx + nyj * dy
+            dist = math.sqrt(dx * dx + dy * dy)
+            rank[k, i] = max(abs(r), dist - slack)
+            if dist > gate:
+                continue
+            res[k, i] = r
+            jac[0], jac[1], jac[2], jac[3] = nxj, nyj, -nxj * oy + nyj * ox, 0.0
+            for a in range(3):
+                gg[k, a] += cell_weight * jac[a] * r
+                for b in range(3):
+                    hh[k, a, b] += cell_weight * jac[a] * jac[b]
+            if face_weight > 0.0:
+                if nxj * ox + nyj * oy > 0.0:          # the normal faces away from the sensor
+                    nxj, nyj, rf = -nxj, -nyj, -r - face_minus[j]
+                else:
+                    rf = r - face_plus[j]
+                rf += offsets[k]
+                jac[0], jac[1], jac[2], jac[3] = nxj, nyj, -nxj * oy + nyj * ox, 1.0
+                for a in range(4):
+                    gg[k, a] += face_weight * jac[a] * rf
+                    for b in range(4):
+                        hh[k, a, b] += face_weight * jac[a] * jac[b]
+    return hh, gg, res, rank
+
+
+@njit(cache=True, nogil=True)
+def face_depths_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, resolution: float,
+                       map_points: np.ndarray, map_normals: np.ndarray, face_plus: np.ndarray,
+                       face_minus: np.ndarray, points: np.ndarray, poses: np.ndarray,
+                       gate: float) -> np.ndarray:
+    """How deep (metres) each scan point lies behind its wall's surface on the sensor's side
+    (``(K, M)``; NaN if its nearest map point is farther than ``gate``); see
+    :func:`field_pairs_kernel` for the arguments."""
+    ny, nx = nearest.shape
+    k_n, m = poses.shape[0], points.shape[0]
+    out = np.full((k_n, m), np.nan)
+    inv = 1.0 / resolution
+    for k in range(k_n):
+        px, py = poses[k, 0], poses[k, 1]
+        c, s = math.cos(poses[k, 2]), math.sin(poses[k, 2])
+        for i in range(m):
+            ox = c * points[i, 0] - s * points[i, 1]
+            oy = s * points[i, 0] + c * points[i, 1]
+            wx, wy = px + ox, py + oy
+            ix = min(max(int(math.floor((wx - origin_x) * inv)), 0), nx - 1)
+            iy = min(max(int(math.floor((wy - origin_y) * inv)), 0), ny - 1)
+            j = nearest[iy, ix]
+            if j < 0:
+                continue
+            dx, dy = wx - map_points[j, 0], wy - map_points[j, 1]
+            if dx * dx + dy * dy > gate * gate:
+                continue
+            r = map_normals[j, 0] * dx + map_normals[j, 1] * dy
+            if map_normals[j, 0] * ox + map_normals[j, 1] * oy > 0.0:
+                out[k, i] = r + face_minus[j]
+            else:
+                out[k, i] = face_plus[j] - r
+    return out
+
+
+@njit(cache=True, nogil=True)
+def refine_field_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, resolution: float,
+                        map_points: np.ndarray, map_normals: np.ndarray, face_plus: np.ndarray,
+                        face_minus: np.ndarray, points: np.ndarray, poses: np.ndarray,
+                        offsets: np.ndarray, gates: np.ndarray, inner: int, offset_gate: float,
+                        faces: bool, face_weight: float, cell_weight: float, damping: float,
+                        offset_weight: float, offset_prior: float, max_depth: float,
+                        started: bool) -> bool:
+    """Gauss–Newton iterations of :func:`tfloc.tfplus.refine.refine_to_field`, one per gate of ``gates``
+    × ``inner``, on ``poses`` ``(K, 3)`` and ``offsets`` ``(K,)`` in place (see there and
+    :func:`field_pairs_kernel`). Returns whether the depth offsets have been started."""
+    k_n = poses.shape[0]
+    for it in range(gates.shape[0]):
+        gate = gates[it]
+        late = faces and gate <= offset_gate
+        if late and not started:
+            started = True
+            d = face_depths_kernel(nearest, origin_x, origin_y, resolution, map_points, map_normals,
+                                   face_plus, face_minus, points, poses, gate)
+            for k in range(k_n):
+                v = d[k][~np.isnan(d[k])]
+                offsets[k] = min(max(np.median(v), 0.0), max_depth) if v.size else offset_prior
+        fw = face_weight if late else 0.0
+        cw = cell_weight if late else 1.0
+        for _ in range(inner):
+            h, g, r, _ = field_pairs_kernel(nearest, origin_x, origin_y, resolution, map_points,
+                                            map_normals, face_plus, face_minus, points, poses,
+                                            offsets, gate, resolution, cw, fw)
+            for k in range(k_n):
+                if np.sum(~np.isnan(r[k])) < 3:
+                    continue
+                hk = h[k] + damping * np.eye(4)
+                gk = g[k].copy()
+                hk[3, 3] += offset_weight
+                gk[3] += offset_weight * (offsets[k] - offset_prior)
+                step = np.linalg.solve(hk, gk)
+                poses[k, 0] -= step[0]
+                poses[k, 1] -= step[1]
+                poses[k, 2] = (poses[k, 2] - step[2] + np.pi) % (2 * np.pi) - np.pi
+                offsets[k] -= step[3]
+    return started
+
+
+@njit(cache=True, nogil=True)
+def see_through_kernel(occ: np.ndarray, origin_x: float, origin_y: float, resolution: float,
+                       poses: np.ndarray, angles: np.ndarray, ranges: np.ndarray,
+                       max_range: float, margin: float) -> np.ndarray:
+    """Which beams ``(K, n)`` of the real scan ``ranges`` ``(n,)`` (metres, ``angles`` relative to
+    the sensor) the occupied grid ``occ`` says cannot be, at each of ``(K, 3)`` poses: a return
+    more than ``margin`` beyond the far side of the first wall the beam meets (where the first
+    run of occupied cells ends: a wall drawn several cells thick holds returns anywhere inside it),
+    or no return (NaN, inf, ≥ ``max_range``) where the beam meets a wall within ``max_range``.
+    Each beam is followed only as far as it needs to be."""
+    H, W = occ.shape
+    k_n, n = poses.shape[0], angles.shape[0]
+    out = np.zeros((k_n, n), dtype=np.bool_)
+    for k in range(k_n):
+        x0, y0 = (poses[k, 0] - origin_x) / resolution, (poses[k, 1] - origin_y) / resolution
+        for b in range(n):
+            r = ranges[b]
+            ret = r > 0.0 and r < max_range            # False for NaN
+            limit = (r - margin) / resolution if ret else max_range / resolution
+            if limit <= 0.0:
+                continue
+            a = poses[k, 2] + angles[b]
+            dx, dy = math.cos(a), math.sin(a)
+            t0, t1 = _entry(x0, y0, dx, dy, W, H)
+            if t0 > t1 or t0 > limit:
+                continue
+            t1 = min(t1, limit)
+            i, j, sx, sy, tdx, tdy, tx, ty = _start(x0, y0, dx, dy, t0, W, H)
+            t = t0
+            inside = False
+            while t <= t1:
+                if occ[j, i]:
+                    if not ret:
+                        out[k, b] = True
+                        break
+                    inside = True
+                elif inside:
+                    out[k, b] = True                 # left the first wall before the return
+                    break
+                t = min(tx, ty)
+                if tx < ty:
+                    tx += tdx
+                    i += sx
+                    if i < 0 or i >= W:
+                        break
+                else:
+                    ty += tdy
+                    j += sy
+                    if j < 0 or j >= H:
+                        break
+    return out

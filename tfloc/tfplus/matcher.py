@@ -14,25 +14,33 @@ needs ~1800 cost evaluations per scan). Stages:
    ``docs/tf-plus.md``).
 2. **Coarse grid over position.** Every free lattice position within ``search_radius`` of the
    VP × those headings is scored on a truncated distance field of the map
-   (:mod:`tfloc.tfplus.coarse`, :mod:`tfloc.maps.fields`): smooth, cheap and free of the corner
-   set's discreteness. Two levels: every ``scan_stride``-th point for all candidates, all points
-   for the best ``shortlist``; the best ``candidates`` (at least ``separation`` apart) go on.
-3. **Point-to-line refinement** of every candidate against its own virtual scan
-   (:mod:`tfloc.tfplus.refine`), batched, with a shrinking outlier gate: centimetre accuracy once the
-   pose is in the basin.
+   (:mod:`tfloc.tfplus.coarse`, :mod:`tfloc.tfplus.view`): smooth, cheap and free of the corner
+   set's discreteness. The field is pooled over ± half a lattice step (``coarse_bound``), so a
+   lattice pose scores at least as well as any translation within its cell (Olson's bound): in
+   a corridor on a real grid, the lattice point nearest the truth can lie 10 cm across the
+   corridor and score worse than points aligned across it but metres off along it. Two levels:
+   about ``coarse_points`` points (whatever the beam count) for all candidates, all points for
+   the best ``shortlist``; the best ``candidates`` (at least ``separation`` apart) go on.
+3. **Point-to-line refinement** of every candidate (:mod:`tfloc.tfplus.refine`), batched, with a
+   shrinking outlier gate: on a grid map against the map itself (nearest occupied cell, then
+   also the walls' surfaces with the returns' depth behind them as a fourth unknown), on a
+   vector map against ray-cast virtual scans (``refine_to="auto"``). A grid drawn from real
+   scans has walls several cells thick, and a ray cast in it stops at the first occupied cell:
+   fitting to that virtual scan biased the answer by the wall's thickness.
 4. **Selection** of the refined candidate with the lowest per-beam cost (truncated point-to-line
-   residual, plus see-through beams, :mod:`tfloc.tfplus.cost`; ``select="residual"``), or the
-   lowest turning-function Err (``select="tf"``); candidates
+   residual to the map, plus see-through beams judged against the far side of the first wall,
+   :mod:`tfloc.tfplus.cost`; ``select="residual"``), or the lowest turning-function Err
+   (``select="tf"``); candidates
    within ``tie_tolerance`` of the best (the scan sees the same geometry from both places, e.g.
    a bare corner) are a tie, broken in favour of the one nearest the VP.
 
-**Amortised per map** (``prepare``): the distance field of the coarse search and the map's
-free-space test. **Per scan**: everything else (virtual scans depend on the candidate poses).
-
-Each stage can be switched off (``tf_seed``, ``heading_sweep``, ``grid``, ``refine``,
-``beam_check``, ``tie_tolerance=0``) for the ablation in
-``benchmarks/tfplus_ablation.py``. It uses only the :class:`~tfloc.core.map.Map` protocol and
-never the true pose.
+Each stage can be switched off or put back as it was before the real logs (``tf_seed``,
+``heading_sweep``, ``grid``, ``coarse_bound``, ``refine``, ``refine_to="virtual"``,
+``select="virtual"``, ``beam_check``, ``tie_tolerance=0``) for the ablations in
+``benchmarks/tfplus_ablation.py`` (simulated) and ``benchmarks/tfplus_ablation_real.py`` (real
+logs); ``docs/tf-plus.md`` has the measurements. It uses the :class:`~tfloc.core.map.Map`
+protocol, on a :class:`~tfloc.maps.grid.GridMap` also its occupied cells (walls have thickness
+there), and never the true pose.
 """
 
 from __future__ import annotations
@@ -47,14 +55,15 @@ from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
 from tfloc.errors import ParameterError
-from tfloc.maps.fields import DistanceField, distance_field
-from tfloc.paper.matcher import TfConfig, scan_turning_function
+from tfloc.maps.grid import GridMap
+from tfloc.paper.shape import ShapeConfig, scan_turning_function
 from tfloc.paper.turning import match
 
 from .coarse import best_candidates, lattice, pose_scores, search
 from .cost import scan_cost
 from .headings import rotation_candidates
-from .refine import RefineConfig, refine
+from .refine import RefineConfig, refine, refine_to_field
+from .view import MapView, map_view
 
 
 @dataclass(frozen=True)
@@ -66,8 +75,15 @@ class TfPlusConfig:
         heading_sweep: sweep the headings θ_VP ± ``heading_span``.
         grid: run the coarse grid search over positions (else only the VP's position).
         refine: run the point-to-line refinement.
+        refine_to: what the refinement fits the scan to: ``"field"``, the map itself (each
+            scan point's nearest map point; on a grid map also the walls' surfaces and the
+            returns' depth behind them, :func:`tfloc.tfplus.refine.refine_to_field`); ``"virtual"``,
+            ray-cast virtual scans (:func:`tfloc.tfplus.refine.refine`: exact on a vector map, whose
+            walls have no thickness, and biased short on a grid whose walls are drawn several
+            cells thick); ``"auto"``: ``"field"`` on a grid map, ``"virtual"`` on any other.
         select: how the final answer is picked among refined candidates: ``"residual"``
-            (truncated point-to-line residual) or ``"tf"`` (turning-function Err, Eq. 13).
+            (truncated point-to-line residual to the map's points), ``"virtual"`` (the same to
+            the virtual scans) or ``"tf"`` (turning-function Err, Eq. 13).
         search_radius: radius of the coarse search around the VP.
         grid_step: lattice spacing of the coarse search.
         clearance: minimum distance of a lattice position from walls.
@@ -79,7 +95,15 @@ class TfPlusConfig:
         heading_step: ... at this spacing.
         field_resolution: cell size of the distance field.
         field_truncation: truncation of the distance field.
+        wall_thickness: on a grid map, walls are followed this far (metres) across to find their
+            surfaces (:mod:`tfloc.maps.walls`).
         scan_stride: every ``scan_stride``-th real point is used by the first coarse level ...
+            (if ``coarse_points`` is 0; else about ``coarse_points`` points, evenly spread,
+            whatever the scanner's beam count)
+        coarse_points: see ``scan_stride``.
+        coarse_bound: score the coarse search on the distance field pooled over ± half a
+            lattice step (a lower bound over each lattice cell), so that the cell holding the
+            true pose is not outscored because its lattice point is a few cm off a wall.
         shortlist: ... and this many of its best poses are rescored on all points.
         candidates: candidates refined.
         separation: minimum distance between candidates.
@@ -89,15 +113,16 @@ class TfPlusConfig:
             (the scan sees the same geometry from both, e.g. a bare corner), broken by
             distance to the VP (0: no tie-break).
         refinement: the point-to-line refinement's parameters.
-        tf: the turning-function parameters (ShortStraw, polygon closure) of the seed; the
-            resampling distance is 5 cm (the paper's S = 1 m gives edges too coarse for
-            their directions to be a heading estimate) and of the ``select="tf"`` Err.
+        shape: the scan-shape parameters (ShortStraw, polygon closure) of the turning-function
+            seed and of the ``select="tf"`` Err; the resampling distance is 5 cm (the paper's
+            S = 1 m gives edges too coarse for their directions to be a heading estimate).
     """
 
     tf_seed: bool = True
     heading_sweep: bool = True
     grid: bool = True
     refine: bool = True
+    refine_to: str = "auto"
     select: str = "residual"
     search_radius: float = 3.3
     grid_step: float = 0.2
@@ -109,7 +134,10 @@ class TfPlusConfig:
     heading_step: float = math.radians(3.0)
     field_resolution: float = 0.05
     field_truncation: float = 0.3
+    wall_thickness: float = 0.3
     scan_stride: int = 9
+    coarse_points: int = 20
+    coarse_bound: bool = True
     shortlist: int = 64
     candidates: int = 4
     separation: float = 0.3
@@ -117,12 +145,19 @@ class TfPlusConfig:
     tie_tolerance: float = 0.1
     beam_check: bool = True
     refinement: RefineConfig = RefineConfig()
-    tf: TfConfig = TfConfig(spacing=0.05)
+    shape: ShapeConfig = ShapeConfig(spacing=0.05)
 
 
-def _field(map_: Map, cfg: TfPlusConfig) -> DistanceField:
-    """The map's distance field, truncated at ``field_truncation`` (built once per map)."""
-    return distance_field(map_, cfg.field_resolution, cfg.field_truncation)
+def _field(map_: Map, cfg: TfPlusConfig) -> MapView:
+    """The map's view (:mod:`tfloc.tfplus.view`), built once per map and configuration."""
+    return map_view(map_, cfg.field_resolution, cfg.field_truncation, cfg.wall_thickness)
+
+
+def _coarse_field(map_: Map, cfg: TfPlusConfig) -> MapView:
+    """The view the coarse search scores on: pooled over ± half a lattice step
+    (``coarse_bound``), else the view itself."""
+    return map_view(map_, cfg.field_resolution, cfg.field_truncation, cfg.wall_thickness,
+                    cfg.grid_step / 2.0 if cfg.coarse_bound else 0.0)
 
 
 def heading_seeds(problem: Problem, cfg: TfPlusConfig) -> tuple[np.ndarray, dict]:
@@ -140,9 +175,9 @@ def heading_seeds(problem: Problem, cfg: TfPlusConfig) -> tuple[np.ndarray, dict
     else:
         heads.append(th0 + offsets)
     if cfg.tf_seed:
-        real = scan_turning_function(problem.ranges, problem.laser, cfg.tf)
+        real = scan_turning_function(problem.ranges, problem.laser, cfg.shape)
         virtual = scan_turning_function(problem.map.raycast(problem.initial, problem.laser),
-                                        problem.laser, cfg.tf)
+                                        problem.laser, cfg.shape)
         if real is not None and virtual is not None:
             rots = rotation_candidates(real, virtual, cfg.max_rotation, cfg.rotation_seeds)
             heads += [th0 - r + offsets for r in rots]
@@ -152,12 +187,12 @@ def heading_seeds(problem: Problem, cfg: TfPlusConfig) -> tuple[np.ndarray, dict
 
 def tf_errs(problem: Problem, poses: np.ndarray, cfg: TfPlusConfig) -> np.ndarray:
     """Turning-function Err (Eq. 13, radians) at each of ``(K, 3)`` poses; inf if degenerate."""
-    real = scan_turning_function(problem.ranges, problem.laser, cfg.tf)
+    real = scan_turning_function(problem.ranges, problem.laser, cfg.shape)
     out = np.full(len(poses), np.inf)
     if real is None:
         return out
     for i, ranges in enumerate(problem.map.raycast(poses, problem.laser)):
-        v = scan_turning_function(ranges, problem.laser, cfg.tf)
+        v = scan_turning_function(ranges, problem.laser, cfg.shape)
         if v is not None:
             out[i] = match(real, v).distance
     return out
@@ -181,12 +216,16 @@ class TurningFunctionPlusMatcher:
 
     def __init__(self, config: TfPlusConfig | None = None, **overrides) -> None:
         self.config = resolve_params(TfPlusConfig, config, overrides)
-        if self.config.select not in ("residual", "tf"):
-            raise ParameterError(f"select must be 'residual' or 'tf', not {self.config.select!r}")
+        if self.config.select not in ("residual", "virtual", "tf"):
+            raise ParameterError(f"select must be 'residual', 'virtual' or 'tf', not {self.config.select!r}")
+        if self.config.refine_to not in ("auto", "field", "virtual"):
+            raise ParameterError(f"refine_to must be 'auto', 'field' or 'virtual', not {self.config.refine_to!r}")
 
     def prepare(self, problem: Problem) -> None:
-        """Build the distance field and the free-space test (once per map; untimed by the harness)."""
+        """Build the map's view, its pooled copy and the free-space test (once per map; untimed
+        by the harness)."""
         _field(problem.map, self.config)
+        _coarse_field(problem.map, self.config)
         xy = problem.initial.xy[None, :]
         problem.map.in_bounds(xy)
         problem.map.is_free(xy)
@@ -205,7 +244,9 @@ class TurningFunctionPlusMatcher:
                                 cfg.clearance)
             if len(positions) == 0:
                 positions = vp.xy[None, :]
-            poses, scores = search(field, points, positions, heads, cfg.scan_stride, cfg.shortlist)
+            stride = max(1, len(points) // cfg.coarse_points) if cfg.coarse_points else cfg.scan_stride
+            poses, scores = search(_coarse_field(problem.map, cfg), points, positions, heads, stride,
+                                   cfg.shortlist)
             cands = best_candidates(poses, scores, cfg.candidates, cfg.separation)
             evaluations = len(positions) * len(heads) + len(poses)
         else:
@@ -214,13 +255,18 @@ class TurningFunctionPlusMatcher:
                 cands = cands[np.argsort(pose_scores(_field(problem.map, cfg), points, cands))[:1]]
             evaluations = len(heads)
         if cfg.refine:
-            cands = refine(problem.map, problem.laser, points, cands, cfg.refinement)
+            to = cfg.refine_to
+            if to == "auto":
+                to = "field" if isinstance(problem.map, GridMap) else "virtual"
+            if to == "field":
+                cands = refine_to_field(_field(problem.map, cfg), points, cands, cfg.refinement)
+            else:
+                cands = refine(problem.map, problem.laser, points, cands, cfg.refinement)
             evaluations += len(cands) * cfg.refinement.iterations
         if cfg.select == "tf":
             cost = tf_errs(problem, cands, cfg)
         else:
-            cost = scan_cost(problem.map, problem.laser, problem.ranges, cands,
-                             cfg.refinement.window, cfg.refinement.inlier_distance, cfg.beam_check)
+            cost = self._cost(problem, cands)
         b = pick(cost, cands, vp, cfg.tie_tolerance)
         pose = Pose.from_array(cands[b])
         info.update({"status": "ok", "candidates": len(cands), "cost": float(cost[b])})
@@ -229,7 +275,11 @@ class TurningFunctionPlusMatcher:
     def score(self, problem: Problem, pose: Pose) -> float:
         """The selection objective at ``pose`` (:func:`tfloc.tfplus.cost.scan_cost`), as its root
         (metres): the root mean square of the truncated per-beam residuals."""
+        return float(np.sqrt(self._cost(problem, pose.as_array()[None, :])[0]))
+
+    def _cost(self, problem: Problem, poses: np.ndarray) -> np.ndarray:
+        """The selection cost (metres²) at ``(K, 3)`` poses (:func:`tfloc.tfplus.cost.scan_cost`)."""
         cfg = self.config
-        cost = scan_cost(problem.map, problem.laser, problem.ranges, pose.as_array()[None, :],
-                         cfg.refinement.window, cfg.refinement.inlier_distance, cfg.beam_check)
-        return float(np.sqrt(cost[0]))
+        field = _field(problem.map, cfg) if cfg.select != "virtual" else None
+        return scan_cost(problem.map, problem.laser, problem.ranges, poses, cfg.refinement.window,
+                         cfg.refinement.inlier_distance, cfg.beam_check, field)

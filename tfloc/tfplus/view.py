@@ -1,0 +1,100 @@
+"""``tf-plus``'s view of a map: the map's distance field with each cell's nearest map point
+(:mod:`tfloc.maps.fields`), and on a grid map each point's distance to its wall's two surfaces
+(:mod:`tfloc.maps.walls`). Built once per map (:mod:`tfloc.maps.cache`).
+
+Why the map's own points, and not a ray-cast virtual scan: a grid map built from real scans draws
+walls several cells thick (the scans' registration error, range noise), and a ray stops at the
+first occupied cell, so the virtual scan is short (measured at the true poses: median −1.5 cm on
+the Intel grid, −7.9 and −14.2 cm on it with the walls thickened by one and two cells). A return
+lies *inside* the wall it hit; the walls are followed across so that a return can be measured
+from the wall's surface. On a vector map the nearest sample point lies on the wall's line, its
+normal is the wall's, and walls have no thickness.
+
+The attribute names are those the compiled kernels take (:mod:`tfloc.tfplus.kernels`): ``table``
+(distances, metres), ``origin`` (the outer corner of cell ``(0, 0)``), ``resolution``,
+``truncation``, ``points``/``normals``/``nearest``, ``face_plus``/``face_minus``, ``faces``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tfloc.core.map import Map
+from tfloc.maps.cache import cached
+from tfloc.maps.fields import DistanceField, distance_field, pooled
+from tfloc.maps.grid import GridMap
+from tfloc.maps.walls import run_extents
+
+
+@dataclass(frozen=True, eq=False)
+class MapView:
+    """The field (with nearest points) and, per map point, how far (metres) its wall's surface
+    lies along ``+normal`` (``face_plus``) and ``−normal`` (``face_minus``); both 0 and
+    ``faces`` false where walls have no thickness (a vector map)."""
+
+    field: DistanceField
+    face_plus: np.ndarray
+    face_minus: np.ndarray
+    faces: bool
+
+    @property
+    def table(self) -> np.ndarray:
+        return self.field.distance
+
+    @property
+    def origin(self) -> np.ndarray:
+        return np.asarray(self.field.corner)
+
+    @property
+    def resolution(self) -> float:
+        return self.field.resolution
+
+    @property
+    def truncation(self) -> float:
+        return self.field.cap
+
+    @property
+    def points(self) -> np.ndarray:
+        return self.field.points
+
+    @property
+    def normals(self) -> np.ndarray:
+        return self.field.normals
+
+    @property
+    def nearest(self) -> np.ndarray:
+        return self.field.nearest
+
+    def __call__(self, xy: np.ndarray) -> np.ndarray:
+        """Distance (metres) at world points ``(..., 2)``."""
+        return self.field(xy)
+
+
+def map_view(map_: Map, resolution: float, truncation: float, wall_thickness: float,
+             pool: float = 0.0) -> MapView:
+    """The view of ``map_`` (field cells of ``resolution``, distances truncated at ``truncation``,
+    walls followed up to ``wall_thickness`` metres across on a grid map), built once per map; with
+    ``pool`` > 0 its distances are pooled over ± ``pool`` metres (a lower bound over that square,
+    :func:`tfloc.maps.fields.pooled`, for the coarse search)."""
+    key = ("tf-plus-view", round(resolution, 9), round(truncation, 9), round(wall_thickness, 9),
+           round(pool, 9))
+    if pool > 0:
+        base = map_view(map_, resolution, truncation, wall_thickness)
+        return cached(map_, key, lambda: MapView(pooled(base.field, pool), base.face_plus,
+                                                base.face_minus, base.faces))
+
+    def build() -> MapView:
+        f = distance_field(map_, resolution, truncation, nearest=True)
+        faces = isinstance(map_, GridMap) and wall_thickness > 0 and len(f.points) > 0
+        if not faces:
+            zero = np.zeros(len(f.points))
+            return MapView(f, zero, zero, False)
+        half_step = map_.resolution / 6.0     # the surface lies half a walking step beyond the run
+        plus, minus = run_extents(f.points, f.normals, map_.occupied, np.asarray(map_.origin),
+                                  map_.resolution, wall_thickness)
+        return MapView(f, np.ascontiguousarray(plus + half_step),
+                       np.ascontiguousarray(minus + half_step), True)
+
+    return cached(map_, key, build)
