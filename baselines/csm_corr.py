@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -40,7 +41,6 @@ from scipy.optimize import least_squares
 from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose, wrap_angle
 from tfloc.core.problem import Estimate, Problem
-from tfloc.errors import ParameterError
 
 from .likelihood import LikelihoodField, likelihood_field
 
@@ -48,6 +48,11 @@ from .likelihood import LikelihoodField, likelihood_field
 @dataclass(frozen=True)
 class Config:
     """Parameters of :class:`CorrelativeMatcher` (metres, degrees where named)."""
+
+    RULES: ClassVar[dict] = {  # values outside these are refused (core.params)
+        "resolution": "> 0", "sigma": "> 0", "window_xy": ">= 0", "window_theta_deg": ">= 0",
+        "rot_step_deg": "> 0", "xy_step_cells": ">= 1", "block": ">= 1", "expand_batch": ">= 1",
+        "refine_scale": "> 0", "refine_max_evals": ">= 1", "min_mean_likelihood": ">= 0"}
 
     resolution: float = 0.02
     sigma: float = 0.10
@@ -78,9 +83,6 @@ class CorrelativeMatcher:
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
         self.config = resolve_params(Config, config, overrides)
-        c = self.config
-        if c.resolution <= 0 or c.sigma <= 0 or c.xy_step_cells < 1 or c.block < 1 or c.rot_step_deg <= 0:
-            raise ParameterError(f"resolution, sigma, rot_step_deg must be > 0 and xy_step_cells, block ≥ 1: {c}")
 
     def _field(self, problem: Problem) -> LikelihoodField:
         c = self.config

@@ -53,6 +53,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import cv2
 import numpy as np
@@ -69,6 +70,12 @@ from ._corner_refine import refine_corners
 @dataclass(frozen=True)
 class Config:
     """Parameters of :class:`CvCornersMatcher` (metres, degrees where named)."""
+
+    RULES: ClassVar[dict] = {  # values outside these are refused (core.params)
+        "corner_spacing": "> 0", "length_tol": ">= 0", "min_pair_length": ">= 0", "max_angle_deg": ">= 0",
+        "max_shift": ">= 0", "max_hypotheses": ">= 1", "inlier_tol": "> 0", "fine_tol": "> 0",
+        "ransac_max_iters": ">= 1", "ransac_confidence": "(0, 1)", "max_scale_error": ">= 0",
+        "max_iterations": ">= 1", "step_xy_tol": ">= 0", "step_theta_tol_deg": ">= 0"}
 
     corner_spacing: float = 0.02
     refine_corners: bool = True

@@ -41,6 +41,7 @@ as 1.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 from kiss_icp.mapping import VoxelHashMap
@@ -49,7 +50,6 @@ from kiss_icp.registration import Registration
 from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
-from tfloc.errors import ParameterError
 from tfloc.maps.cache import cached, map_geometry
 
 from ._geometry import embed_z0, matrix_to_pose, pose_to_matrix
@@ -58,6 +58,11 @@ from ._geometry import embed_z0, matrix_to_pose, pose_to_matrix
 @dataclass(frozen=True)
 class Config:
     """Parameters of :class:`KissIcpMatcher` (metres)."""
+
+    RULES: ClassVar[dict] = {  # values outside these are refused (core.params)
+        "voxel_sizes": "> 0", "gate_factor": "> 0", "kernel_factor": "> 0", "max_points_per_voxel": ">= 1",
+        "max_num_iterations": ">= 1", "convergence_criterion": ">= 0", "max_num_threads": ">= 1",
+        "map_spacing": "> 0", "min_inlier_fraction": "[0, 1]"}
 
     voxel_sizes: tuple[float, ...] = (2.0, 1.0, 0.3, 0.1)
     gate_factor: float = 3.0
@@ -88,8 +93,6 @@ class KissIcpMatcher:
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
         self.config = resolve_params(Config, config, overrides)
-        if not self.config.voxel_sizes or min(self.config.voxel_sizes) <= 0:
-            raise ParameterError(f"voxel_sizes must be positive metres, got {self.config.voxel_sizes}")
         self._registration = Registration(max_num_iterations=self.config.max_num_iterations,
                                           convergence_criterion=self.config.convergence_criterion,
                                           max_num_threads=self.config.max_num_threads)

@@ -33,13 +33,13 @@ sample within that gate counts as the gate), in metres.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
 from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
-from tfloc.errors import ParameterError
 from tfloc.maps.cache import map_geometry, point_to_line_residuals
 
 from ._geometry import embed_z0, matrix_to_pose, pose_to_matrix
@@ -52,6 +52,10 @@ _reg = o3d.pipelines.registration
 @dataclass(frozen=True)
 class Config:
     """Parameters of :class:`Open3dIcpMatcher` (metres)."""
+
+    RULES: ClassVar[dict] = {  # values outside these are refused (core.params)
+        "gates": "> 0", "max_iterations": ">= 1", "relative_fitness": ">= 0", "relative_rmse": ">= 0",
+        "map_spacing": "> 0", "crop_margin": ">= 0", "min_fitness": "[0, 1]"}
 
     gates: tuple[float, ...] = (2.0, 1.0, 0.5, 0.2, 0.1)
     max_iterations: int = 30
@@ -69,8 +73,6 @@ class Open3dIcpMatcher:
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
         self.config = resolve_params(Config, config, overrides)
-        if not self.config.gates or min(self.config.gates) <= 0:
-            raise ParameterError(f"gates must be positive metres, got {self.config.gates}")
 
     def localize(self, problem: Problem) -> Estimate:
         """Register the real scan to the map near ``problem.initial``."""

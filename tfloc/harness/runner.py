@@ -5,6 +5,10 @@ The pool is :class:`pebble.ProcessPool` (spawned workers; a task past its time l
 with its worker, which is replaced). Each worker is started with its thread pools (OpenMP,
 BLAS, numba) limited to ``max(1, cores // jobs)`` threads, so that together the workers use the
 2 cores the benchmark is specified for, and a matcher never gets more than 2.
+
+Before anything is written, every matcher is built once in this process and the run's
+fingerprint is computed (:mod:`tfloc.harness.fingerprint`); an existing run directory is resumed
+only when its fingerprint is the same.
 """
 
 from __future__ import annotations
@@ -25,10 +29,12 @@ from pathlib import Path
 from pebble import ProcessExpired, ProcessPool
 from tqdm import tqdm
 
-from tfloc.io.estimates import ResultWriter, done_keys
+from tfloc.errors import ConfigError, ResultsError
+from tfloc.io.estimates import ResultWriter, done_keys, drop_rows, sync_dir
 from tfloc.io.scenario import iter_scans, read_scenario
 
 from .config import RunConfig
+from .fingerprint import build_matchers, differences, fingerprint
 from .task import Task, failure_row, run_task, warm_up
 
 THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS",
@@ -90,14 +96,37 @@ def environment() -> dict:
                         "node": platform.node()}}
 
 
-def write_run_json(config: RunConfig, out: Path, n_tasks: int, n_done: int) -> None:
+def read_run_json(out: Path) -> dict | None:
+    """The ``run.json`` of a run directory: ``{}`` if there is none, ``None`` if it is unreadable."""
     path = out / "run.json"
-    previous = json.loads(path.read_text()) if path.exists() else {}
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        return {}
+    except (OSError, ValueError):
+        return None
+    return doc if isinstance(doc, dict) else None
+
+
+def write_run_json(config: RunConfig, out: Path, n_tasks: int, n_done: int, fp: dict | None = None) -> None:
+    """Write ``run.json`` atomically (a kill leaves the old or the new file, never half of one)."""
+    path = out / "run.json"
+    previous = read_run_json(out) or {}
     starts = previous.get("sessions", []) + [{"started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
                                               "tasks": n_tasks, "already_done": n_done}]
     doc = {"config": config.to_dict(), **environment(), "threads_per_job": threads_per_job(config.jobs),
-           "datasets": {read_scenario(d).name: str(d) for d in config.datasets}, "sessions": starts}
-    path.write_text(json.dumps(doc, indent=2) + "\n")
+           "datasets": {read_scenario(d).name: str(d) for d in config.datasets}, "sessions": starts,
+           "fingerprint": fp}
+    tmp = path.with_name("run.json.tmp")
+    try:
+        with tmp.open("w") as fh:
+            fh.write(json.dumps(doc, indent=2) + "\n")
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+        sync_dir(out)
+    except OSError as exc:
+        raise ResultsError(f"{path}: cannot write ({exc.strerror or exc}); nothing was run") from None
 
 
 def execute_local(tasks: list[Task], jobs: int, timeout_s: float,
@@ -106,17 +135,21 @@ def execute_local(tasks: list[Task], jobs: int, timeout_s: float,
     ctx = multiprocessing.get_context("spawn")
     with ProcessPool(max_workers=jobs, context=ctx, initializer=_init_worker,
                      initargs=(threads_per_job(jobs),)) as pool:
-        warm = {}
-        for t in tasks:  # compile kernels and load data outside the timed, time-limited tasks
-            warm.setdefault((t.dataset, t.matcher, t.params_json), t)
-        for f in [pool.schedule(warm_up, args=(t,)) for t in warm.values()]:
-            try:
-                f.result()
-            except Exception:  # noqa: BLE001 - the task itself will report the failure
-                pass
-        futures = {pool.schedule(run_task, args=(t,), timeout=timeout_s): t for t in tasks}
-        for fut in as_completed(futures):
-            on_row(collect(fut, futures[fut]))
+        try:
+            warm = {}
+            for t in tasks:  # compile kernels and load data outside the timed, time-limited tasks
+                warm.setdefault((t.dataset, t.matcher, t.params_json), t)
+            for f in [pool.schedule(warm_up, args=(t,)) for t in warm.values()]:
+                try:
+                    f.result()
+                except Exception:  # noqa: BLE001 - the task itself will report the failure
+                    pass
+            futures = {pool.schedule(run_task, args=(t,), timeout=timeout_s): t for t in tasks}
+            for fut in as_completed(futures):
+                on_row(collect(fut, futures[fut]))
+        except BaseException:  # a failed write, Ctrl-C: stop the workers, do not run the rest
+            pool.stop()
+            raise
 
 
 def collect(fut, task: Task) -> dict:
@@ -134,24 +167,52 @@ def collect(fut, task: Task) -> dict:
 Executor = Callable[[list[Task], int, float, Callable[[dict], None]], None]
 
 
+def _discard(out: Path) -> None:
+    (out / "estimates.csv").unlink(missing_ok=True)
+    (out / "run.json").unlink(missing_ok=True)
+
+
 def run(config: RunConfig, progress: bool | None = None, executor: Executor = execute_local,
-        regenerate: bool = False) -> Path:
+        regenerate: bool = False, retry_errors: bool = False) -> Path:
     """Run (or resume) a benchmark; returns the run directory holding ``estimates.csv``.
 
-    An existing ``estimates.csv`` is resumed: finished tasks are skipped. With ``regenerate``, a
-    *complete* previous run is discarded and run again (an interrupted one is still resumed), so
-    one command both reproduces a committed reference run and survives interruptions.
+    Every matcher is built first, in this process (a bad parameter raises :class:`ConfigError`
+    before anything is written). An existing ``estimates.csv`` is resumed when the run's
+    fingerprint is the same: finished tasks are skipped; another configuration raises
+    :class:`ConfigError` saying what differs. With ``regenerate``, a *complete* previous run or
+    one of another configuration is discarded and run again (an interrupted one is still
+    resumed), so one command both reproduces a committed reference run and survives
+    interruptions. With ``retry_errors``, rows whose status is ``error:…`` or ``timeout`` are
+    removed (the file is rewritten atomically) and their tasks run again.
     """
     out = Path(config.out)
-    out.mkdir(parents=True, exist_ok=True)
+    fp = fingerprint(config, build_matchers(config))
     tasks = make_tasks(config)
-    done = done_keys(out / "estimates.csv")
+    est = out / "estimates.csv"
+    done = done_keys(est) if out.is_dir() else set()
+    if done:
+        diff = differences((read_run_json(out) or {}).get("fingerprint"), fp)
+        if diff and not regenerate:
+            more = f" (and {len(diff) - 3} more)" if len(diff) > 3 else ""
+            raise ConfigError(f"{out} holds a run of another configuration: {'; '.join(diff[:3])}{more}; "
+                              "to start it over give --regenerate, to keep it choose another --out")
+        if diff:
+            _discard(out)
+            done = set()
     todo = [t for t in tasks if t.key not in done]
     if regenerate and not todo and tasks:
-        (out / "estimates.csv").unlink()
-        (out / "run.json").unlink(missing_ok=True)
+        _discard(out)
         todo = tasks
-    write_run_json(config, out, len(tasks), len(tasks) - len(todo))
+    elif retry_errors and done:
+        keep = done_keys(est, redo=("error", "timeout"))
+        retry = {t.key for t in tasks if t.key in done and t.key not in keep}
+        drop_rows(est, done - retry)
+        todo = [t for t in tasks if t.key not in done or t.key in retry]
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ResultsError(f"{out}: cannot create the run directory ({exc.strerror or exc})") from None
+    write_run_json(config, out, len(tasks), len(tasks) - len(todo), fp)
     if not todo:
         return out
     bar = tqdm(total=len(tasks), initial=len(tasks) - len(todo), unit="task", desc=config.name,
@@ -161,7 +222,7 @@ def run(config: RunConfig, progress: bool | None = None, executor: Executor = ex
         def on_row(row: dict) -> None:
             nonlocal failures
             writer.write(row)
-            failures += row.get("status", "ok") not in ("ok", "failed")
+            failures += str(row.get("status", "ok")).startswith(("error", "timeout"))
             bar.update(1)
             if failures:
                 bar.set_postfix(errors=failures, refresh=False)

@@ -71,19 +71,26 @@ def read_scenario(root: str | Path) -> Scenario:
     for key in ("name", "map", "laser"):
         if key not in doc:
             raise DatasetError(f"{path}: missing field {key!r}")
+    if not isinstance(doc["map"], str) or not doc["map"].strip():
+        raise DatasetError(f"{path}: field 'map' must be a path (a string), got {doc['map']!r:.60}")
     las = doc["laser"]
     try:
         laser = LaserSpec.from_degrees(float(las["max_range"]), float(las["fov_deg"]),
                                        float(las["resolution_deg"]),
                                        None if las.get("angle_min_deg") is None else float(las["angle_min_deg"]))
-    except (KeyError, TypeError, ValueError) as exc:
-        raise DatasetError(f"{path}: bad 'laser' field ({exc!r}); needs max_range, fov_deg, "
+    except (KeyError, TypeError, ValueError, OverflowError) as exc:
+        raise DatasetError(f"{path}: bad 'laser' field ({exc!r:.100}); needs max_range, fov_deg, "
                            "resolution_deg[, angle_min_deg]") from None
-    if not (laser.max_range > 0 and laser.resolution > 0 and laser.fov > 0):
-        raise DatasetError(f"{path}: laser max_range, fov_deg and resolution_deg must be positive")
+    if not all(math.isfinite(v) for v in (laser.max_range, laser.fov, laser.resolution, laser.angle_min)):
+        raise DatasetError(f"{path}: laser values must be finite numbers")
+    if not (laser.max_range > 0 and 0 < laser.resolution <= laser.fov <= 2 * math.pi + 1e-9):
+        raise DatasetError(f"{path}: laser max_range must be positive and 0 < resolution_deg ≤ fov_deg ≤ 360")
     extra = {k: v for k, v in doc.items() if k not in ("name", "map", "laser", "description")}
-    return Scenario(str(doc["name"]), (root / doc["map"]).resolve(), laser,
-                    str(doc.get("description", "")), root, extra)
+    try:
+        map_path = (root / doc["map"]).resolve()
+    except (OSError, ValueError) as exc:
+        raise DatasetError(f"{path}: field 'map' is not a usable path ({exc})") from None
+    return Scenario(str(doc["name"]), map_path, laser, str(doc.get("description", "")), root, extra)
 
 
 def _float(text: str, path: Path, line: int, column: str) -> float:

@@ -80,6 +80,9 @@ def csv_rows(path: str | Path, error: type[TflocError], what: str,
         header = list(reader.fieldnames or [])
     except csv.Error as exc:
         raise error(f"{path}:1: unreadable CSV header ({exc})") from None
+    twice = sorted({c for c in header if header.count(c) > 1})
+    if twice:
+        raise error(f"{path}:1: header names column(s) {', '.join(map(repr, twice))} more than once")
     missing = [c for c in required if c not in header]
     if missing:
         raise error(f"{path}:1: header lacks column(s) {', '.join(missing)}")

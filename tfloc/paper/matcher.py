@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
@@ -75,6 +76,12 @@ class TfConfig:
         penalty: cost of an invalid candidate pose.
         seed: seed of the random initial simplex.
     """
+
+    RULES: ClassVar[dict] = {  # values outside these are refused (core.params)
+        "spacing": "> 0", "window": ">= 1", "straw_t": "> 0", "line_threshold": "(0, 1]",
+        "n_orientations": ">= 1", "orientation_step": ">= 0", "simplex_size": "> 0",
+        "err_threshold": ">= 0", "xy_tol": ">= 0", "theta_tol": ">= 0", "max_iterations": ">= 1",
+        "max_outer": ">= 1", "penalty": ">= 0", "seed": ">= 0"}
 
     spacing: float = 1.0
     window: int = 1

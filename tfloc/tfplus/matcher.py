@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -43,7 +44,6 @@ from tfloc.core.map import Map
 from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
-from tfloc.errors import ParameterError
 from tfloc.maps.fields import DistanceField, distance_field
 from tfloc.paper.matcher import TfConfig, scan_turning_function
 from tfloc.paper.turning import match
@@ -90,6 +90,13 @@ class TfPlusConfig:
             resampling distance is 5 cm (the paper's S = 1 m gives edges too coarse for
             their directions to be a heading estimate) and of the ``select="tf"`` Err.
     """
+
+    RULES: ClassVar[dict] = {  # values outside these are refused (core.params)
+        "select": ("residual", "tf"), "search_radius": ">= 0", "grid_step": "> 0", "clearance": ">= 0",
+        "heading_offsets": "finite", "rotation_seeds": ">= 0", "max_rotation": ">= 0", "heading_span": ">= 0",
+        "heading_step": "> 0", "field_resolution": "> 0", "field_truncation": "> 0", "scan_stride": ">= 1",
+        "shortlist": ">= 1", "candidates": ">= 1", "separation": ">= 0", "min_returns": ">= 1",
+        "tie_tolerance": ">= 0"}
 
     tf_seed: bool = True
     heading_sweep: bool = True
@@ -178,8 +185,6 @@ class TurningFunctionPlusMatcher:
 
     def __init__(self, config: TfPlusConfig | None = None, **overrides) -> None:
         self.config = resolve_params(TfPlusConfig, config, overrides)
-        if self.config.select not in ("residual", "tf"):
-            raise ParameterError(f"select must be 'residual' or 'tf', not {self.config.select!r}")
 
     def localize(self, problem: Problem) -> Estimate:
         cfg = self.config

@@ -16,6 +16,7 @@ real points ``p`` (sensor frame) to ``R(φ) p + t`` in the virtual pose's frame,
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -43,6 +44,10 @@ class RefineConfig:
             (0: never prune).
         keep: see ``prune_after``.
     """
+
+    RULES: ClassVar[dict] = {  # values outside these are refused (core.params)
+        "iterations": ">= 1", "inner": ">= 1", "window": ">= 0", "gate_start": "> 0", "gate_end": "> 0",
+        "inlier_distance": "> 0", "damping": ">= 0", "prune_after": ">= 0", "keep": ">= 1"}
 
     iterations: int = 6
     inner: int = 2
