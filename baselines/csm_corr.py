@@ -38,7 +38,7 @@ from typing import ClassVar
 import numpy as np
 from scipy.optimize import least_squares
 
-from tfloc.core.params import resolve_params
+from tfloc.core.params import Configured
 from tfloc.core.pose import Pose, wrap_angle
 from tfloc.core.problem import Estimate, Problem
 
@@ -49,10 +49,10 @@ from .likelihood import LikelihoodField, likelihood_field
 class Config:
     """Parameters of :class:`CorrelativeMatcher` (metres, degrees where named)."""
 
-    RULES: ClassVar[dict] = {  # values outside these are refused (core.params)
-        "resolution": "> 0", "sigma": "> 0", "window_xy": ">= 0", "window_theta_deg": ">= 0",
-        "rot_step_deg": "> 0", "xy_step_cells": ">= 1", "block": ">= 1", "expand_batch": ">= 1",
-        "refine_scale": "> 0", "refine_max_evals": ">= 1", "min_mean_likelihood": ">= 0"}
+    RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params)
+        "> 0": ("resolution", "sigma", "rot_step_deg", "refine_scale"),
+        ">= 0": ("window_xy", "window_theta_deg", "min_mean_likelihood"),
+        ">= 1": ("xy_step_cells", "block", "expand_batch", "refine_max_evals")}
 
     resolution: float = 0.02
     sigma: float = 0.10
@@ -76,13 +76,11 @@ class _Grid:
     block_starts: np.ndarray  # (B,) offsets of each block's first translation, in cells
 
 
-class CorrelativeMatcher:
+class CorrelativeMatcher(Configured):
     """Olson's real-time correlative scan matcher over the protocol's window (see the module docstring)."""
 
     name = "csm-corr"
-
-    def __init__(self, config: Config | None = None, **overrides: object) -> None:
-        self.config = resolve_params(Config, config, overrides)
+    CONFIG = Config
 
     def _field(self, problem: Problem) -> LikelihoodField:
         c = self.config

@@ -71,11 +71,12 @@ from ._corner_refine import refine_corners
 class Config:
     """Parameters of :class:`CvCornersMatcher` (metres, degrees where named)."""
 
-    RULES: ClassVar[dict] = {  # values outside these are refused (core.params)
-        "corner_spacing": "> 0", "length_tol": ">= 0", "min_pair_length": ">= 0", "max_angle_deg": ">= 0",
-        "max_shift": ">= 0", "max_hypotheses": ">= 1", "inlier_tol": "> 0", "fine_tol": "> 0",
-        "ransac_max_iters": ">= 1", "ransac_confidence": "(0, 1)", "max_scale_error": ">= 0",
-        "max_iterations": ">= 1", "step_xy_tol": ">= 0", "step_theta_tol_deg": ">= 0"}
+    RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params)
+        "> 0": ("corner_spacing", "inlier_tol", "fine_tol"),
+        ">= 0": ("length_tol", "min_pair_length", "max_angle_deg", "max_shift", "max_scale_error",
+                 "step_xy_tol", "step_theta_tol_deg"),
+        ">= 1": ("max_hypotheses", "ransac_max_iters", "max_iterations"),
+        "(0, 1)": ("ransac_confidence",)}
 
     corner_spacing: float = 0.02
     refine_corners: bool = True

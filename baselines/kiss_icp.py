@@ -59,10 +59,11 @@ from ._geometry import embed_z0, matrix_to_pose, pose_to_matrix
 class Config:
     """Parameters of :class:`KissIcpMatcher` (metres)."""
 
-    RULES: ClassVar[dict] = {  # values outside these are refused (core.params)
-        "voxel_sizes": "> 0", "gate_factor": "> 0", "kernel_factor": "> 0", "max_points_per_voxel": ">= 1",
-        "max_num_iterations": ">= 1", "convergence_criterion": ">= 0", "max_num_threads": ">= 1",
-        "map_spacing": "> 0", "min_inlier_fraction": "[0, 1]"}
+    RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params)
+        "> 0": ("voxel_sizes", "gate_factor", "kernel_factor", "map_spacing"),
+        ">= 0": ("convergence_criterion",),
+        ">= 1": ("max_points_per_voxel", "max_num_iterations", "max_num_threads"),
+        "[0, 1]": ("min_inlier_fraction",)}
 
     voxel_sizes: tuple[float, ...] = (2.0, 1.0, 0.3, 0.1)
     gate_factor: float = 3.0

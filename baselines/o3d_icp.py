@@ -37,7 +37,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from tfloc.core.params import resolve_params
+from tfloc.core.params import Configured
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
 from tfloc.maps.cache import map_geometry, point_to_line_residuals
@@ -53,9 +53,11 @@ _reg = o3d.pipelines.registration
 class Config:
     """Parameters of :class:`Open3dIcpMatcher` (metres)."""
 
-    RULES: ClassVar[dict] = {  # values outside these are refused (core.params)
-        "gates": "> 0", "max_iterations": ">= 1", "relative_fitness": ">= 0", "relative_rmse": ">= 0",
-        "map_spacing": "> 0", "crop_margin": ">= 0", "min_fitness": "[0, 1]"}
+    RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params)
+        "> 0": ("gates", "map_spacing"),
+        ">= 0": ("relative_fitness", "relative_rmse", "crop_margin"),
+        ">= 1": ("max_iterations",),
+        "[0, 1]": ("min_fitness",)}
 
     gates: tuple[float, ...] = (2.0, 1.0, 0.5, 0.2, 0.1)
     max_iterations: int = 30
@@ -66,13 +68,11 @@ class Config:
     min_fitness: float = 0.5
 
 
-class Open3dIcpMatcher:
+class Open3dIcpMatcher(Configured):
     """open3d point-to-line ICP with a coarse-to-fine gate schedule (see the module docstring)."""
 
     name = "o3d-icp"
-
-    def __init__(self, config: Config | None = None, **overrides: object) -> None:
-        self.config = resolve_params(Config, config, overrides)
+    CONFIG = Config
 
     def localize(self, problem: Problem) -> Estimate:
         """Register the real scan to the map near ``problem.initial``."""

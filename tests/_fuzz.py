@@ -230,6 +230,32 @@ def dump_yaml(doc) -> bytes:
     return yaml.safe_dump(doc, sort_keys=False).encode()
 
 
+_DUMP = {".json": (json.loads, dump_json), ".geojson": (json.loads, dump_json), ".yaml": (yaml.safe_load, dump_yaml)}
+_SEP = {".csv": b",", ".pgm": b" "}
+
+
+@st.composite
+def damaged(draw, files: dict[str, bytes], weights: dict[str, int] | None = None) -> tuple[list[str], dict[str, bytes]]:
+    """``files`` (name → bytes) with one of them damaged: its bytes (fields split at the format's
+    separator), or for JSON/YAML also its document. Returns what was done and the files."""
+    names = [n for n in sorted(files) for _ in range((weights or {}).get(n, 1))]
+    name = draw(st.sampled_from(names))
+    suffix = os.path.splitext(name)[1]
+    byte_damage = mutated(files[name], _SEP.get(suffix))
+    if suffix in _DUMP:
+        load, dump = _DUMP[suffix]
+        what, blob = draw(st.one_of(byte_damage, doc_mutation(load(files[name]))))
+        blob = blob if isinstance(blob, bytes) else dump(blob)
+    else:
+        what, blob = draw(byte_damage)
+    return [name, *what], {**files, name: blob}
+
+
+def write_files(root, files: dict[str, bytes]) -> None:
+    for name, blob in files.items():
+        (root / name).write_bytes(blob)
+
+
 # ---------------------------------------------------------------------------------------------
 # The oracle
 

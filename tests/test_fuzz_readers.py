@@ -9,7 +9,6 @@ TflocError naming the file (see tests/_fuzz.py). ``make fuzz`` runs thousands of
 
 from __future__ import annotations
 
-import json
 import math
 import shutil
 import tempfile
@@ -17,10 +16,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from _estimates import frame, row
-from _fuzz import SETTINGS, Tally, doc_mutation, dump_json, dump_yaml, finish, judge, mutated
+from _estimates import row, write_run
+from _fuzz import SETTINGS, Tally, damaged, finish, judge, mutated, write_files
 from hypothesis import given
-from hypothesis import strategies as st
 
 import tfloc
 from tfloc.core.pose import Pose
@@ -47,11 +45,6 @@ def _use(m) -> None:
         m.raycast(Pose(float(centre[0, 0]), float(centre[0, 1]), 0.3), LASER)
 
 
-def _either(data_strategy, doc_strategy=None):
-    """A byte mutation, or (for JSON/YAML) a document mutation."""
-    return data_strategy if doc_strategy is None else st.one_of(data_strategy, doc_strategy)
-
-
 @pytest.fixture(scope="module")
 def scenario_files(tmp_path_factory) -> dict[str, bytes]:
     room = tfloc.load_map(ROOM)
@@ -66,24 +59,15 @@ def scenario_files(tmp_path_factory) -> dict[str, bytes]:
 
 def test_scenario_directory(scenario_files) -> None:
     tally = Tally("scenario directory")
-    base_doc = json.loads(scenario_files["scenario.json"])
     with tempfile.TemporaryDirectory() as tmp:
         ds = Path(tmp) / "ds"
         ds.mkdir()
-        base_doc["map"] = str(ROOM)
 
         @SETTINGS
-        @given(st.sampled_from(["scenario.json", "scans.csv"]), st.data())
-        def case(name, data):
-            files = dict(scenario_files, **{"scenario.json": dump_json(base_doc)})
-            if name == "scans.csv":
-                what, files[name] = data.draw(mutated(files[name], b","))
-            else:
-                what, blob = data.draw(_either(mutated(files[name]), doc_mutation(base_doc)))
-                files[name] = blob if isinstance(blob, bytes) else dump_json(blob)
-            for n, b in files.items():
-                (ds / n).write_bytes(b)
-            judge(tally, [name, *what], lambda: read_scans(read_scenario(ds)), [str(ds)])
+        @given(damaged(scenario_files))
+        def case(d):
+            write_files(ds, d[1])
+            judge(tally, d[0], lambda: read_scans(read_scenario(ds)), [str(ds)])
 
         case()
     finish(tally)
@@ -91,17 +75,14 @@ def test_scenario_directory(scenario_files) -> None:
 
 def test_geojson_map() -> None:
     tally = Tally("GeoJSON map")
-    base = ROOM.read_bytes()
-    doc = json.loads(base)
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "m.geojson"
 
         @SETTINGS
-        @given(_either(mutated(base), doc_mutation(doc)))
-        def case(m):
-            what, blob = m
-            path.write_bytes(blob if isinstance(blob, bytes) else dump_json(blob))
-            judge(tally, what, lambda: _use(read_vector_map(path)), [str(path)])
+        @given(damaged({"m.geojson": ROOM.read_bytes()}))
+        def case(d):
+            write_files(path.parent, d[1])
+            judge(tally, d[0][1:], lambda: _use(read_vector_map(path)), [str(path)])
 
         case()
     finish(tally)
@@ -119,25 +100,15 @@ def ros_files(tmp_path_factory) -> dict[str, bytes]:
 
 
 def test_ros_map(ros_files) -> None:
-    import yaml
-
     tally = Tally("ROS map YAML+PGM")
-    doc = yaml.safe_load(ros_files["map.yaml"])
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp)
 
         @SETTINGS
-        @given(st.sampled_from(["map.yaml", "map.pgm"]), st.data())
-        def case(name, data):
-            files = dict(ros_files)
-            if name == "map.pgm":
-                what, files[name] = data.draw(mutated(files[name], b" "))
-            else:
-                what, blob = data.draw(_either(mutated(files[name]), doc_mutation(doc)))
-                files[name] = blob if isinstance(blob, bytes) else dump_yaml(blob)
-            for n, b in files.items():
-                (root / n).write_bytes(b)
-            judge(tally, [name, *what], lambda: _use(read_ros_map(root / "map.yaml")), [str(root)])
+        @given(damaged(ros_files))
+        def case(d):
+            write_files(root, d[1])
+            judge(tally, d[0], lambda: _use(read_ros_map(root / "map.yaml")), [str(root)])
 
         case()
     finish(tally)
@@ -196,21 +167,13 @@ def _small_run(path: Path) -> None:
     for d in ("detail-1", "real-x-relations"):
         for i in range(4):
             for m in ("tf", "csm-corr"):
-                status = {1: "timeout", 2: "error:ValueError: x"}.get(i, "ok") if m == "tf" else "ok"
+                status = {1: "timeout", 2: "error:ValueError: x", 3: "invalid:ds/scans.csv:5: initial pose (9.000, "
+                          "1.000) lies outside the map"}.get(i, "ok") if m == "tf" else "ok"
                 ok = status == "ok"
                 rows.append(row(m, 0.02 * (i + 1) if ok else None, 0.5 * i if ok else None, 0.4 + 0.9 * i,
                                 3.0 * i, status, 0.01 if ok else None, d, f"{d}-{i}", "local" if i % 2 else "loop",
                                 score_est=1.0 if i == 3 and ok else None, score_true=0.5 if i == 3 and ok else None))
-    path.mkdir(parents=True, exist_ok=True)
-    frame(rows).to_csv(path / "estimates.csv", index=False)
-    run = {"config": {"name": "fuzz", "matchers": [{"label": "tf", "name": "tf", "params": {}},
-                                                   {"label": "csm-corr", "name": "csm-corr", "params": {}}],
-                      "jobs": 2, "timeout_s": 10.0, "limit_per_group": 0,
-                      "success": {"dist_m": 0.1, "orient_deg": 2.0}},
-           "versions": {"tfloc": "0.1.0"}, "git": {"commit": "abc", "dirty": False},
-           "machine": {"platform": "test", "cpu_count": 2, "python": "3.11"}, "threads_per_job": 1,
-           "datasets": {}, "sessions": [{"started": "2026-01-01T00:00:00+0000", "tasks": 24, "already_done": 0}]}
-    (path / "run.json").write_text(json.dumps(run))
+    write_run(path, rows, {})
 
 
 def test_estimates_through_report(tmp_path_factory) -> None:
@@ -219,25 +182,17 @@ def test_estimates_through_report(tmp_path_factory) -> None:
     tally = Tally("estimates.csv via tfloc report")
     src = tmp_path_factory.mktemp("run-src")
     _small_run(src)
-    base = {n: (src / n).read_bytes() for n in ("estimates.csv", "run.json")}
-    doc = json.loads(base["run.json"])
+    files = {n: (src / n).read_bytes() for n in ("estimates.csv", "run.json")}
     with tempfile.TemporaryDirectory() as tmp:
         run_dir = Path(tmp) / "run"
 
         @SETTINGS
-        @given(st.sampled_from(["estimates.csv", "estimates.csv", "run.json"]), st.data())
-        def case(name, data):
+        @given(damaged(files, {"estimates.csv": 2}))
+        def case(d):
             shutil.rmtree(run_dir, ignore_errors=True)
             run_dir.mkdir()
-            files = dict(base)
-            if name == "estimates.csv":
-                what, files[name] = data.draw(mutated(files[name], b","))
-            else:
-                what, blob = data.draw(_either(mutated(files[name]), doc_mutation(doc)))
-                files[name] = blob if isinstance(blob, bytes) else dump_json(blob)
-            for n, b in files.items():
-                (run_dir / n).write_bytes(b)
-            judge(tally, [name, *what], lambda: write_report(run_dir, with_figures=False), [str(run_dir)])
+            write_files(run_dir, d[1])
+            judge(tally, d[0], lambda: write_report(run_dir, with_figures=False), [str(run_dir)])
 
         case()
     finish(tally)

@@ -79,6 +79,16 @@ def test_every_matcher_has_a_config_with_defaults_that_pass_its_rules() -> None:
         assert type(get_matcher(m, **{}).config)() == cfg
 
 
+def test_every_rule_names_a_parameter() -> None:
+    for m in MATCHERS:
+        configs = [get_matcher(m).config]
+        configs += [v for c in configs for v in vars(c).values() if dataclasses.is_dataclass(v)]
+        for c in configs:
+            names = {f.name for f in dataclasses.fields(c)}
+            for rule, params in getattr(type(c), "RULES", {}).items():
+                assert set(params) <= names, (m, rule, set(params) - names)
+
+
 @pytest.mark.parametrize("matcher, key, value, message", [
     ("csm-corr", "search_radiuss", 2.0, r"unknown parameter\(s\) search_radiuss; known: block, "),
     ("csm-corr", "resolution", -0.02, r"resolution must be > 0, got -0.02"),

@@ -189,7 +189,13 @@ def run(config: RunConfig, progress: bool | None = None, executor: Executor = ex
     fp = fingerprint(config, build_matchers(config))
     tasks = make_tasks(config)
     est = out / "estimates.csv"
-    done = done_keys(est) if out.is_dir() else set()
+    try:
+        done = done_keys(est) if out.is_dir() else set()
+    except ResultsError:  # damaged, or written by another version: only --regenerate goes on
+        if not regenerate:
+            raise
+        _discard(out)
+        done = set()
     if done:
         diff = differences((read_run_json(out) or {}).get("fingerprint"), fp)
         if diff and not regenerate:

@@ -87,7 +87,7 @@ def done_keys(path: Path, redo: tuple[str, ...] = ()) -> set[tuple[str, str, str
     header, rows = read_rows(path)
     if header != COLUMNS:
         raise ResultsError(f"{path}: its columns are not those this tfloc writes ({len(header)} vs "
-                           f"{len(COLUMNS)}): made by another version")
+                           f"{len(COLUMNS)}): made by another version; --regenerate or another --out")
     return {tuple(r[k] for k in KEY) for _, r in rows if status_kind(r["status"]) not in redo}
 
 

@@ -38,7 +38,8 @@ def read_vector_map(path: str | Path) -> VectorMap:
         try:
             g = shape(f["geometry"])
         except Exception as exc:  # shapely raises several types for bad coordinates
-            raise MapFormatError(f"{where}: bad geometry ({exc})") from None
+            why = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+            raise MapFormatError(f"{where}: bad geometry ({why})") from None
         if g.is_empty or not shapely.is_valid(g) or not shapely.get_coordinates(g).size:
             raise MapFormatError(f"{where}: empty or invalid {g.geom_type} ({shapely.is_valid_reason(g)})")
         props = f.get("properties") or {}

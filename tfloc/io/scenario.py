@@ -25,6 +25,7 @@ from tfloc.errors import DatasetError
 
 from .text import csv_rows, parse_text
 
+MAX_BEAMS = 1_000_000  # a laser with more beams is a damaged scenario.json, not a scanner
 COLUMNS = ["scan_id", "group", "true_x", "true_y", "true_theta", "init_x", "init_y", "init_theta",
            "ranges"]
 
@@ -85,6 +86,8 @@ def read_scenario(root: str | Path) -> Scenario:
         raise DatasetError(f"{path}: laser values must be finite numbers")
     if not (laser.max_range > 0 and 0 < laser.resolution <= laser.fov <= 2 * math.pi + 1e-9):
         raise DatasetError(f"{path}: laser max_range must be positive and 0 < resolution_deg ≤ fov_deg ≤ 360")
+    if laser.fov / laser.resolution > MAX_BEAMS:
+        raise DatasetError(f"{path}: laser resolution_deg is too fine: more than {MAX_BEAMS} beams")
     extra = {k: v for k, v in doc.items() if k not in ("name", "map", "laser", "description")}
     try:
         map_path = (root / doc["map"]).resolve()

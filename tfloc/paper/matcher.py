@@ -44,7 +44,7 @@ from typing import ClassVar
 import numpy as np
 
 from tfloc.core.laser import LaserSpec
-from tfloc.core.params import resolve_params
+from tfloc.core.params import Configured
 from tfloc.core.pose import Pose, wrap_angle
 from tfloc.core.problem import Estimate, Problem
 
@@ -77,11 +77,11 @@ class TfConfig:
         seed: seed of the random initial simplex.
     """
 
-    RULES: ClassVar[dict] = {  # values outside these are refused (core.params)
-        "spacing": "> 0", "window": ">= 1", "straw_t": "> 0", "line_threshold": "(0, 1]",
-        "n_orientations": ">= 1", "orientation_step": ">= 0", "simplex_size": "> 0",
-        "err_threshold": ">= 0", "xy_tol": ">= 0", "theta_tol": ">= 0", "max_iterations": ">= 1",
-        "max_outer": ">= 1", "penalty": ">= 0", "seed": ">= 0"}
+    RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params)
+        "> 0": ("spacing", "straw_t", "simplex_size"),
+        ">= 0": ("orientation_step", "err_threshold", "xy_tol", "theta_tol", "penalty", "seed"),
+        ">= 1": ("window", "n_orientations", "max_iterations", "max_outer"),
+        "(0, 1]": ("line_threshold",)}
 
     spacing: float = 1.0
     window: int = 1
@@ -203,13 +203,11 @@ def simplex(cost: _Cost, start: Pose, size: float, rng: np.random.Generator) -> 
     return min(pts, key=f), it
 
 
-class TurningFunctionMatcher:
+class TurningFunctionMatcher(Configured):
     """The paper's method (``tf``): turning-function scan matching with a Nelder–Mead simplex."""
 
     name = "tf"
-
-    def __init__(self, config: TfConfig | None = None, **overrides) -> None:
-        self.config = resolve_params(TfConfig, config, overrides)
+    CONFIG = TfConfig
 
     def localize(self, problem: Problem) -> Estimate:
         cfg = self.config

@@ -108,7 +108,7 @@ def header(run_dir: Path, run: dict, df: pd.DataFrame, thr: Thresholds, s2s: set
     lines = [f"# tfloc benchmark report: {cfg.get('name', run_dir.name)}\n",
              f"- Run directory: `{run_dir}`",
              f"- Report generated: {datetime.now(UTC).strftime('%Y-%m-%d %H:%M UTC')}",
-             f"- Run started: {sessions[0]['started'] if sessions else 'unknown'}"
+             f"- Run started: {sessions[0].get('started', 'unknown') if sessions else 'unknown'}"
              + (f" ({len(sessions)} sessions, resumed)" if len(sessions) > 1 else ""),
              f"- Commit: `{commit}`",
              f"- Machine: {mach.get('platform', '?')}, {mach.get('cpu_count', '?')} CPUs, Python "

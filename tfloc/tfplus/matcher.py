@@ -41,7 +41,7 @@ from typing import ClassVar
 import numpy as np
 
 from tfloc.core.map import Map
-from tfloc.core.params import resolve_params
+from tfloc.core.params import Configured
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
 from tfloc.maps.fields import DistanceField, distance_field
@@ -91,12 +91,13 @@ class TfPlusConfig:
             their directions to be a heading estimate) and of the ``select="tf"`` Err.
     """
 
-    RULES: ClassVar[dict] = {  # values outside these are refused (core.params)
-        "select": ("residual", "tf"), "search_radius": ">= 0", "grid_step": "> 0", "clearance": ">= 0",
-        "heading_offsets": "finite", "rotation_seeds": ">= 0", "max_rotation": ">= 0", "heading_span": ">= 0",
-        "heading_step": "> 0", "field_resolution": "> 0", "field_truncation": "> 0", "scan_stride": ">= 1",
-        "shortlist": ">= 1", "candidates": ">= 1", "separation": ">= 0", "min_returns": ">= 1",
-        "tie_tolerance": ">= 0"}
+    RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params)
+        "> 0": ("grid_step", "heading_step", "field_resolution", "field_truncation"),
+        ">= 0": ("search_radius", "clearance", "rotation_seeds", "max_rotation", "heading_span",
+                 "separation", "tie_tolerance"),
+        ">= 1": ("scan_stride", "shortlist", "candidates", "min_returns"),
+        "finite": ("heading_offsets",),
+        ("residual", "tf"): ("select",)}
 
     tf_seed: bool = True
     heading_sweep: bool = True
@@ -178,13 +179,11 @@ def pick(cost: np.ndarray, poses: np.ndarray, vp: Pose, tie_tolerance: float) ->
     return int(tied[np.argmin(near)])
 
 
-class TurningFunctionPlusMatcher:
+class TurningFunctionPlusMatcher(Configured):
     """``tf-plus``: turning-function heading seed, coarse grid, point-to-line refinement."""
 
     name = "tf-plus"
-
-    def __init__(self, config: TfPlusConfig | None = None, **overrides) -> None:
-        self.config = resolve_params(TfPlusConfig, config, overrides)
+    CONFIG = TfPlusConfig
 
     def localize(self, problem: Problem) -> Estimate:
         cfg = self.config

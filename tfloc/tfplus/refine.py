@@ -45,9 +45,10 @@ class RefineConfig:
         keep: see ``prune_after``.
     """
 
-    RULES: ClassVar[dict] = {  # values outside these are refused (core.params)
-        "iterations": ">= 1", "inner": ">= 1", "window": ">= 0", "gate_start": "> 0", "gate_end": "> 0",
-        "inlier_distance": "> 0", "damping": ">= 0", "prune_after": ">= 0", "keep": ">= 1"}
+    RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params)
+        "> 0": ("gate_start", "gate_end", "inlier_distance"),
+        ">= 0": ("window", "damping", "prune_after"),
+        ">= 1": ("iterations", "inner", "keep")}
 
     iterations: int = 6
     inner: int = 2
