@@ -69,12 +69,13 @@ def read_ros_map(yaml_path: str | Path) -> GridMap:
         with Image.open(img_path) as im:
             im.load()
             if im.mode not in ("L", "LA", "RGB", "RGBA", "I", "I;16", "P", "1"):
-                raise MapFormatError(f"{img_path}: unsupported image mode {im.mode}")
+                raise MapFormatError(f"{img_path}: unsupported image mode {im.mode} (the map image of {path})")
             v = np.asarray(im.convert("L"), dtype=np.float32)
     except FileNotFoundError:
         raise MapFormatError(f"{path}: image {doc['image']!r} not found next to the YAML") from None
     except (UnidentifiedImageError, OSError, SyntaxError, ValueError) as exc:
-        raise MapFormatError(f"{img_path}: cannot read map image ({exc})") from None
+        why = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+        raise MapFormatError(f"{img_path}: cannot read the map image of {path} ({why})") from None
     p = v / 255.0 if negate else (255.0 - v) / 255.0
     occ = np.where((p > occ_t) | (p < free_t), p, np.nan).astype(np.float32)
     try:

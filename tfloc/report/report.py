@@ -76,8 +76,11 @@ def _check_run(run: object, path: Path) -> None:
     ok &= all(isinstance(v, dict) and isinstance(v.get("started", ""), str) for v in run.get("sessions", []))
     ok &= all(isinstance(m, dict) and isinstance(m.get("label"), str) and isinstance(m.get("name"), str)
               and isinstance(m.get("params", {}), dict) for m in run.get("config", {}).get("matchers", []))
-    ok &= all(isinstance(v, int | float) and not isinstance(v, bool) and v >= 0
-              for v in run.get("config", {}).get("success", {}).values())
+    try:
+        thr = Thresholds.from_run(run)
+        ok &= thr.dist_m >= 0 and thr.orient_deg >= 0  # (NaN is not)
+    except (TypeError, ValueError, OverflowError):
+        ok = False
     if not ok:
         raise ResultsError(f"{path}: malformed datasets, sessions, config.matchers or config.success")
 
