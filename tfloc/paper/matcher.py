@@ -78,8 +78,8 @@ class TfConfig:
     """
 
     RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params)
-        "> 0": ("spacing", "straw_t", "simplex_size"),
-        ">= 0": ("orientation_step", "err_threshold", "xy_tol", "theta_tol", "penalty", "seed"),
+        "> 0": ("spacing", "simplex_size"),
+        ">= 0": ("straw_t", "orientation_step", "err_threshold", "xy_tol", "theta_tol", "penalty", "seed"),
         ">= 1": ("window", "n_orientations", "max_iterations", "max_outer"),
         "(0, 1]": ("line_threshold",)}
 
