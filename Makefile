@@ -1,12 +1,12 @@
-# tfloc: the two commands of the README are `make bench` and `make test`.
-# Both create .venv on first use and (re)install the package when pyproject.toml changes.
+# tfloc: the commands of the README are `make quick`, `make bench` and `make test`.
+# Each creates .venv on first use and (re)install the package when pyproject.toml changes.
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.tfloc-installed
 JOBS   ?= 2
 
-.PHONY: install bench test test-unit timing lint clean-venv real-data fuzz chaos
+.PHONY: install quick bench test test-unit timing lint clean-venv real-data fuzz chaos
 
 $(STAMP): pyproject.toml
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -17,14 +17,25 @@ $(STAMP): pyproject.toml
 
 install: $(STAMP)
 
-## The main job: every registered matcher on the bundled scenarios, with a report.
+## A quick first run (a few minutes): every matcher on the first 3 scans of every group of the
+## paper protocol, a quiet re-timing, and the full report → results/paper-protocol-quick/report.md
+quick: $(STAMP)
+	$(BIN)/tfloc bench benchmarks/paper-protocol.toml --quick --jobs $(JOBS) --regenerate
+	$(BIN)/tfloc timing results/paper-protocol-quick --per-stratum 1
+	$(BIN)/tfloc report results/paper-protocol-quick
+
+## The main job: every registered matcher on the bundled scenarios, a side-by-side timing pass
+## of each run (timing.md), and the reports.
 bench: $(STAMP)
 	$(BIN)/tfloc bench benchmarks/paper-protocol.toml --jobs $(JOBS) --regenerate
+	$(BIN)/tfloc timing results/paper-protocol
 	$(BIN)/tfloc report results/paper-protocol
 	$(BIN)/tfloc bench benchmarks/real-csail-relations.toml --jobs $(JOBS) --regenerate
+	$(BIN)/tfloc timing results/real-csail-relations
 	$(BIN)/tfloc report results/real-csail-relations
 	$(BIN)/tfloc real-note results/real-csail-relations
 	$(BIN)/tfloc bench benchmarks/real-scan-to-map.toml --jobs $(JOBS) --regenerate
+	$(BIN)/tfloc timing results/real-scan-to-map
 	$(BIN)/tfloc report results/real-scan-to-map
 
 ## Rebuild the real-log datasets and grid maps from data/real/ (deterministic).

@@ -25,6 +25,10 @@ Configuration choices and why:
 * ``converged`` = the refinement reported success and the best grid score is at least
   ``min_mean_likelihood`` = 0.3 per beam; a self-check, not a claim of correctness.
 
+**Amortised per map** (``prepare``): the distance and likelihood fields and Olson's
+max-pooled low-resolution table. **Per scan**: the endpoint look-ups of the search, the block
+expansion and the refinement.
+
 ``score(problem, pose)`` is the matcher's own objective: the negative mean likelihood
 ``-mean exp(-d² / 2σ²)`` of the scan endpoints at ``pose`` (interpolated distance ``d``).
 """
@@ -98,6 +102,14 @@ class CorrelativeMatcher(Configured):
         block_starts = steps[:: c.block]
         return _Grid(thetas, steps, block_starts)
 
+    def _span(self) -> int:
+        """The side, in cells, of the max-pooling window of one block of translations (odd)."""
+        return (self.config.block - 1) * self.config.xy_step_cells + 1
+
+    def prepare(self, problem: Problem) -> None:
+        """Build the likelihood field and its pooled table (once per map; untimed by the harness)."""
+        self._field(problem).max_pooled(self._span())
+
     def localize(self, problem: Problem) -> Estimate:
         """Search the window about ``problem.initial`` exhaustively (multi-resolution), then refine."""
         c = self.config
@@ -119,8 +131,7 @@ class CorrelativeMatcher(Configured):
         base = cy * w + cx
 
         # Low resolution: upper bounds for every (rotation, block_y, block_x).
-        span = (c.block - 1) * c.xy_step_cells + 1
-        pooled = field.max_pooled(span).ravel()
+        pooled = field.max_pooled(self._span()).ravel()
         bs = grid.block_starts
         block_off = (bs[:, None] * w + bs[None, :]).ravel()  # (B²,), y-major
         bounds = np.take(pooled, base[:, :, None] + block_off[None, None, :]).sum(axis=1)  # (R, B²)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from tfloc.paper.corners import corner_candidates, resample, shortstraw
-from tfloc.paper.matcher import TfConfig
+from tfloc.paper.shape import ShapeConfig
 
 
 @pytest.fixture(scope="module")
@@ -23,7 +23,7 @@ def test_to_points(benchmark, office, lms200, office_pose):
 
 def test_shortstraw(benchmark, scan_points):
     """Resample + candidates + Is-Line merging at the paper's S = 1 m."""
-    cfg = TfConfig()
+    cfg = ShapeConfig()
     shortstraw(scan_points, cfg.spacing, cfg.window, cfg.straw_t, cfg.line_threshold)  # warm-up (JIT)
     c = benchmark(shortstraw, scan_points, cfg.spacing, cfg.window, cfg.straw_t, cfg.line_threshold)
     assert len(c) >= 3

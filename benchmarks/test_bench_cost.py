@@ -8,7 +8,8 @@ import pytest
 
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Problem
-from tfloc.paper.matcher import TfConfig, TurningFunctionMatcher, _Cost, scan_turning_function
+from tfloc.paper.matcher import TfConfig, TurningFunctionMatcher, _Cost
+from tfloc.paper.shape import scan_turning_function
 
 
 @pytest.fixture(scope="module")
@@ -18,7 +19,7 @@ def problem(office, lms200, office_pose):
 
 
 def test_scan_turning_function(benchmark, problem):
-    scan_turning_function(problem.ranges, problem.laser, TfConfig())  # warm-up (JIT)
+    scan_turning_function(problem.ranges, problem.laser, TfConfig().shape)  # warm-up (JIT)
     tf = benchmark(scan_turning_function, problem.ranges, problem.laser, TfConfig())
     assert tf is not None and tf.n_edges >= 3
 
@@ -26,7 +27,7 @@ def test_scan_turning_function(benchmark, problem):
 def test_cost_one_pose(benchmark, problem):
     """``_Cost.errors`` at one pose; target ≤ 300 µs (ideally ≤ 100 µs) median."""
     cfg = TfConfig()
-    cost = _Cost(problem, cfg, scan_turning_function(problem.ranges, problem.laser, cfg))
+    cost = _Cost(problem, cfg, scan_turning_function(problem.ranges, problem.laser, cfg.shape))
     pose = problem.initial.as_array()[None, :]
     cost.errors(pose)  # warm-up (JIT)
     errs, rots = benchmark(cost.errors, pose)
@@ -36,7 +37,7 @@ def test_cost_one_pose(benchmark, problem):
 def test_cost_seven_orientations(benchmark, problem):
     """Alg. 5's Function1 batch: seven orientations at one position (one batched raycast)."""
     cfg = TfConfig()
-    cost = _Cost(problem, cfg, scan_turning_function(problem.ranges, problem.laser, cfg))
+    cost = _Cost(problem, cfg, scan_turning_function(problem.ranges, problem.laser, cfg.shape))
     p = problem.initial
     th = p.theta + np.radians(np.arange(-3, 4))
     poses = np.column_stack((np.full(7, p.x), np.full(7, p.y), th))

@@ -6,14 +6,14 @@ import numpy as np
 import pytest
 
 from tfloc.core.pose import Pose
-from tfloc.paper.matcher import TfConfig, scan_corners, scan_polygon
+from tfloc.paper.shape import ShapeConfig, scan_corners, scan_polygon
 from tfloc.paper.turning import match, turning_function
 
 
 @pytest.fixture(scope="module")
 def polygons(office, lms200, office_pose):
     """Scan polygons (S = 0.25 m, about 20-30 vertices) at the pose and 0.3 m / 3° off it."""
-    cfg = TfConfig(spacing=0.25)
+    cfg = ShapeConfig(spacing=0.25)
     off = Pose(office_pose.x + 0.3, office_pose.y - 0.2, office_pose.theta + np.radians(3))
     return [scan_polygon(scan_corners(office.raycast(p, lms200), lms200, cfg), cfg)
             for p in (office_pose, off)]

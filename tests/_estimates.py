@@ -16,7 +16,7 @@ def row(matcher: str = "A", dist_m: float | None = 0.01, orient_deg: float | Non
         init_dist_m: float = 0.5, init_deg: float = 5.0, status: str = "ok",
         runtime_s: float | None = 0.01, dataset: str = "detail-1", scan_id: str = "s0",
         group: str = "g", truth: bool = True, score_est: float | None = None,
-        score_true: float | None = None, outcome: str = "") -> dict:
+        score_true: float | None = None, outcome: str = "", cpu_s: float | None = None) -> dict:
     """One result row. The true pose is at the origin facing 0; the initial pose lies along +x
     at ``init_dist_m`` with heading ``init_deg``; the estimate along +y at ``dist_m`` with
     heading ``orient_deg`` (``None``: no estimate)."""
@@ -32,6 +32,7 @@ def row(matcher: str = "A", dist_m: float | None = 0.01, orient_deg: float | Non
             r.update(dist_err_m=dist_m, orient_err_rad=math.radians(orient_deg))
     if runtime_s is not None:
         r.update(runtime_s=runtime_s, converged=1, iterations=10, evaluations=20)
+        r.update(cpu_s=runtime_s if cpu_s is None else cpu_s)
     r.update(score_est=score_est, score_true=score_true)
     return r
 
@@ -40,8 +41,9 @@ def frame(rows: list[dict]) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=COLUMNS)
 
 
-def synthetic_run(path: Path, truth: bool = True, seed: int = 7) -> Path:
-    """A run directory with estimates for the paper's datasets and one scan-to-scan dataset."""
+def synthetic_run(path: Path, truth: bool = True, seed: int = 7, wall_per_cpu: float = 2.0) -> Path:
+    """A run directory with estimates for the paper's datasets and one scan-to-scan dataset
+    (wall time ``wall_per_cpu`` × CPU time)."""
     rng = np.random.default_rng(seed)
     rows = []
     datasets = ["detail-1", "detail-2", "detail-3", "office-pool", "real-x-relations"]
@@ -50,6 +52,7 @@ def synthetic_run(path: Path, truth: bool = True, seed: int = 7) -> Path:
             init_d = rng.uniform(0.0, 3.0) if d != "real-x-relations" else rng.uniform(0.0, 0.3)
             init_a = rng.uniform(0.0, 15.0)
             for m, scale in (("tf", 0.05), ("csm-corr", 0.005)):
+                wall = float(rng.uniform(0.001, 0.5))
                 status = "ok"
                 if m == "tf" and i == 3:
                     status = "timeout"
@@ -61,11 +64,11 @@ def synthetic_run(path: Path, truth: bool = True, seed: int = 7) -> Path:
                 ok = status == "ok"
                 succ = dist <= 0.10 and ang <= 2.0
                 rows.append(row(m, dist if ok else None, ang if ok else None, init_d, init_a, status,
-                                float(rng.uniform(0.001, 0.5)) if ok else None, d, f"{d}-{i:03d}",
+                                wall if ok else None, d, f"{d}-{i:03d}",
                                 "local" if i % 2 else "loop", truth,
                                 score_est=None if succ or not ok else 1.0,
                                 score_true=None if succ or not ok else (0.5 if i % 2 else 2.0),
-                                outcome=""))
+                                outcome="", cpu_s=wall / wall_per_cpu))
     return write_run(path, rows, {d: str(path / "no-such-dir" / d) for d in datasets})
 
 
@@ -81,6 +84,7 @@ def write_run(path: Path, rows: list[dict], datasets: dict[str, str]) -> Path:
            "versions": {"tfloc": "0.1.0"}, "git": {"commit": "abc123", "dirty": False},
            "machine": {"platform": "test", "cpu_count": 2, "python": "3.11"}, "threads_per_job": 1,
            "datasets": datasets,
-           "sessions": [{"started": "2026-01-01T00:00:00+0000", "tasks": 10, "already_done": 0}]}
+           "sessions": [{"started": "2026-01-01T00:00:00+0000", "tasks": 10, "already_done": 0,
+                         "loadavg_start": [3.5, 3.0, 2.5], "loadavg_end": [4.25, 3.5, 3.0]}]}
     (path / "run.json").write_text(json.dumps(run))
     return path

@@ -120,10 +120,10 @@ def test_cli_localize_writes_rows_without_truth(dataset, tmp_path):
 
     df = pd.read_csv(out)
     assert list(df.scan_id) == ["s0", "s1"]
-    for col in ("scan_id", "matcher", "est_x", "est_y", "est_theta", "runtime_s", "converged",
+    for col in ("scan_id", "matcher", "est_x", "est_y", "est_theta", "runtime_s", "cpu_s", "converged",
                 "iterations", "status"):
         assert col in df.columns
-    assert df.runtime_s.gt(0).all() and df.matcher.eq("tf").all()
+    assert df.runtime_s.gt(0).all() and df.cpu_s.gt(0).all() and df.matcher.eq("tf").all()
 
 
 def test_cli_bad_input_is_one_line_without_traceback(dataset, tmp_path):

@@ -8,7 +8,8 @@ from shapely.geometry import box
 
 import tfloc
 from tfloc import Pose, Problem, VectorMap
-from tfloc.paper.matcher import TfConfig, TurningFunctionMatcher, scan_corners
+from tfloc.paper.matcher import TfConfig, TurningFunctionMatcher
+from tfloc.paper.shape import scan_corners
 
 TRUE = Pose(3.0, 3.5, 0.4)
 

@@ -40,11 +40,11 @@ def cluster():
 
 
 def sorted_rows(df: pd.DataFrame) -> pd.DataFrame:
-    return df.drop(columns="runtime_s").sort_values(KEY).reset_index(drop=True)
+    return df.drop(columns=["runtime_s", "cpu_s"]).sort_values(KEY).reset_index(drop=True)
 
 
 def test_local_cluster_gives_the_local_runners_estimates(tmp_path):
-    """CLI --scheduler local:2 vs the local process pool: identical rows but for runtime_s."""
+    """CLI --scheduler local:2 vs the local process pool: identical rows but for runtime_s, cpu_s."""
     args = ["data/scenarios/detail-1", "--limit-per-group", "1", "--no-progress",
             "--allow-import", "--matchers", "csm-corr,toy_matchers:ThreadsInfo,toy_matchers:TwoMinima"]
     for out, extra in ((tmp_path / "local", []), (tmp_path / "dask", ["--scheduler", "local:2"])):

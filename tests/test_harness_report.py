@@ -48,7 +48,7 @@ def test_report_states_definitions_thresholds_and_exclusions(report):
 
 def test_report_has_per_dataset_and_scan_to_scan_tables(report):
     _, _, md = report
-    assert "### office-pool" in md and "Success rate (%) by initial distance offset" in md
+    assert "### office-pool" in md and "Success rate (%) [95 % CI] by initial distance offset" in md
     assert "### real-x-relations" in md and "Trans. error (m) mean ± std" in md
     section = md.split("### real-x-relations")[1]
     assert "| `tf` | loop |" in section and "| `tf` | all |" in section

@@ -138,3 +138,20 @@ def test_fast_atan2_error_bound():
                      [[1, 0], [0, 1], [-1, 0], [0, -1], [1, 1], [-1, -1], [-1, 1e-300], [-1, -1e-300]]))
     err = [abs(math.remainder(_atan2(y, x) - math.atan2(y, x), 2 * math.pi)) for x, y in pts]
     assert max(err) < 1e-5 < _ANGLE_MARGIN / 5
+
+
+@pytest.mark.parametrize("laser", LASERS, ids=lambda s: f"{math.degrees(s.fov):.0f}deg")
+def test_poses_sharing_a_position_give_the_ranges_of_single_casts(laser):
+    """Consecutive poses at one position (tf's seven orientations) reuse the heading-independent
+    work; each row must equal the cast of its pose alone, bit for bit."""
+    rng = np.random.default_rng(7)
+    segs = np.ascontiguousarray(rng.uniform(-6, 6, (60, 4)))
+    poses = []
+    for _ in range(20):
+        x, y, th = rng.uniform(-5, 5), rng.uniform(-5, 5), rng.uniform(-4, 4)
+        poses += [[x, y, th + k * math.radians(1.0)] for k in range(-3, 4)]
+    poses = np.ascontiguousarray(poses)
+    a = np.asarray(laser.angles, dtype=float)
+    batch = raycast_segments(poses, a, segs, laser.max_range)
+    single = np.vstack([raycast_segments(p[None], a, segs, laser.max_range) for p in poses])
+    np.testing.assert_array_equal(batch, single)

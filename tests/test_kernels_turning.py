@@ -116,14 +116,14 @@ def test_match_of_scan_polygons_matches_oracle():
     from tfloc.core.laser import LaserSpec
     from tfloc.core.pose import Pose
     from tfloc.maps.vector import VectorMap
-    from tfloc.paper.matcher import TfConfig, scan_corners, scan_polygon
+    from tfloc.paper.shape import ShapeConfig, scan_corners, scan_polygon
 
     rng = np.random.default_rng(11)
     laser = LaserSpec.lms200()
     segs = np.vstack((rng.uniform(-7, 7, (25, 4)),
                       [[-8, -8, 8, -8], [8, -8, 8, 8], [8, 8, -8, 8], [-8, 8, -8, -8]]))
     m = VectorMap.from_segments(segs)
-    cfg = TfConfig(spacing=0.25)
+    cfg = ShapeConfig(spacing=0.25)
     polys = [scan_polygon(scan_corners(m.raycast(Pose(*rng.uniform(-4, 4, 2), rng.uniform(-3, 3)),
                                                  laser), laser, cfg), cfg) for _ in range(12)]
     for p in polys:

@@ -1,6 +1,7 @@
-"""End to end: the ``tf`` matcher with the compiled kernels gives the same answers as with the
-previous implementations (brute-force raycast, numpy ShortStraw candidates / turning function /
-matching, kept as oracles in tests/test_kernels_*.py)."""
+"""End to end: the ``tf`` matcher with the compiled kernels (the fused cost evaluation of
+tfloc/_tf_kernels.py) gives the same answers as with the previous implementations run step by
+step (brute-force raycast, numpy ShortStraw candidates / turning function / matching, kept as
+oracles in tests/test_kernels_*.py)."""
 
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ from test_kernels_turning import match_ref, turning_function_ref
 
 import tfloc.maps.vector
 import tfloc.paper.matcher
+import tfloc.paper.shape
 from tfloc import Pose, Problem
 from tfloc.maps._raycast import raycast_segments_bruteforce
 from tfloc.paper.matcher import TfConfig, TurningFunctionMatcher
@@ -35,9 +37,10 @@ def test_localize_matches_the_reference_pipeline(test_room, lms200, config, monk
     problems = list(_problems(test_room, lms200))
     fast = [matcher.localize(p) for p in problems]
     with monkeypatch.context() as mp:
+        mp.setattr(tfloc.paper.matcher, "_FUSED", False)  # step by step, through the oracles below
         mp.setattr(tfloc.maps.vector, "raycast_segments", raycast_segments_bruteforce)
-        mp.setattr(tfloc.paper.matcher, "shortstraw", shortstraw_ref)
-        mp.setattr(tfloc.paper.matcher, "turning_function", turning_function_ref)
+        mp.setattr(tfloc.paper.shape, "shortstraw", shortstraw_ref)
+        mp.setattr(tfloc.paper.shape, "turning_function", turning_function_ref)
         mp.setattr(tfloc.paper.matcher, "match", lambda real, virtual: match_ref(real, virtual)[0])
         ref = [matcher.localize(p) for p in problems]
     for f, r in zip(fast, ref, strict=True):

@@ -21,8 +21,12 @@ the `error:` rows; --retry-errors runs them again).
 Matchers named `module:Class` (not registered ones) are imported: that runs the module's code.
 Run only configurations you trust; such matchers are refused without --allow-import.
 
+--quick runs a small stratified subset (the first 3 scans of every group of every dataset) into
+RUN-quick: a full report with figures in a few minutes (make quick).
+
 Examples:
   tfloc bench benchmarks/paper-protocol.toml
+  tfloc bench benchmarks/paper-protocol.toml --quick        # → results/paper-protocol-quick
   tfloc bench data/scenarios/detail-1 --matchers tf,csm-corr --out results/try --jobs 2
   tfloc bench benchmarks/paper-protocol.toml --scheduler local:2           # a local Dask cluster
   tfloc bench benchmarks/paper-protocol.toml --scheduler tls://HOST:8786 \
@@ -41,6 +45,7 @@ from tfloc.evaluation.outcome import Thresholds
 from tfloc.harness.config import RunConfig, check_imports, load_config, parse_matchers
 
 HELP = "run matchers over scenario datasets (resumable), writing RUN/estimates.csv"
+QUICK_PER_GROUP = 3
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -66,6 +71,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "scheduler's and workers' certificates (default: the Dask config, distributed.comm.tls)")
     p.add_argument("--tls-cert", metavar="PEM", help="TLS: this client's certificate")
     p.add_argument("--tls-key", metavar="PEM", help="TLS: this client's private key (if not in --tls-cert)")
+    p.add_argument("--quick", action="store_true",
+                   help=f"a quick first run: the first {QUICK_PER_GROUP} scans of each group (unless "
+                   "--limit-per-group says otherwise), into OUT-quick (unless --out is given)")
     p.add_argument("--regenerate", action="store_true",
                    help="if OUT holds a complete run, or a run of another configuration, discard it and "
                         "run again (an interrupted run of the same configuration is still resumed); make "
@@ -96,6 +104,9 @@ def config_from_args(args: argparse.Namespace) -> RunConfig:
         cfg = RunConfig(name=name, out=args.out or Path("results") / name,
                         datasets=tuple(Path(d) for d in args.inputs),
                         matchers=parse_matchers(names, {}, "--matchers"))
+    if args.quick:
+        cfg = cfg.with_overrides(name=f"{cfg.name}-quick", out=cfg.out.with_name(f"{cfg.out.name}-quick"),
+                                 limit_per_group=QUICK_PER_GROUP)
     return cfg.with_overrides(
         name=args.name, out=args.out, jobs=args.jobs, timeout_s=args.timeout,
         limit_per_group=args.limit_per_group,

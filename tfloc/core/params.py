@@ -109,7 +109,8 @@ def _typed(name: str, value: Any, current: Any, optional: bool = False) -> Any:
             raise _bad(name, "an integer", value)
         return value
     if isinstance(current, float):
-        if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        if isinstance(value, bool) or not isinstance(value, int | float) or math.isnan(value) or (
+                math.isinf(value) and not math.isinf(current)):  # inf only where the default is
             raise _bad(name, "a finite number", value)
         return float(value)
     if isinstance(current, str):

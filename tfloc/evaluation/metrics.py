@@ -13,6 +13,13 @@ Which rows count where (stated in every report):
   errors. Error and improvement statistics use only these; the others are *excluded* and
   counted in ``n_excluded``.
 * **timed rows**: status ``ok`` or ``failed`` with a runtime (timeouts and errors have none).
+  Runtimes are CPU time (``cpu_s``: the worker process's, all threads, during ``localize``);
+  the wall time (``runtime_s``) is kept beside it, and their ratio shows contention. Runs made
+  before ``cpu_s`` existed have no CPU time (``n_cpu`` = 0).
+
+Intervals (:mod:`tfloc.evaluation.stats`): the success rate has a Wilson 95 % interval
+(``success_lo_pct``, ``success_hi_pct``); the median distance error and the median CPU time
+have percentile bootstrap 95 % intervals (``*_median_lo_*``, ``*_median_hi_*``).
 
 Bins are left-closed, right-open: ``[0, 100)``, ``[100, 200)``, ``[200, 300)`` cm and
 ``[300, ∞)``; an initial offset of exactly 100 cm falls in ``100–200``. Angle bins likewise
@@ -29,7 +36,17 @@ import pandas as pd
 
 from tfloc.datasets.protocol import ANGLE_BINS_DEG, DIST_BINS_M
 
-from .outcome import NO_ANSWER, OUTCOMES, SUCCESS, Thresholds, failure_kind
+from .outcome import (
+    DIVERGED,
+    NEAR,
+    NO_ANSWER,
+    OUTCOMES,
+    SUCCESS,
+    Thresholds,
+    failure_kind,
+    search_outcome,
+)
+from .stats import bootstrap_median, wilson
 
 #: The protocol's offset bins (:mod:`tfloc.datasets.protocol`) as report bins, plus an open last bin.
 DIST_EDGES_CM = (*(100.0 * lo for lo, _ in DIST_BINS_M), 100.0 * DIST_BINS_M[-1][1])
@@ -45,14 +62,17 @@ ANGLE_BINS = _labels(ANGLE_EDGES_DEG)
 UNSCORED = "unscored"  # failed under overridden thresholds but the run recorded no scores
 METRIC_COLUMNS = (
     "n", "n_truth", "n_est", "n_excluded", "n_timeout", "n_error", "n_invalid",
-    "dist_mean_cm", "dist_std_cm", "dist_median_cm", "dist_p90_cm", "dist_max_cm",
+    "dist_mean_cm", "dist_std_cm", "dist_median_cm", "dist_median_lo_cm", "dist_median_hi_cm",
+    "dist_p90_cm", "dist_max_cm",
     "orient_mean_deg", "orient_std_deg", "orient_median_deg", "orient_p90_deg", "orient_max_deg",
     "dist_impr_mean_pct", "dist_impr_median_pct", "dist_impr_min_pct",
     "orient_impr_mean_pct", "orient_impr_median_pct", "orient_impr_min_pct",
-    "success_rate_pct",
+    "success_rate_pct", "success_lo_pct", "success_hi_pct",
     *(f"n_{o.replace('-', '_')}" for o in (*OUTCOMES, UNSCORED)),
     *(f"share_{o.replace('-', '_')}_pct" for o in OUTCOMES),
-    "runtime_median_ms", "runtime_p95_ms", "n_timed")
+    "n_near", "n_diverged",
+    "runtime_median_ms", "runtime_p95_ms", "n_timed",
+    "cpu_median_ms", "cpu_median_lo_ms", "cpu_median_hi_ms", "cpu_p95_ms", "n_cpu", "wall_per_cpu_median")
 
 
 def _bin(values: pd.Series, edges: tuple[float, ...], labels: tuple[str, ...]) -> pd.Series:
@@ -112,6 +132,7 @@ def prepare(df: pd.DataFrame, thr: Thresholds) -> pd.DataFrame:
     out = df.copy()
     num = {c: pd.to_numeric(out[c], errors="coerce") for c in
            ("dist_err_m", "orient_err_rad", "init_dist_err_m", "init_orient_err_rad", "runtime_s")}
+    num["cpu_s"] = pd.to_numeric(out.get("cpu_s", pd.Series(np.nan, index=out.index)), errors="coerce")
     est = has_estimate(out)
     out["dist_bin"] = dist_bin(num["init_dist_err_m"])
     out["angle_bin"] = angle_bin(num["init_orient_err_rad"])
@@ -125,8 +146,11 @@ def prepare(df: pd.DataFrame, thr: Thresholds) -> pd.DataFrame:
     out["dist_impr_pct"] = di.where(out["estimate"] & (num["init_dist_err_m"] > 0))
     out["orient_impr_pct"] = oi.where(out["estimate"] & (num["init_orient_err_rad"] > 0))
     out["outcome_eval"] = classify(out, thr)
+    out["search_eval"] = np.where(out["estimate"], search_outcome(
+        num["dist_err_m"], num["orient_err_rad"], num["init_dist_err_m"], thr), None)
     timed = out["status"].isin(["ok", "failed"]) & num["runtime_s"].notna()
     out["runtime_ms"] = (num["runtime_s"] * 1000.0).where(timed)
+    out["cpu_ms"] = (num["cpu_s"] * 1000.0).where(timed)
     return out
 
 
@@ -165,8 +189,18 @@ def group_metrics(g: pd.DataFrame) -> dict[str, float]:
     for o in OUTCOMES:
         m[f"share_{o.replace('-', '_')}_pct"] = 100.0 * counts.get(o, 0) / n_truth if n_truth else np.nan
     m["success_rate_pct"] = m["share_success_pct"]
-    rt = g["runtime_ms"].dropna()
+    searches = g["search_eval"].value_counts()
+    m.update(n_near=int(searches.get(NEAR, 0)), n_diverged=int(searches.get(DIVERGED, 0)))
+    lo, hi = wilson(int(counts.get(SUCCESS, 0)), n_truth)
+    m.update(success_lo_pct=100.0 * lo, success_hi_pct=100.0 * hi)
+    m["dist_median_lo_cm"], m["dist_median_hi_cm"] = bootstrap_median(g["dist_err_cm"])
+    rt, cpu = g["runtime_ms"].dropna(), g["cpu_ms"].dropna()
     m.update(runtime_median_ms=_q(rt, 50), runtime_p95_ms=_q(rt, 95), n_timed=len(rt))
+    lo, hi = bootstrap_median(cpu)
+    both = g[["runtime_ms", "cpu_ms"]].dropna()
+    both = both[both["cpu_ms"] > 0]
+    m.update(cpu_median_ms=_q(cpu, 50), cpu_median_lo_ms=lo, cpu_median_hi_ms=hi, cpu_p95_ms=_q(cpu, 95),
+             n_cpu=len(cpu), wall_per_cpu_median=_q(both["runtime_ms"] / both["cpu_ms"], 50))
     return m
 
 

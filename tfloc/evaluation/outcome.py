@@ -7,6 +7,12 @@
   **local-optimum** if it scores the true pose lower than its answer (the search stopped short
   of a better optimum), **ambiguous** if not (its objective prefers the wrong pose).
 
+Where a failed search ended (:func:`search_outcome`), measured from the poses alone: the
+``local-optimum`` label says nothing about *where* the search stopped (with a noisy objective it
+holds almost whenever the objective at the truth sits at its noise floor), so failures are also
+told apart as **near** (stopped within 30 cm and 5° of the truth: a stall in the basin) and
+**diverged** (ended farther from the true position than the initial guess was).
+
 Inputs are metres and radians; the functions are vectorised (scalars or arrays alike).
 """
 
@@ -20,6 +26,9 @@ import numpy as np
 
 SUCCESS, LOCAL_OPTIMUM, AMBIGUOUS, NO_ANSWER = "success", "local-optimum", "ambiguous", "no-answer"
 OUTCOMES = (SUCCESS, LOCAL_OPTIMUM, AMBIGUOUS, NO_ANSWER)
+NEAR, DIVERGED, OTHER = "near", "diverged", "other"
+SEARCH_OUTCOMES = (SUCCESS, NEAR, DIVERGED, OTHER)
+NEAR_DIST_M, NEAR_ORIENT_DEG = 0.30, 5.0
 
 
 @dataclass(frozen=True)
@@ -73,3 +82,14 @@ def outcome(answered: Any, dist_err_m: Any, orient_err_rad: Any, score_est: Any,
                    np.where(thresholds.success(dist_err_m, orient_err_rad), SUCCESS,
                             failure_kind(score_est, score_true)))
     return str(out) if out.ndim == 0 else out
+
+
+def search_outcome(dist_err_m: Any, orient_err_rad: Any, init_dist_err_m: Any, thresholds: Thresholds,
+                   near: Thresholds = Thresholds(NEAR_DIST_M, NEAR_ORIENT_DEG)) -> Any:
+    """Where each search ended (:data:`SEARCH_OUTCOMES`, the first rule that holds): ``success``
+    (within ``thresholds``), ``near`` (within ``near``), ``diverged`` (farther from the true
+    position than the initial guess), else ``other``; NaN errors (no answer) give ``other``."""
+    d = np.asarray(dist_err_m, dtype=float)
+    out = np.select([thresholds.success(d, orient_err_rad), near.success(d, orient_err_rad),
+                     d > np.asarray(init_dist_err_m, dtype=float)], [SUCCESS, NEAR, DIVERGED], OTHER)
+    return str(out) if out.ndim == 0 else out.astype(object)

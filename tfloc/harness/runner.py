@@ -2,9 +2,10 @@
 to ``estimates.csv`` as tasks finish, and resume by skipping what is already there.
 
 The pool is :class:`pebble.ProcessPool` (spawned workers; a task past its time limit is killed
-with its worker, which is replaced). Each worker is started with its thread pools (OpenMP,
-BLAS, numba) limited to ``max(1, cores // jobs)`` threads, so that together the workers use the
-2 cores the benchmark is specified for, and a matcher never gets more than 2.
+with its worker, which is replaced). Each worker is started with every thread pool (OpenMP,
+BLAS, numba, OpenCV, open3d; :mod:`tfloc.harness.threads`) limited to one thread, so that a
+task's CPU time is one matcher on one core and ``jobs`` workers use ``jobs`` cores. ``run.json``
+records the load average when a session starts and ends (contention shows in wall time).
 
 Before anything is written, every matcher is built once in this process and the run's
 fingerprint is computed (:mod:`tfloc.harness.fingerprint`); an existing run directory is resumed
@@ -36,9 +37,8 @@ from tfloc.io.scenario import iter_scans, read_scenario
 from .config import RunConfig
 from .fingerprint import build_matchers, differences, fingerprint
 from .task import Task, failure_row, run_task, warm_up
+from .threads import limit_threads
 
-THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS",
-               "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")
 PACKAGES = ("tfloc", "numpy", "scipy", "shapely", "numba", "pandas", "open3d", "kiss-icp",
             "opencv-python-headless", "small-gicp", "karto-scanmatcher", "pebble", "matplotlib")
 
@@ -60,19 +60,20 @@ def make_tasks(config: RunConfig) -> list[Task]:
 
 
 def threads_per_job(jobs: int) -> int:
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-    return max(1, min(2, cores // jobs))
+    """Threads per worker: always 1, so CPU time per task is one matcher on one core."""
+    return 1
 
 
 def _init_worker(threads: int) -> None:
-    for var in THREAD_VARS:
-        os.environ[var] = str(threads)
-    try:
-        from threadpoolctl import threadpool_limits
+    limit_threads(threads)
 
-        threadpool_limits(threads)
-    except ImportError:
-        pass
+
+def load_average() -> list[float] | None:
+    """The 1, 5 and 15 minute load averages (``os.getloadavg``), or None where unavailable."""
+    try:
+        return [round(x, 2) for x in os.getloadavg()]
+    except (AttributeError, OSError):
+        return None
 
 
 def environment() -> dict:
@@ -109,14 +110,20 @@ def read_run_json(out: Path) -> dict | None:
 
 
 def write_run_json(config: RunConfig, out: Path, n_tasks: int, n_done: int, fp: dict | None = None) -> None:
-    """Write ``run.json`` atomically (a kill leaves the old or the new file, never half of one)."""
-    path = out / "run.json"
+    """Start a session in ``run.json`` (the configuration, environment and fingerprint)."""
     previous = read_run_json(out) or {}
     starts = previous.get("sessions", []) + [{"started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-                                              "tasks": n_tasks, "already_done": n_done}]
+                                              "tasks": n_tasks, "already_done": n_done,
+                                              "loadavg_start": load_average()}]
     doc = {"config": config.to_dict(), **environment(), "threads_per_job": threads_per_job(config.jobs),
            "datasets": {read_scenario(d).name: str(d) for d in config.datasets}, "sessions": starts,
            "fingerprint": fp}
+    _save_run_json(out, doc)
+
+
+def _save_run_json(out: Path, doc: dict) -> None:
+    """Write ``run.json`` atomically (a kill leaves the old or the new file, never half of one)."""
+    path = out / "run.json"
     tmp = path.with_name("run.json.tmp")
     try:
         with tmp.open("w") as fh:
@@ -126,7 +133,15 @@ def write_run_json(config: RunConfig, out: Path, n_tasks: int, n_done: int, fp: 
         os.replace(tmp, path)
         sync_dir(out)
     except OSError as exc:
-        raise ResultsError(f"{path}: cannot write ({exc.strerror or exc}); nothing was run") from None
+        raise ResultsError(f"{path}: cannot write ({exc.strerror or exc})") from None
+
+
+def close_session(out: Path) -> None:
+    """Record the end time and load average of the last session in ``run.json``."""
+    doc = read_run_json(out)
+    if doc and doc.get("sessions"):
+        doc["sessions"][-1].update(ended=time.strftime("%Y-%m-%dT%H:%M:%S%z"), loadavg_end=load_average())
+        _save_run_json(out, doc)
 
 
 def execute_local(tasks: list[Task], jobs: int, timeout_s: float,
@@ -139,7 +154,7 @@ def execute_local(tasks: list[Task], jobs: int, timeout_s: float,
             warm = {}
             for t in tasks:  # compile kernels and load data outside the timed, time-limited tasks
                 warm.setdefault((t.dataset, t.matcher, t.params_json), t)
-            for f in [pool.schedule(warm_up, args=(t,)) for t in warm.values()]:
+            for f in [pool.schedule(warm_up, args=(t,), timeout=timeout_s) for t in warm.values()]:
                 try:
                     f.result()
                 except Exception:  # noqa: BLE001 - the task itself will report the failure
@@ -237,6 +252,7 @@ def run(config: RunConfig, progress: bool | None = None, executor: Executor = ex
             executor(todo, config.jobs, config.timeout_s, on_row)
         finally:
             bar.close()
+            close_session(out)
     return out
 
 

@@ -25,7 +25,7 @@ from .text import csv_rows
 COLUMNS = ["dataset", "scan_id", "group", "matcher",
            "true_x", "true_y", "true_theta", "init_x", "init_y", "init_theta",
            "est_x", "est_y", "est_theta", "dist_err_m", "orient_err_rad",
-           "init_dist_err_m", "init_orient_err_rad", "runtime_s", "converged", "iterations",
+           "init_dist_err_m", "init_orient_err_rad", "runtime_s", "cpu_s", "converged", "iterations",
            "evaluations", "status", "outcome", "score_est", "score_true", "info"]
 KEY = ("dataset", "scan_id", "matcher")
 #: the columns every reader needs (older runs may lack the others)
@@ -80,14 +80,11 @@ def read_rows(path: Path, required: tuple[str, ...] = REQUIRED) -> tuple[list[st
 
 def done_keys(path: Path, redo: tuple[str, ...] = ()) -> set[tuple[str, str, str]]:
     """Keys (dataset, scan_id, matcher) already in the results file, but for those whose status
-    kind is in ``redo``. The file must have the columns this version writes."""
+    kind is in ``redo``."""
     repair(path)
     if not path.exists() or path.stat().st_size == 0:
         return set()
-    header, rows = read_rows(path)
-    if header != COLUMNS:
-        raise ResultsError(f"{path}: its columns are not those this tfloc writes ({len(header)} vs "
-                           f"{len(COLUMNS)}): made by another version; --regenerate or another --out")
+    _, rows = read_rows(path)
     return {tuple(r[k] for k in KEY) for _, r in rows if status_kind(r["status"]) not in redo}
 
 
@@ -103,14 +100,14 @@ def status_counts(path: Path) -> dict[str, int]:
 def drop_rows(path: Path, keep: set[tuple[str, str, str]]) -> int:
     """Rewrite the results file with only the rows whose key is in ``keep``, atomically (a kill
     leaves the old file or the new one, never a mix); returns how many rows were dropped."""
-    _, rows = read_rows(path)
+    header, rows = read_rows(path)
     kept = [r for _, r in rows if tuple(r[k] for k in KEY) in keep]
     if len(kept) == len(rows):
         return 0
     tmp = path.with_name(path.name + ".tmp")
     try:
         with tmp.open("w", newline="") as fh:
-            w = csv.DictWriter(fh, fieldnames=COLUMNS, extrasaction="ignore")
+            w = csv.DictWriter(fh, fieldnames=header, extrasaction="ignore")
             w.writeheader()
             w.writerows(kept)
             fh.flush()
@@ -144,8 +141,9 @@ class ResultWriter:
         try:
             repair(self.path)
             new = not self.path.exists() or self.path.stat().st_size == 0
+            header = COLUMNS if new else _header(self.path)  # resuming an older run keeps its columns
             self._fh = self.path.open("a", newline="")
-            self._w = csv.DictWriter(self._fh, fieldnames=COLUMNS, extrasaction="ignore")
+            self._w = csv.DictWriter(self._fh, fieldnames=header, extrasaction="ignore")
             if new:
                 self._w.writeheader()
                 self._sync()
@@ -180,6 +178,11 @@ class ResultWriter:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+def _header(path: Path) -> list[str]:
+    with path.open(newline="") as fh:
+        return next(csv.reader(fh))
 
 
 def _fmt(v: Any) -> Any:

@@ -121,6 +121,52 @@ def _uniform_spacing(rel_angles: np.ndarray) -> tuple[float, float, float]:
     return a0, res, dev
 
 
+@njit(cache=True, nogil=True)
+def _arcs(ox: float, oy: float, segs: np.ndarray, max_range: float, dev: float,
+          near: np.ndarray, dist: np.ndarray, seg_of: np.ndarray, every: np.ndarray,
+          start: np.ndarray, width: np.ndarray, margin: np.ndarray, h_safe: np.ndarray,
+          den_min: np.ndarray, ex: np.ndarray, ey: np.ndarray) -> int:
+    """What :func:`raycast_segments` needs of the segments seen from ``(ox, oy)``, independent of
+    the heading: the segments within ``max_range``, nearest first (``seg_of``), whether each must
+    be tested against every beam (``every``), else the arc it subtends (``start``, ``width``,
+    ``margin``) and its occlusion test (``h_safe``, ``den_min``, ``ex``, ``ey``); returns their count."""
+    two_pi = 2.0 * np.pi
+    k = _near_segments(ox, oy, segs, max_range, near, dist)
+    order = np.argsort(dist[:k])
+    for jj in range(k):
+        j = order[jj]
+        m = near[j]
+        seg_of[jj] = m
+        seg = segs[m]
+        ax, ay = seg[0] - ox, seg[1] - oy
+        bx, by = seg[2] - ox, seg[3] - oy
+        length = np.sqrt((bx - ax) ** 2 + (by - ay) ** 2)
+        slack = 2.0 * _U_TOL * length     # how far beyond an end a counted hit can lie
+        h = dist[j]
+        if h <= 1e3 * slack or h < 1e-9:  # through (or at) the sensor: every beam
+            every[jj] = True
+            continue
+        # arc [start, start + width] (relative to the first beam) the segment subtends
+        alpha = _atan2(ay, ax)
+        beta = _atan2(by, bx)
+        d = beta - alpha
+        d = d - two_pi * np.floor((d + np.pi) / two_pi)   # in [-π, π)
+        if abs(d) > np.pi - 1e-3:         # nearly through the sensor: every beam
+            every[jj] = True
+            continue
+        every[jj] = False
+        # A beam hit (within the u tolerance) lies ≥ h − slack away; with |den| ≥ den_min the
+        # computed t is within 1e-9 (relative) of the true one, so a beam whose nearest hit
+        # so far is below h_safe cannot be hit here (segments are visited front to back).
+        ex[jj], ey[jj] = bx - ax, by - ay
+        h_safe[jj] = (h - slack) * (1.0 - 1e-9)
+        den_min[jj] = 1e-5 * length * (1.0 + length / h)
+        start[jj] = alpha if d >= 0.0 else beta
+        width[jj] = abs(d)
+        margin[jj] = _ANGLE_MARGIN + dev + 2.0 * slack / (h - slack)
+    return k
+
+
 @njit(cache=True, fastmath=False, nogil=True)
 def raycast_segments(poses: np.ndarray, rel_angles: np.ndarray, segs: np.ndarray,
                      max_range: float) -> np.ndarray:
@@ -134,7 +180,8 @@ def raycast_segments(poses: np.ndarray, rel_angles: np.ndarray, segs: np.ndarray
     360° scanners included). A segment within rounding distance of the sensor is intersected
     with every beam, so the answer never depends on the arc computation. Segments are visited
     nearest first, and a beam whose hit so far is nearer than a segment's distance skips it
-    (only when the skip provably agrees with the brute force's test).
+    (only when the skip provably agrees with the brute force's test). Consecutive poses at the
+    same position (e.g. several headings) share the heading-independent work (:func:`_arcs`).
     """
     P = poses.shape[0]
     B = rel_angles.shape[0]
@@ -149,57 +196,46 @@ def raycast_segments(poses: np.ndarray, rel_angles: np.ndarray, segs: np.ndarray
     dys = np.empty(B)
     near = np.empty(M, dtype=np.int64)
     dist = np.empty(M)
+    seg_of = np.empty(M, dtype=np.int64)
+    every = np.empty(M, dtype=np.bool_)
+    start = np.empty(M)
+    width = np.empty(M)
+    margin = np.empty(M)
+    h_safe = np.empty(M)
+    den_min = np.empty(M)
+    ex = np.empty(M)
+    ey = np.empty(M)
+    k = 0
+    wrap_up = two_pi / res <= B - 1.0   # can an arc one turn up reach a beam (360° scanners)?
     for p in range(P):
         ox, oy, th = poses[p, 0], poses[p, 1], poses[p, 2]
         for b in range(B):
             a = th + rel_angles[b]
             dxs[b], dys[b] = np.cos(a), np.sin(a)
             best[b] = max_range
-        k = _near_segments(ox, oy, segs, max_range, near, dist)
-        order = np.argsort(dist[:k])
+        if p == 0 or ox != poses[p - 1, 0] or oy != poses[p - 1, 1]:
+            k = _arcs(ox, oy, segs, max_range, dev, near, dist, seg_of, every, start, width,
+                      margin, h_safe, den_min, ex, ey)
         for jj in range(k):
-            j = order[jj]
-            m = near[j]
-            seg = segs[m]
-            ax, ay = seg[0] - ox, seg[1] - oy
-            bx, by = seg[2] - ox, seg[3] - oy
-            length = np.sqrt((bx - ax) ** 2 + (by - ay) ** 2)
-            slack = 2.0 * _U_TOL * length     # how far beyond an end a counted hit can lie
-            h = dist[j]
-            if h <= 1e3 * slack or h < 1e-9:  # through (or at) the sensor: every beam
+            seg = segs[seg_of[jj]]
+            if every[jj]:
                 for b in range(B):
                     best[b] = _hit(ox, oy, dxs[b], dys[b], seg, best[b])
                 continue
-            # arc [start, start + width] (relative to the first beam) the segment subtends
-            alpha = _atan2(ay, ax)
-            beta = _atan2(by, bx)
-            d = beta - alpha
-            d = d - two_pi * np.floor((d + np.pi) / two_pi)   # in [-π, π)
-            if abs(d) > np.pi - 1e-3:         # nearly through the sensor: every beam
-                for b in range(B):
-                    best[b] = _hit(ox, oy, dxs[b], dys[b], seg, best[b])
-                continue
-            # A beam hit (within the u tolerance) lies ≥ h − slack away; with |den| ≥ den_min the
-            # computed t is within 1e-9 (relative) of the true one, so a beam whose nearest hit
-            # so far is below h_safe cannot be hit here (segments are visited front to back).
-            ex, ey = bx - ax, by - ay
-            h_safe = (h - slack) * (1.0 - 1e-9)
-            den_min = 1e-5 * length * (1.0 + length / h)
-            start = alpha if d >= 0.0 else beta
-            width = abs(d)
-            margin = _ANGLE_MARGIN + dev + 2.0 * slack / (h - slack)
-            rel = start - th - a0 - margin
+            rel = start[jj] - th - a0 - margin[jj]
             rel = rel - two_pi * np.floor(rel / two_pi)        # in [0, 2π)
-            top = rel + width + 2.0 * margin
+            top = rel + width[jj] + 2.0 * margin[jj]
             for wrap in range(-1, 2):                          # beams i·res ≡ arc (mod 2π)
+                if (wrap == -1 and top < two_pi) or (wrap == 1 and not wrap_up):
+                    continue                                   # (the tests below would skip it)
                 lo_f = np.ceil((rel + wrap * two_pi) / res)
                 hi_f = np.floor((top + wrap * two_pi) / res)
                 if hi_f < 0.0 or lo_f > B - 1.0:
                     continue
                 lo, hi = int(max(lo_f, 0.0)), int(min(hi_f, B - 1.0))
                 for b in range(lo, hi + 1):
-                    if best[b] <= h_safe:      # occluded: t ≥ h > best, unless t is ill-conditioned
-                        if abs(dxs[b] * ey - dys[b] * ex) >= den_min:
+                    if best[b] <= h_safe[jj]:  # occluded: t ≥ h > best, unless t is ill-conditioned
+                        if abs(dxs[b] * ey[jj] - dys[b] * ex[jj]) >= den_min[jj]:
                             continue
                     best[b] = _hit(ox, oy, dxs[b], dys[b], seg, best[b])
         for b in range(B):

@@ -14,6 +14,12 @@ Readings of the paper's text, each chosen because the literal text does not work
   local-minimum selection, as written); Alg. 3 then thins them.
 * **Alg. 2 uses w = 1** where Wolin et al. use w = 3: the default follows the paper; the
   window is a parameter.
+* **Alg. 1 walks chords, not the path.** Its formula steps from the last emitted point P1
+  towards the next input point (a chord); its sentence says P3 lies "exactly S Euclidian distance
+  away from the P1 in the slop direction of the straight line from P(i−1) to P(i)", and Wolin et
+  al.'s RESAMPLE-POINTS walks the *path* through P(i−1), P(i), emitting a point every S of path
+  length. :func:`resample` is the chord walk (the default), :func:`resample_path` the path walk
+  (``shortstraw(..., along_path=True)``). They differ only where the path turns within S.
 * **Alg. 3 sums squared steps** (``PathD ← PathD + ‖p_i − p_{i+1}‖²``). For points resampled at
   spacing S that makes ``D/PathD`` scale as 1/S, so the test only means "straight" when S = 1.
   We sum the plain step lengths (ShortStraw's IS-LINE), which is identical at S = 1.
@@ -26,17 +32,34 @@ from numba import njit
 
 
 @njit(cache=True, nogil=True)
+def _emit(out: np.ndarray, m: int, x: float, y: float) -> int:
+    """Write point ``m`` into ``out`` (unless ``out`` only counts, shape ``(0, 2)``); the new
+    count, or -1 if ``out`` is full."""
+    if out.shape[0] > 0:
+        if m >= out.shape[0]:
+            return -1
+        out[m, 0], out[m, 1] = x, y
+    return m + 1
+
+
+@njit(cache=True, nogil=True)
+def _emit_last(points: np.ndarray, out: np.ndarray, m: int, lx: float, ly: float, spacing: float) -> int:
+    """Alg. 1's end: the last input point is appended when it lies more than ``spacing/2`` beyond
+    the last emitted point ``(lx, ly)``."""
+    n = points.shape[0]
+    ex, ey = points[n - 1, 0] - lx, points[n - 1, 1] - ly
+    if np.sqrt(ex * ex + ey * ey) > 0.5 * spacing:
+        return _emit(out, m, points[n - 1, 0], points[n - 1, 1])
+    return m
+
+
+@njit(cache=True, nogil=True)
 def _resample_into(points: np.ndarray, spacing: float, out: np.ndarray) -> int:
     """Algorithm 1 written into ``out``; returns the number of points, or -1 if ``out`` is too
     small (``out`` of shape ``(0, 2)`` just counts)."""
     n = points.shape[0]
-    cap = out.shape[0]
-    count_only = cap == 0
-    m = 0
     p1x, p1y = points[0, 0], points[0, 1]
-    if not count_only:
-        out[0, 0], out[0, 1] = p1x, p1y
-    m += 1
+    m = _emit(out, 0, p1x, p1y)
     i = 1
     surely_inside = spacing * spacing * (1.0 - 1e-9)   # d² below this ⇒ d ≤ spacing, no sqrt
     while i < n:
@@ -48,21 +71,12 @@ def _resample_into(points: np.ndarray, spacing: float, out: np.ndarray) -> int:
         d = np.sqrt(d2)
         if d > spacing:
             p1x, p1y = p1x + dx / d * spacing, p1y + dy / d * spacing
-            if not count_only:
-                if m >= cap:
-                    return -1
-                out[m, 0], out[m, 1] = p1x, p1y
-            m += 1
+            m = _emit(out, m, p1x, p1y)
+            if m < 0:
+                return -1
         else:
             i += 1
-    lx, ly = points[n - 1, 0] - p1x, points[n - 1, 1] - p1y
-    if np.sqrt(lx * lx + ly * ly) > 0.5 * spacing:
-        if not count_only:
-            if m >= cap:
-                return -1
-            out[m, 0], out[m, 1] = points[n - 1, 0], points[n - 1, 1]
-        m += 1
-    return m
+    return _emit_last(points, out, m, p1x, p1y, spacing)
 
 
 @njit(cache=True, nogil=True)
@@ -89,6 +103,62 @@ def resample(points: np.ndarray, spacing: float) -> np.ndarray:
     if m < 0:                  # not expected; count exactly and redo
         out = np.empty((_resample_into(points, spacing, np.empty((0, 2))), 2))
         m = _resample_into(points, spacing, out)
+    return out[:m]
+
+
+@njit(cache=True, nogil=True)
+def _resample_path_into(points: np.ndarray, spacing: float, out: np.ndarray) -> int:
+    """The path walk of :func:`resample_path` written into ``out``; returns the number of points,
+    or -1 if ``out`` is too small (``out`` of shape ``(0, 2)`` just counts)."""
+    n = points.shape[0]
+    px, py = points[0, 0], points[0, 1]       # where the walk stands (last emitted or input point)
+    lx, ly = px, py                           # last emitted point
+    m = _emit(out, 0, px, py)
+    walked = 0.0                              # path length since the last emitted point
+    i = 1
+    while i < n:
+        dx, dy = points[i, 0] - px, points[i, 1] - py
+        d = np.sqrt(dx * dx + dy * dy)
+        if d > 0.0 and walked + d >= spacing:
+            f = (spacing - walked) / d
+            px, py = px + f * dx, py + f * dy
+            lx, ly = px, py
+            m = _emit(out, m, px, py)
+            if m < 0:
+                return -1
+            walked = 0.0
+        else:
+            walked += d
+            px, py = points[i, 0], points[i, 1]
+            i += 1
+    return _emit_last(points, out, m, lx, ly, spacing)
+
+
+@njit(cache=True, nogil=True)
+def resample_path(points: np.ndarray, spacing: float) -> np.ndarray:
+    """Algorithm 1 read as Wolin et al.'s RESAMPLE-POINTS: walk along the path through the input
+    points ``(N, 2)`` and emit a point every ``spacing`` metres of path length, on the segment
+    from P(i−1) to P(i) where that length is reached.
+
+    Returns ``(M, 2)``; the first input point is always kept, and the last input point is
+    appended when it lies more than ``spacing/2`` (straight distance) beyond the last emitted
+    point, as in :func:`resample`.
+    """
+    n = points.shape[0]
+    if n == 0:
+        return np.empty((0, 2))
+    path = 0.0
+    for i in range(1, n):
+        dx, dy = points[i, 0] - points[i - 1, 0], points[i, 1] - points[i - 1, 1]
+        path += np.sqrt(dx * dx + dy * dy)
+    cap = 2 * n + 16
+    if np.isfinite(path) and path / spacing < 1e9:
+        cap += int(path / spacing)
+    out = np.empty((cap, 2))
+    m = _resample_path_into(points, spacing, out)
+    if m < 0:                  # not expected; count exactly and redo
+        out = np.empty((_resample_path_into(points, spacing, np.empty((0, 2))), 2))
+        m = _resample_path_into(points, spacing, out)
     return out[:m]
 
 
@@ -174,9 +244,9 @@ def merge_lines(points: np.ndarray, corners: np.ndarray, threshold: float = 0.95
 
 @njit(cache=True, nogil=True)
 def _shortstraw(points: np.ndarray, spacing: float, window: int, t: float,
-                line_threshold: float) -> np.ndarray:
+                line_threshold: float, along_path: bool = False) -> np.ndarray:
     """Algs. 1–3 in one compiled call (see :func:`shortstraw`)."""
-    res = resample(points, spacing)
+    res = resample_path(points, spacing) if along_path else resample(points, spacing)
     n = res.shape[0]
     if n <= 2 * window:
         cand = np.arange(n) if n < 2 else np.array([0, n - 1], dtype=np.int64)
@@ -196,13 +266,15 @@ def is_line(points: np.ndarray, a: int, b: int, threshold: float = 0.95) -> bool
 
 
 def shortstraw(points: np.ndarray, spacing: float, window: int = 1, t: float = 0.99,
-               line_threshold: float = 0.95) -> np.ndarray:
+               line_threshold: float = 0.95, along_path: bool = False) -> np.ndarray:
     """ShortStraw corners of an ordered polyline ``(N, 2)`` (metres) → corner points ``(K, 2)``.
 
-    Alg. 1 (resample at ``spacing``), Alg. 2 (straw candidates, ``window``, ``t``), Alg. 3
-    (Is-Line merging at ``line_threshold``). The first and last points are always corners.
+    Alg. 1 (resample at ``spacing`` metres: chords, or along the path if ``along_path``), Alg. 2
+    (straw candidates, ``window``, ``t``), Alg. 3 (Is-Line merging at ``line_threshold``). The
+    first and last points are always corners.
     """
     pts = np.ascontiguousarray(points, dtype=float)
     if len(pts) < 2:
         return pts.copy()
-    return _shortstraw(pts, float(spacing), int(window), float(t), float(line_threshold))
+    return _shortstraw(pts, float(spacing), int(window), float(t), float(line_threshold),
+                       bool(along_path))

@@ -33,42 +33,76 @@ Readings (the text is ambiguous or wrong; each choice is the one that works):
   and two points ``simplex_size`` metres away at a seeded random direction, 60° apart.
 * **Invalid candidates** (inside a wall/obstacle, off the map, fewer than 2 corners in the
   virtual scan) cost ``penalty`` instead of raising.
+
+Ambiguous readings are switches of :class:`TfConfig` (each quotes the sentence it reads); the
+defaults are the literal reading above, and ``tf-best`` (:mod:`tfloc.paper.best`) is the same
+search with the best-measured reading of each.
+
+Speed: one Function1 call is one batched raycast plus one compiled call
+(:func:`tfloc.paper.kernels.scan_errors`) for the corners, turning functions and matching of all
+its orientations; it runs the same kernels as the step-by-step functions of this module, so the
+answers are identical.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import ClassVar
 
 import numpy as np
 
-from tfloc.core.laser import LaserSpec
 from tfloc.core.params import Configured
 from tfloc.core.pose import Pose, wrap_angle
 from tfloc.core.problem import Estimate, Problem
+from tfloc.errors import ParameterError
 
-from .corners import shortstraw
-from .turning import TurningFunction, match, turning_function
+from .kernels import scan_errors
+from .shape import ShapeConfig, scan_turning_function
+from .turning import Match, TurningFunction, match, match_l1
 
-_ORIGIN = np.zeros((1, 2))
+_NORMS = ("l2", "l1")
 
 
 @dataclass(frozen=True)
 class TfConfig:
-    """Parameters of the ``tf`` matcher; defaults follow the paper where it gives a value.
+    """Parameters of the ``tf`` matcher; defaults follow the paper where it gives a value and are
+    otherwise the literal reading of ``main`` (the switches below name the alternatives).
 
     Attributes:
-        spacing: S of Alg. 1, resampling distance (metres). The paper writes S = 1 without a
-            unit; see the module notes of :mod:`tfloc.paper.corners` and the README for the choice.
-        window: w of Alg. 2 (the paper's w = 1; ShortStraw's authors use 3).
-        straw_t: t of Alg. 2 (0.99).
-        line_threshold: Is-Line threshold of Alg. 3 (0.95).
-        close_through_origin: close the scan polygon through the sensor origin.
-        n_orientations: orientations checked per simplex vertex (7).
-        orientation_step: spacing of those orientations (radians).
-        simplex_size: initial simplex size (metres); should cover the largest position offset.
-        err_threshold: Eq. 13's threshold on Err (radians).
+        spacing, window, straw_t, line_threshold, resampling, close_through_origin: how a scan
+            becomes a polygon (Algs. 1–4), :class:`tfloc.paper.shape.ShapeConfig` (the readings
+            of the text, quoted there); :attr:`shape` collects them.
+        err_norm: Err. ``"l2"`` (default): Eq. 13, "Err = (∫₀¹ |Θ_R(L) − Θ_V(L)|² dL)^½";
+            ``"l1"``: Sec. 4.3, "The area between the two graphs is then computed. Rectangles are
+            created between two graphs because they are in the form of histograms. Each
+            rectangle's area is determined, and the area between the two graphs is calculated by
+            adding the total areas together." (∫|Θ_R − Θ_V − θ|, best θ = weighted median).
+        n_orientations: orientations checked per simplex vertex (7: "the angle of each of these
+            three vertices is examined locally in seven orientations").
+        orientation_step: spacing of those orientations (radians). The paper gives none; the
+            literal default is 1°, the scanner's "angular resolution of 1 degree" (the seven
+            cover ±3°). 5° makes them cover ±15°, the protocol's largest angle offset ("The
+            angle difference in this scenario ranges from 0 to 15 degrees").
+        rotation_correction: after a simplex run, correct the heading by the histogram's rotation
+            offset (Sec. 4.3's transfer "to the same coordinate system"; default ``True``) or
+            keep the best of the seven orientations only (``False``).
+        heading_clamp: the largest heading change (radians) from the initial heading the outer
+            iterations may make. Default ``inf`` (unbounded, as written: Eq. 2's Δθ = Σ δθ_k has
+            no bound). A finite value reads "the angle of each of these three vertices is
+            examined locally" as a bound; the protocol's largest initial angle offset is 15°.
+        simplex_size: initial simplex size (metres). "Three points are chosen at random in an
+            arbitrary interval in the beginning. The maximum value of the robot position
+            difference should be covered by this interval." Literal default: a fixed 1 m; the
+            covering reading is the protocol's largest offset, 3 m ("The difference in the
+            position ... ranges from 0 to 300 cm").
+        keep_best: across outer iterations, return the pose of lowest Err (``True``) or the last
+            pose (``False``, default). Alg. 5 keeps the best within one run ("B ← find the point
+            among B, NB and W with minimum error"); of the repetition the text says only "This
+            operation is iterated by the algorithm until a suitable fixation between the two
+            positions is found", which leaves the answer of the last iteration.
+        err_threshold: Eq. 13's threshold on Err (radians; radians × unit length for ``l1``).
         xy_tol: simplex size (metres) and outer-iteration move below which the search stops.
         theta_tol: outer-iteration heading change (radians) below which the search stops.
         max_iterations: simplex iterations per outer iteration.
@@ -78,7 +112,7 @@ class TfConfig:
     """
 
     RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params)
-        "> 0": ("spacing", "simplex_size"),
+        "> 0": ("spacing", "simplex_size", "heading_clamp"),
         ">= 0": ("straw_t", "orientation_step", "err_threshold", "xy_tol", "theta_tol", "penalty", "seed"),
         ">= 1": ("window", "n_orientations", "max_iterations", "max_outer"),
         "(0, 1]": ("line_threshold",)}
@@ -98,31 +132,31 @@ class TfConfig:
     max_outer: int = 8
     penalty: float = 1e3
     seed: int = 0
+    err_norm: str = "l2"
+    resampling: str = "chord"
+    rotation_correction: bool = True
+    heading_clamp: float = math.inf
+    keep_best: bool = False
+
+    @property
+    def shape(self) -> ShapeConfig:
+        """The parameters of the scan's shape (Algs. 1–4)."""
+        return ShapeConfig(self.spacing, self.window, self.straw_t, self.line_threshold,
+                           self.resampling, self.close_through_origin)
+
+    def __post_init__(self) -> None:
+        if self.err_norm not in _NORMS:
+            raise ParameterError(f"tf: err_norm must be one of {_NORMS}, not {self.err_norm!r}")
+        self.shape  # noqa: B018 - validates the shape parameters
+        if not self.heading_clamp > 0:
+            raise ParameterError(f"tf: heading_clamp must be > 0 radians (inf = unbounded), not {self.heading_clamp!r}")
 
 
-def scan_corners(ranges: np.ndarray, laser: LaserSpec, config: TfConfig = TfConfig()) -> np.ndarray:
-    """ShortStraw corners of one scan, ``(K, 2)`` in the sensor frame (metres).
-
-    No-return beams are dropped and their neighbours joined (see module notes).
-    """
-    pts = laser.to_points(ranges)
-    return shortstraw(pts, config.spacing, config.window, config.straw_t, config.line_threshold)
+def _match(config: TfConfig) -> Callable[[TurningFunction, TurningFunction], Match]:
+    return match_l1 if config.err_norm == "l1" else match
 
 
-def scan_polygon(corners: np.ndarray, config: TfConfig = TfConfig()) -> np.ndarray:
-    """The closed scan polygon of a scan's corners (through the sensor origin if configured)."""
-    if config.close_through_origin:
-        return np.concatenate((_ORIGIN, corners))
-    return corners
-
-
-def scan_turning_function(ranges: np.ndarray, laser: LaserSpec,
-                          config: TfConfig = TfConfig()) -> TurningFunction | None:
-    """Turning function of a scan, or ``None`` if its polygon is degenerate (< 3 edges)."""
-    try:
-        return turning_function(scan_polygon(scan_corners(ranges, laser, config), config))
-    except ValueError:
-        return None
+_FUSED = True  # one compiled call per batch (tests switch it off to compare with the oracles)
 
 
 @dataclass
@@ -135,6 +169,30 @@ class _Cost:
     evaluations: int = 0
     cache: dict = field(default_factory=dict)
 
+    def __post_init__(self) -> None:
+        cfg, laser = self.config, self.problem.laser
+        n = cfg.n_orientations
+        self._offsets = (np.arange(n) - (n - 1) / 2) * cfg.orientation_step
+        self._kernel_args = (  # everything scan_errors needs after the scans, converted once
+            laser.directions, float(laser.max_range), float(cfg.spacing), int(cfg.window),
+            float(cfg.straw_t), float(cfg.line_threshold), bool(cfg.close_through_origin),
+            cfg.resampling == "path", cfg.err_norm == "l1", self.real.breaks, self.real.angles,
+            float(cfg.penalty))
+
+    def _scan_errors(self, scans: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Err and rotation offset (radians, in [-π, π)) of each virtual scan ``(P, n_beams)``."""
+        if _FUSED:
+            return scan_errors(scans, *self._kernel_args)
+        cfg, laser = self.config, self.problem.laser
+        errs, rots = np.full(len(scans), cfg.penalty), np.zeros(len(scans))
+        distance = _match(cfg)
+        for j, ranges in enumerate(scans):
+            tf_v = scan_turning_function(ranges, laser, cfg.shape)
+            if tf_v is not None:
+                m = distance(self.real, tf_v)
+                errs[j], rots[j] = m.distance, m.rotation
+        return errs, rots
+
     def errors(self, poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Err and rotation offset (radians) at each of ``(N, 3)`` poses (one batched raycast)."""
         cfg, prob = self.config, self.problem
@@ -146,12 +204,7 @@ class _Cost:
         else:
             free = prob.map.is_free(xy)
         if free.any():
-            scans = prob.map.raycast(poses[free], prob.laser)
-            for j, ranges in zip(np.flatnonzero(free), scans, strict=True):
-                tf_v = scan_turning_function(ranges, prob.laser, cfg)
-                if tf_v is not None:
-                    m = match(self.real, tf_v)
-                    errs[j], rots[j] = m.distance, m.rotation
+            errs[free], rots[free] = self._scan_errors(prob.map.raycast(poses[free], prob.laser))
         self.evaluations += len(poses)
         return errs, rots
 
@@ -160,14 +213,21 @@ class _Cost:
 
         Returns (Err, heading of the best orientation, its rotation offset)."""
         key = (float(xy[0]), float(xy[1]))
-        if key not in self.cache:
-            k = np.arange(self.config.n_orientations) - (self.config.n_orientations - 1) / 2
-            th = theta_v + k * self.config.orientation_step
-            poses = np.column_stack((np.full_like(th, xy[0]), np.full_like(th, xy[1]), th))
-            errs, rots = self.errors(poses)
-            b = int(np.argmin(errs))
-            self.cache[key] = (float(errs[b]), float(th[b]), float(rots[b]))
-        return self.cache[key]
+        hit = self.cache.get(key)
+        if hit is None:
+            th = theta_v + self._offsets
+            poses = np.empty((len(th), 3))
+            poses[:, 0], poses[:, 1], poses[:, 2] = key[0], key[1], th
+            prob = self.problem
+            if prob.map.is_free(poses[:1, :2])[0]:  # the orientations share one position
+                errs, rots = self._scan_errors(prob.map.raycast(poses, prob.laser))
+                b = int(np.argmin(errs))
+                hit = (float(errs[b]), float(th[b]), float(rots[b]))
+            else:
+                hit = (float(self.config.penalty), float(th[0]), 0.0)
+            self.evaluations += len(th)
+            self.cache[key] = hit
+        return hit
 
 
 def simplex(cost: _Cost, start: Pose, size: float, rng: np.random.Generator) -> tuple[np.ndarray, int]:
@@ -209,9 +269,20 @@ class TurningFunctionMatcher(Configured):
     name = "tf"
     CONFIG = TfConfig
 
+    def heading(self, best: float, rot: float, initial: float) -> float:
+        """The heading after an outer iteration (radians): the best of the seven orientations,
+        corrected by the rotation offset ``rot`` (if ``rotation_correction``), kept within
+        ``heading_clamp`` of the ``initial`` heading."""
+        cfg = self.config
+        theta = float(wrap_angle(best - rot)) if cfg.rotation_correction else best
+        if math.isfinite(cfg.heading_clamp):
+            change = min(max(float(wrap_angle(theta - initial)), -cfg.heading_clamp), cfg.heading_clamp)
+            theta = float(wrap_angle(initial + change))
+        return theta
+
     def localize(self, problem: Problem) -> Estimate:
         cfg = self.config
-        real = scan_turning_function(problem.ranges, problem.laser, cfg)
+        real = scan_turning_function(problem.ranges, problem.laser, cfg.shape)
         if real is None:
             return Estimate(problem.initial, False, 0, 0, {"status": "no-answer",
                                                            "reason": "real scan has < 3 polygon edges"})
@@ -219,24 +290,29 @@ class TurningFunctionMatcher(Configured):
         rng = np.random.default_rng(cfg.seed)
         pose, size, iters, converged = problem.initial, cfg.simplex_size, 0, False
         err, outer = cost.function1(pose.xy, pose.theta)[0], 0
+        best: tuple[float, Pose] | None = None
         while outer < cfg.max_outer:
             outer += 1
             xy, n = simplex(cost, pose, size, rng)
             iters += n
             err, heading, rot = cost.function1(xy, pose.theta)
-            new = Pose(float(xy[0]), float(xy[1]), float(wrap_angle(heading - rot)))
+            new = Pose(float(xy[0]), float(xy[1]), self.heading(heading, rot, problem.initial.theta))
+            if best is None or err < best[0]:
+                best = (err, new)
             moved, turned = new.distance_to(pose), abs(wrap_angle(new.theta - pose.theta))
             pose, size = new, max(size / 2.0, 10 * cfg.xy_tol)
             cost.cache.clear()
             if err <= cfg.err_threshold or (moved < cfg.xy_tol and turned < cfg.theta_tol):
                 converged = True
                 break
+        if cfg.keep_best and best is not None:
+            err, pose = best
         return Estimate(pose, converged, iters, cost.evaluations,
                         {"err": float(err), "outer": outer, "corners": int(real.n_edges)})
 
     def score(self, problem: Problem, pose: Pose) -> float:
         """Eq. 13's Err at exactly ``pose`` (no orientation search); ``penalty`` if degenerate."""
-        real = scan_turning_function(problem.ranges, problem.laser, self.config)
+        real = scan_turning_function(problem.ranges, problem.laser, self.config.shape)
         if real is None:
             return float(self.config.penalty)
         return float(_Cost(problem, self.config, real).errors(pose.as_array()[None, :])[0][0])

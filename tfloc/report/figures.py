@@ -171,15 +171,17 @@ def fig_cdf(p: pd.DataFrame, path: Path, thr: Thresholds) -> Path | None:
 
 
 def fig_runtime(p: pd.DataFrame, path: Path) -> Path | None:
-    """Runtime per scan (ms, log scale), one box per matcher."""
-    t = p[p["runtime_ms"].notna()]
+    """CPU time per scan (ms, log scale), one box per matcher (wall time for runs without CPU time)."""
+    metric = "cpu_ms" if "cpu_ms" in p and p["cpu_ms"].notna().any() else "runtime_ms"
+    kind = "CPU time" if metric == "cpu_ms" else "wall time (this run has no CPU times)"
+    t = p[p[metric].notna()]
     if t.empty:
         return None
     matchers = sorted(t["matcher"].unique())
     col = colours(list(p["matcher"].unique()))
     fig = Figure(figsize=(max(5.0, 1.3 * len(matchers) + 2), 4.4), layout="constrained")
     ax = fig.subplots()
-    data = [np.maximum(t.loc[t["matcher"] == m, "runtime_ms"].to_numpy(), 1e-3) for m in matchers]
+    data = [np.maximum(t.loc[t["matcher"] == m, metric].to_numpy(), 1e-3) for m in matchers]
     bp = ax.boxplot(data, positions=range(len(matchers)), whis=(5, 95), showfliers=True, patch_artist=True,
                     medianprops={"color": "black"}, flierprops={"markersize": 2.5, "alpha": 0.5})
     ax.set_xticks(range(len(matchers)), matchers)
@@ -188,9 +190,9 @@ def fig_runtime(p: pd.DataFrame, path: Path) -> Path | None:
         patch.set_alpha(0.6)
     ax.set_yscale("log")
     ax.grid(True, which="both", axis="y", alpha=0.3)
-    ax.set_ylabel("runtime per scan (ms)")
+    ax.set_ylabel(f"{kind.split(' (')[0]} per scan (ms)")
     ax.set_xlabel("matcher")
-    ax.set_title("Runtime per scan (box: quartiles, whiskers: p5–p95)")
+    ax.set_title(f"{kind[0].upper() + kind[1:]} per scan (box: quartiles, whiskers: p5–p95)")
     return _save(fig, path)
 
 

@@ -57,8 +57,10 @@ def write_note(results: Path, dataset: Path, thresholds: Thresholds | None = Non
     est = read_estimates(results, need) if est_path.is_file() else None
     all_ids = np.array([s.scan_id for s in scans])
     in_run = np.isin(all_ids, est["scan_id"].astype(str).unique()) if est is not None else np.ones(len(scans), bool)
+    cpu = est is not None and "cpu_s" in est.columns and est["cpu_s"].notna().any()
+    time_col = "cpu_s" if cpu else "runtime_s"  # CPU time; wall time for runs made before cpu_s
     head = ("| method | relations | trans. error m (mean ± std) | max m | squared m² | rot. error ° (mean ± std) "
-            "| max ° | success | runtime ms (median / mean) |\n|---|---|---|---|---|---|---|---|---|")
+            f"| max ° | success | {'CPU' if cpu else 'wall'} ms (median / mean) |\n|---|---|---|---|---|---|---|---|---|")
     lines = [
         "# MIT CSAIL relations: scan-to-scan relation errors",
         "",
@@ -91,7 +93,7 @@ def write_note(results: Path, dataset: Path, thresholds: Thresholds | None = Non
                 r = np.where(bad, pd.Series(odo_r[mask], index=ids), df["orient_err_rad"])
                 ok = thresholds.success(t, r)
                 label = f"`{name}`" + (f" ({int(bad.sum())} not answered)" if bad.any() else "")
-                lines.append(_row(label, relation_stats(t, r, ok, df["runtime_s"].dropna().to_numpy())))
+                lines.append(_row(label, relation_stats(t, r, ok, df[time_col].dropna().to_numpy())))
         lines.append("")
     if est is None:
         lines += ["**No matcher results yet**: run `tfloc bench benchmarks/real-csail-relations.toml`, then "

@@ -1,8 +1,10 @@
 """``tfloc report RUN``: RUN/report.md, RUN/summary.csv and RUN/figures/*.png from a run's results.
 
 Reads ``estimates.csv`` and ``run.json`` (:mod:`tfloc.harness.runner`), computes the metrics
-(:mod:`tfloc.evaluation.metrics`, :mod:`tfloc.evaluation.summary`), draws the figures
-(:mod:`tfloc.report.figures`) and writes the markdown (:mod:`tfloc.report.sections`).
+(:mod:`tfloc.evaluation.metrics`, :mod:`tfloc.evaluation.summary`) and the paired tests
+(:mod:`tfloc.evaluation.paired`, also written to ``paired.csv``), draws the figures
+(:mod:`tfloc.report.figures`, :mod:`tfloc.report.failures`) and writes the markdown
+(:mod:`tfloc.report.sections`). A timing pass (``tfloc timing RUN``) is linked when present.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import pandas as pd
 from tfloc.errors import ResultsError
 from tfloc.evaluation.metrics import prepare, summarize
 from tfloc.evaluation.outcome import Thresholds
+from tfloc.evaluation.paired import ALPHA, paired_table
 from tfloc.evaluation.paper import CITATION
 from tfloc.evaluation.summary import (
     POOL,
@@ -30,6 +33,11 @@ from tfloc.io.text import parse_text
 
 from . import figures as F
 from . import sections as S
+from .failures import draw_failures, failures_section
+from .landscape import draw_landscapes, landscape_section
+from .mdtable import num
+
+CONTENTION = 1.5  # median wall / CPU time above this: other processes competed for the cores
 
 
 @dataclass(frozen=True)
@@ -134,7 +142,32 @@ def header(run_dir: Path, run: dict, df: pd.DataFrame, thr: Thresholds, s2s: set
                  f"error ≤ {thr.orient_deg:g}°")
     st = df["status"].map(lambda s: status_kind(s) or s)
     lines.append(f"- Rows: {len(df)} (" + ", ".join(f"{k}: {v}" for k, v in st.value_counts().items()) + ")")
+    starts = [x.get("loadavg_start") for x in sessions]
+    end = sessions[-1].get("loadavg_end") if sessions else None
+    if any(starts) or end:
+        lines.append("- Load average (1 min) at the start of each session: "
+                     + ", ".join(num(v[0], 2) if v else "?" for v in starts)
+                     + (f"; at the end: {end[0]:.2f}" if end else "") + f" ({mach.get('cpu_count', '?')} CPUs)")
+    lines += contention(df)
     return "\n".join(lines) + "\n"
+
+
+def contention(p: pd.DataFrame) -> list[str]:
+    """A warning when wall time exceeds CPU time (the machine was shared), or when the run has
+    no CPU times (made before ``cpu_s`` was recorded)."""
+    if "cpu_ms" not in p or not p["cpu_ms"].notna().any():
+        return ["- **No CPU times in this run** (made before `cpu_s` was recorded): the runtime "
+                "columns show wall time only, which other processes on the machine inflate."]
+    t = p[(p["cpu_ms"] > 0) & p["runtime_ms"].notna()]
+    ratio = (t["runtime_ms"] / t["cpu_ms"]).groupby(t["matcher"]).median()
+    overall = float((t["runtime_ms"] / t["cpu_ms"]).median())
+    if overall <= CONTENTION:
+        return [f"- Wall / CPU time per task: median {overall:.2f} (no sign of contention)."]
+    return [f"- **Contention**: the median wall / CPU time per task is {overall:.2f} (per matcher: "
+            + ", ".join(f"`{m}` {v:.2f}" for m, v in ratio.items()) + f"; > {CONTENTION:g} means other "
+            "processes shared the cores). Wall times are inflated, unevenly across matchers; the "
+            "runtimes of this report are CPU times, which this affects far less. A quiet side-by-side "
+            "re-timing: `tfloc timing RUN` (timing.md)."]
 
 
 def definitions(thr: Thresholds) -> str:
@@ -162,8 +195,17 @@ def definitions(thr: Thresholds) -> str:
   or `failed` with a finite pose). Timeouts, errors and failed scans without a pose have no error;
   they are **excluded** from those statistics (the `n` column says how many: "(k excl.)") but
   count as failures in the success rate and as `no-answer` in the outcomes.
-- **Runtime** per scan: the matcher's `localize` call only (data loading and numba compilation
-  happen before timing), median and p95 in ms over scans with status `ok` or `failed`.
+- **Runtime** per scan is **CPU time**: the worker process's CPU time (all its threads; every
+  library runs one thread) during the matcher's `localize` call only (data loading, numba
+  compilation and what depends only on the map are done before timing), median with a bootstrap
+  95 % interval and p95 in ms over scans with status `ok` or `failed`. The wall time is shown
+  beside it; on a shared machine it is inflated by other processes, CPU time far less.
+- **Intervals**: success rates with Wilson 95 % score intervals; medians with percentile
+  bootstrap 95 % intervals (2000 resamples, seeded). Written as `value [low–high]`.
+- **Paired comparisons**: every pair of matchers on the scans both answered (with truth); an
+  exact McNemar test on success (binomial test of the scans where only one succeeded) and a
+  paired bootstrap 95 % interval of the success-rate difference. P-values are Holm-adjusted
+  within each table (all pairs on one dataset, or pooled); significant = adjusted p < {ALPHA:g}.
 - **Bins** come from the true and initial poses (not from group labels): initial distance offset
   [0, 100), [100, 200), [200, 300), [300, ∞) cm; initial angle offset [0, 5), [5, 10), [10, 15),
   [15, ∞) degrees. Left edge included: an offset of exactly 100 cm is in 100–200.
@@ -185,19 +227,34 @@ def _dataset_section(p: pd.DataFrame, name: str, s2s: set[str]) -> str:
         out.append("Scan-to-scan (Kümmerle et al. 2009 style): errors of the estimated relative pose.\n")
         k = pd.concat([summarize(t, ["matcher"]).assign(group="all"), summarize(t, ["matcher", "group"])])
         out.append(S.scan_to_scan(k.sort_values(["matcher", "group"], key=lambda s: s.replace("all", ""))))
+        out.append("Outcomes (count and share of scans with ground truth):\n")
+        out.append(S.outcomes(summarize(t, ["matcher"])))
     else:
-        out.append(S.accuracy(summarize(t, ["matcher"])))
-        out.append("Success rate (%) by initial distance offset:\n")
-        out.append(S.success_by(t, "dist_bin", " cm"))
-        out.append("Success rate (%) by initial angle offset:\n")
-        out.append(S.success_by(t, "angle_bin", "°"))
-    out.append("Outcomes (count and share of scans with ground truth):\n")
-    out.append(S.outcomes(summarize(t, ["matcher"])))
+        out += _scan_to_map_tables(t)
     return "\n".join(out)
 
 
+def _scan_to_map_tables(t: pd.DataFrame) -> list[str]:
+    """Accuracy, outcomes and success by offset bin of scored scan-to-map rows."""
+    per_matcher = summarize(t, ["matcher"])
+    return [S.accuracy(per_matcher), "Outcomes (count and share of scans with ground truth):\n",
+            S.outcomes(per_matcher), "Success rate (%) [95 % CI] by initial distance offset:\n",
+            S.success_by(t, "dist_bin", " cm"), "Success rate (%) [95 % CI] by initial angle offset:\n",
+            S.success_by(t, "angle_bin", "°")]
+
+
+def _paired_section(pt: pd.DataFrame) -> list[str]:
+    out = ["## Paired comparisons (same scans)\n",
+           "Success of every pair of matchers scan by scan (see Definitions; `paired.csv` has every "
+           "row). Difference = a − b in percentage points.\n"]
+    for d, g in pt.groupby("dataset", sort=False):
+        out.append(f"### {'scan-to-map datasets pooled' if d == 'all' else d}\n")
+        out.append(S.paired(g))
+    return out
+
+
 def render(run_dir: Path, run: dict, p: pd.DataFrame, thr: Thresholds, s2s: set[str],
-           figs: list[Path]) -> str:
+           figs: list[Path], pt: pd.DataFrame | None = None, failures: str = "", landscape: str = "") -> str:
     """The whole report.md text."""
     parts = [header(run_dir, run, p, thr, s2s), definitions(thr)]
     truth = p[p["truth"]]
@@ -222,13 +279,14 @@ def render(run_dir: Path, run: dict, p: pd.DataFrame, thr: Thresholds, s2s: set[
         if s2s:
             parts.append("Scan-to-scan datasets are left out: their initial offsets are odometry, often "
                          "under a millimetre, which makes the improvement meaningless.\n")
-        parts.append(S.accuracy(summarize(s2m, ["matcher"])))
-        parts.append("Outcomes:\n")
-        parts.append(S.outcomes(summarize(s2m, ["matcher"])))
-        parts.append("Success rate (%) by initial distance offset:\n")
-        parts.append(S.success_by(s2m, "dist_bin", " cm"))
-        parts.append("Success rate (%) by initial angle offset:\n")
-        parts.append(S.success_by(s2m, "angle_bin", "°"))
+        parts += _scan_to_map_tables(s2m)
+    if pt is not None and len(pt):
+        parts += _paired_section(pt)
+    if (run_dir / "timing.md").is_file():
+        parts.append("## Quiet re-timing\n\nA side-by-side timing pass of a stratified sample of this "
+                     "run's scans in one pinned process: [timing.md](timing.md).\n")
+    if landscape:
+        parts.append(landscape)
     parts.append("## Tasks without an answer (timeouts, errors)\n")
     parts.append(S.failures(p))
     if p["status"].str.startswith("invalid:").any():
@@ -236,6 +294,9 @@ def render(run_dir: Path, run: dict, p: pd.DataFrame, thr: Thresholds, s2s: set[
         parts.append("The scan's problem cannot be posed (e.g. its initial pose lies outside the map): no "
                      "matcher ran. These count as no-answer in the success rate, not as errors.\n")
         parts.append(S.invalid(p))
+    if failures:
+        parts.append("## Failure pictures\n")
+        parts.append(failures)
     if figs:
         parts.append("## Figures\n")
         parts += [f"![{f.stem}](figures/{f.name})\n" for f in figs]
@@ -251,7 +312,10 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
     p = prepare(df, thr)
     s2s = scan_to_scan_datasets(run, list(p["dataset"].unique()))
     summary = write_summary(summary_table(p, s2s), run_dir / "summary.csv")
+    pt = paired_table(p, s2s)
+    pt.to_csv(run_dir / "paired.csv", index=False, float_format="%.6g")
     figs: list[Path] = []
+    failures = landscape = ""
     if with_figures:
         fd = run_dir / "figures"
         sc = scenario_summary(p[p["truth"]])
@@ -259,7 +323,9 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
                 F.fig_basin(p, fd / "basin.png", s2s), F.fig_cdf(p, fd / "error_cdf.png", thr),
                 F.fig_runtime(p, fd / "runtime.png"), F.fig_outcomes(p, fd / "outcomes.png", s2s)]
         figs = [f for f in made if f is not None]
+        failures = failures_section(draw_failures(run_dir, p, run.get("datasets", {})))
+        landscape = landscape_section(*draw_landscapes(run_dir, p, run.get("datasets", {})))
     report = run_dir / "report.md"
-    report.write_text(render(run_dir, run, p, thr, s2s, figs))
+    report.write_text(render(run_dir, run, p, thr, s2s, figs, pt, failures, landscape))
     return ReportFiles(report, summary, tuple(figs))
 

@@ -10,6 +10,7 @@ import pandas as pd
 
 from tfloc.evaluation.metrics import summarize
 from tfloc.evaluation.outcome import OUTCOMES
+from tfloc.evaluation.paired import ALPHA
 from tfloc.evaluation.paper import PAPER_TF, TABLE_OF, paper_row
 
 from .mdtable import num, pm, table
@@ -35,6 +36,11 @@ def _samples(sc: pd.DataFrame, scenario: str) -> list[str]:
     return [k for k in paper if k in measured] + [k for k in measured if k not in paper]
 
 
+def _scenarios(sc: pd.DataFrame) -> list[tuple[str, list[str]]]:
+    """The paper's scenarios present in ``sc`` with their samples, in table order."""
+    return [(s, _samples(sc, s)) for s in ("I", "II", "III") if _samples(sc, s)]
+
+
 def _label(scenario: str, key: str) -> str:
     r = paper_row(scenario, key)
     return f"{r.label} ({key}{UNIT[scenario]})" if r else f"— ({key}{UNIT[scenario]})"
@@ -43,6 +49,21 @@ def _label(scenario: str, key: str) -> str:
 def _measured(m: pd.Series) -> list[str]:
     return [num(m["dist_mean_cm"], 2), num(m["orient_mean_deg"], 3),
             num(m["dist_impr_mean_pct"], 2), num(m["orient_impr_mean_pct"], 2)]
+
+
+def ci(m: pd.Series, value: str, lo: str, hi: str, digits: int = 1) -> str:
+    """``value [lo–hi]`` of metric row ``m`` (the interval omitted when missing)."""
+    a, b = num(m[lo], digits), num(m[hi], digits)
+    return num(m[value], digits) + ("" if "—" in (a, b) else f" [{a}–{b}]")
+
+
+def _success(m: pd.Series) -> str:
+    return ci(m, "success_rate_pct", "success_lo_pct", "success_hi_pct")
+
+
+def _published(r) -> list[str]:
+    """The paper's four published values of one row, as printed in its tables."""
+    return [f"{r.dist_err_cm:.4f}", f"{r.orient_err_deg:.4f}", f"{r.dist_impr_pct:.4f}", f"{r.orient_impr_pct:.4f}"]
 
 
 def _n(m: pd.Series) -> str:
@@ -54,17 +75,13 @@ def _paper(scenario: str, key: str) -> list[str] | None:
     r = paper_row(scenario, key)
     if r is None:
         return None
-    return [num(r.sample, 0), "paper (published)", f"{r.dist_err_cm:.4f}", f"{r.orient_err_deg:.4f}",
-            f"{r.dist_impr_pct:.4f}", f"{r.orient_impr_pct:.4f}", "—"]
+    return [num(r.sample, 0), "paper (published)", *_published(r), "—"]
 
 
 def paper_vs_tf(sc: pd.DataFrame, matcher: str = "tf") -> str:
     """Tables 2–4 as in the paper, the published row above the measured ``matcher`` row."""
     out = []
-    for scenario in ("I", "II", "III"):
-        samples = _samples(sc, scenario)
-        if not samples:
-            continue
+    for scenario, samples in _scenarios(sc):
         out.append(f"### Table {TABLE_OF[scenario]} — Scenario {scenario}: {TITLES[scenario]}\n")
         mine = sc[(sc["scenario"] == scenario) & (sc["matcher"] == matcher)].set_index("sample")
         if mine.empty:
@@ -77,8 +94,9 @@ def paper_vs_tf(sc: pd.DataFrame, matcher: str = "tf") -> str:
             if key in mine.index:
                 m = mine.loc[key]
                 rows.append([_label(scenario, key), _n(m), f"tfloc `{matcher}` (measured)", *_measured(m),
-                             num(m["success_rate_pct"], 1)])
-        out.append(table(["Scenario", "Sample", "Source", *PAPER_COLS, "Success (%)"], rows, "lrl" + "r" * 5))
+                             _success(m)])
+        out.append(table(["Scenario", "Sample", "Source", *PAPER_COLS, "Success (%) [95 % CI]"], rows,
+                         "lrl" + "r" * 5))
     if out:
         out.append(READING)
     return "\n".join(out)
@@ -87,10 +105,7 @@ def paper_vs_tf(sc: pd.DataFrame, matcher: str = "tf") -> str:
 def all_matchers(sc: pd.DataFrame) -> str:
     """The same tables with every matcher of the run, grouped by sample (paper's tf row first)."""
     out = []
-    for scenario in ("I", "II", "III"):
-        samples = _samples(sc, scenario)
-        if not samples:
-            continue
+    for scenario, samples in _scenarios(sc):
         out.append(f"### Scenario {scenario} (Table {TABLE_OF[scenario]} layout): all matchers\n")
         rows = []
         s = sc[sc["scenario"] == scenario]
@@ -98,27 +113,36 @@ def all_matchers(sc: pd.DataFrame) -> str:
             r = paper_row(scenario, key)
             if r:
                 rows.append([_label(scenario, key), num(r.sample, 0), "tf (paper, published)",
-                             f"{r.dist_err_cm:.4f}", f"{r.orient_err_deg:.4f}", f"{r.dist_impr_pct:.4f}",
-                             f"{r.orient_impr_pct:.4f}", "—", "—"])
+                             *_published(r), "—", "—"])
             for _, m in s[s["sample"] == key].iterrows():
                 rows.append([_label(scenario, key), _n(m), f"`{m['matcher']}`", *_measured(m),
-                             num(m["dist_median_cm"], 2), num(m["success_rate_pct"], 1)])
+                             num(m["dist_median_cm"], 2), _success(m)])
         out.append(table(["Scenario", "Sample", "Matcher", *PAPER_COLS, "Median Distance Error (cm)",
-                          "Success (%)"], rows, "lrl" + "r" * 6))
+                          "Success (%) [95 % CI]"], rows, "lrl" + "r" * 6))
     return "\n".join(out)
 
 
+def _cpu(m: pd.Series) -> list[str]:
+    """CPU median [95 % CI], CPU p95 and wall median, ms."""
+    return [ci(m, "cpu_median_ms", "cpu_median_lo_ms", "cpu_median_hi_ms"), num(m["cpu_p95_ms"], 1),
+            num(m["runtime_median_ms"], 1)]
+
+
+CPU_COLS = ["CPU median (ms) [95 % CI]", "CPU p95 (ms)", "wall median (ms)"]
+
+
 def accuracy(g: pd.DataFrame) -> str:
-    """Per matcher: n, success, distance/orientation error mean/median/p90/max, runtime."""
-    rows = [[f"`{m['matcher']}`", _n(m), num(m["success_rate_pct"], 1),
-             num(m["dist_mean_cm"], 2), num(m["dist_median_cm"], 2), num(m["dist_p90_cm"], 2),
+    """Per matcher: n, success, distance/orientation error mean/median/p90/max, CPU time."""
+    rows = [[f"`{m['matcher']}`", _n(m), _success(m),
+             num(m["dist_mean_cm"], 2), ci(m, "dist_median_cm", "dist_median_lo_cm", "dist_median_hi_cm", 2),
+             num(m["dist_p90_cm"], 2),
              num(m["dist_max_cm"], 2), num(m["orient_mean_deg"], 3), num(m["orient_median_deg"], 3),
              num(m["orient_p90_deg"], 3), num(m["orient_max_deg"], 2),
-             num(m["dist_impr_mean_pct"], 1), num(m["orient_impr_mean_pct"], 1),
-             num(m["runtime_median_ms"], 1), num(m["runtime_p95_ms"], 1)] for _, m in g.iterrows()]
-    return table(["Matcher", "n", "Success (%)", "Dist. mean (cm)", "median", "p90", "max",
+             num(m["dist_impr_mean_pct"], 1), num(m["orient_impr_mean_pct"], 1), *_cpu(m)]
+            for _, m in g.iterrows()]
+    return table(["Matcher", "n", "Success (%) [95 % CI]", "Dist. mean (cm)", "median [95 % CI]", "p90", "max",
                   "Orient. mean (°)", "median", "p90", "max", "Dist. impr. (%)", "Orient. impr. (%)",
-                  "Runtime median (ms)", "p95 (ms)"], rows)
+                  *CPU_COLS], rows)
 
 
 def success_by(p: pd.DataFrame, col: str, unit: str) -> str:
@@ -129,20 +153,23 @@ def success_by(p: pd.DataFrame, col: str, unit: str) -> str:
     for matcher, g in t.groupby("matcher", sort=True):
         cells = g.set_index(col)
         rows.append([f"`{matcher}`"] + [
-            f"{num(cells.loc[b, 'success_rate_pct'], 1)} (n={int(cells.loc[b, 'n_truth'])})"
-            if b in cells.index else "—" for b in bins])
+            f"{_success(cells.loc[b])} (n={int(cells.loc[b, 'n_truth'])})" if b in cells.index else "—"
+            for b in bins])
     return table(["Matcher"] + [f"{b}{unit}" for b in bins], rows)
 
 
 def outcomes(g: pd.DataFrame) -> str:
-    """Outcome counts and shares per matcher."""
+    """Outcome counts and shares per matcher, and where failed searches ended: near the truth
+    (≤ 30 cm, ≤ 5°: a stall in the basin) or farther from it than they started (diverged)."""
     extra = int(g["n_unscored"].sum()) > 0
     rows = []
     for _, m in g.iterrows():
         cells = [f"{int(m['n_' + o.replace('-', '_')])} ({num(m['share_' + o.replace('-', '_') + '_pct'], 1)} %)"
                  for o in OUTCOMES]
-        rows.append([f"`{m['matcher']}`", int(m["n_truth"]), *cells] + ([int(m["n_unscored"])] if extra else []))
-    return table(["Matcher", "n", *OUTCOMES] + (["unscored"] if extra else []), rows)
+        rows.append([f"`{m['matcher']}`", int(m["n_truth"]), *cells] + ([int(m["n_unscored"])] if extra else [])
+                    + [int(m["n_near"]), int(m["n_diverged"])])
+    return table(["Matcher", "n", *OUTCOMES] + (["unscored"] if extra else [])
+                 + ["failed near the truth", "diverged"], rows)
 
 
 def scan_to_scan(g: pd.DataFrame) -> str:
@@ -152,18 +179,17 @@ def scan_to_scan(g: pd.DataFrame) -> str:
         t_mean, t_std, t_max = (m[k] / 100.0 for k in ("dist_mean_cm", "dist_std_cm", "dist_max_cm"))
         rows.append([f"`{m['matcher']}`", m.get("group", "all"), _n(m), pm(t_mean, t_std, 3), num(t_max, 3),
                      pm(m["orient_mean_deg"], m["orient_std_deg"], 2), num(m["orient_max_deg"], 2),
-                     num(m["success_rate_pct"], 1), num(m["runtime_median_ms"], 1),
-                     num(m["runtime_p95_ms"], 1)])
+                     _success(m), *_cpu(m)])
     return table(["Matcher", "Relations", "n", "Trans. error (m) mean ± std", "max (m)",
-                  "Rot. error (°) mean ± std", "max (°)", "Success (%)", "Runtime median (ms)",
-                  "p95 (ms)"], rows, "llr" + "r" * 7)
+                  "Rot. error (°) mean ± std", "max (°)", "Success (%) [95 % CI]", *CPU_COLS],
+                 rows, "llr" + "r" * 8)
 
 
 def runtime_only(g: pd.DataFrame) -> str:
     """For datasets without truth: rows, status counts and runtimes per matcher."""
     rows = [[f"`{m['matcher']}`", int(m["n"]), int(m["n_timed"]), int(m["n_timeout"]), int(m["n_error"]),
-             num(m["runtime_median_ms"], 1), num(m["runtime_p95_ms"], 1)] for _, m in g.iterrows()]
-    return table(["Matcher", "n", "answered", "timeouts", "errors", "Runtime median (ms)", "p95 (ms)"], rows)
+             *_cpu(m)] for _, m in g.iterrows()]
+    return table(["Matcher", "n", "answered", "timeouts", "errors", *CPU_COLS], rows)
 
 
 def failures(p: pd.DataFrame, limit: int = 5) -> str:
@@ -177,6 +203,22 @@ def failures(p: pd.DataFrame, limit: int = 5) -> str:
         out.append(f"- `{matcher}`: {len(g)} task(s) without an answer\n" +
                    "".join(f"  - {n} × `{s}`\n" for s, n in msgs.items()))
     return "".join(out)
+
+
+def paired(t: pd.DataFrame) -> str:
+    """Paired comparisons of one family (:func:`tfloc.evaluation.paired.paired_comparisons`)."""
+    if t.empty:
+        return "_Fewer than two matchers with common scans._\n"
+    rows = [[f"`{r.a}` − `{r.b}`", int(r.n), num(r.success_a_pct, 1), num(r.success_b_pct, 1),
+             f"{int(r.only_a)} / {int(r.only_b)}",
+             f"{num(r.diff_pct, 1)} [{num(r.diff_lo_pct, 1)}, {num(r.diff_hi_pct, 1)}]",
+             _p(r.p_mcnemar), _p(r.p_holm), "**yes**" if r.significant else "no"] for r in t.itertuples()]
+    return table(["Pair (a − b)", "scans", "a (%)", "b (%)", "only a / only b succeeded",
+                  "difference (pp) [95 % CI]", "McNemar p", "Holm p", f"significant (α = {ALPHA:g})"], rows)
+
+
+def _p(p: float) -> str:
+    return "<1e-4" if p < 1e-4 else f"{p:.4f}"
 
 
 def invalid(p: pd.DataFrame, limit: int = 5) -> str:

@@ -6,7 +6,7 @@ gives an edge-direction histogram of the scan; rotating the robot shifts it circ
 moving the robot mostly changes how long each wall looks, not its direction. The circular
 cross-correlation of the real and the virtual scan's histograms, searched over ±``max_rotation``
 (the initial guess's heading is that good), peaks at the rotation offset. The two closing edges
-through the sensor origin (:func:`tfloc.paper.matcher.scan_polygon`) are not walls and are left out.
+through the sensor origin (:func:`tfloc.paper.shape.scan_polygon`) are not walls and are left out.
 """
 
 from __future__ import annotations

@@ -26,6 +26,9 @@ needs ~1800 cost evaluations per scan). Stages:
    within ``tie_tolerance`` of the best (the scan sees the same geometry from both places, e.g.
    a bare corner) are a tie, broken in favour of the one nearest the VP.
 
+**Amortised per map** (``prepare``): the distance field of the coarse search and the map's
+free-space test. **Per scan**: everything else (virtual scans depend on the candidate poses).
+
 Each stage can be switched off (``tf_seed``, ``heading_sweep``, ``grid``, ``refine``,
 ``beam_check``, ``tie_tolerance=0``) for the ablation in
 ``benchmarks/tfplus_ablation.py``. It uses only the :class:`~tfloc.core.map.Map` protocol and
@@ -184,6 +187,13 @@ class TurningFunctionPlusMatcher(Configured):
 
     name = "tf-plus"
     CONFIG = TfPlusConfig
+
+    def prepare(self, problem: Problem) -> None:
+        """Build the distance field and the free-space test (once per map; untimed by the harness)."""
+        _field(problem.map, self.config)
+        xy = problem.initial.xy[None, :]
+        problem.map.in_bounds(xy)
+        problem.map.is_free(xy)
 
     def localize(self, problem: Problem) -> Estimate:
         cfg = self.config

@@ -1,0 +1,77 @@
+"""One thread per matcher in a worker: every library's thread limit is 1, and a busy matcher's
+CPU time (all threads of the process) does not exceed its wall time."""
+
+from __future__ import annotations
+
+import multiprocessing
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import pytest
+
+from tfloc.harness.runner import _init_worker, threads_per_job
+
+ROOT = Path(__file__).resolve().parents[1]
+MATCHERS = ("tf", "tf-plus", "o3d-icp", "kiss-icp", "cv-corners", "csm-corr", "gicp", "karto")
+
+
+def _probe(min_cpu_s: float = 0.3) -> tuple[dict, dict]:
+    """In a worker: every matcher on a test-room scan, repeated until it has used ``min_cpu_s`` of
+    CPU; returns the thread settings and per matcher (CPU s, wall s) of the repeated calls."""
+    import numba
+
+    from tfloc import LaserSpec, Pose, Problem, get_matcher, load_map
+    from tfloc.errors import MatcherError
+    from tfloc.harness.task import warm
+    from tfloc.harness.threads import thread_settings
+
+    assert numba.njit(lambda x: x + 1)(1) == 2  # compiling after the limits were set still works
+    room = load_map(ROOT / "data" / "maps" / "test-room.geojson")
+    laser = LaserSpec.lms200()
+    true = Pose(3.0, 3.5, 0.3)
+    problem = Problem(room, laser, room.raycast(true, laser), Pose(3.6, 3.1, 0.45))
+    times = {}
+    for name in MATCHERS:
+        try:
+            m = get_matcher(name)
+        except MatcherError:  # an optional library that is not installed (karto on Python ≥ 3.12)
+            continue
+        warm(m, problem)
+        c0, w0 = time.process_time(), time.perf_counter()
+        while time.process_time() - c0 < min_cpu_s:
+            m.localize(problem)
+        times[name] = (time.process_time() - c0, time.perf_counter() - w0)
+    return thread_settings(), times
+
+
+@pytest.fixture(scope="module")
+def probe():
+    ctx = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(1, mp_context=ctx, initializer=_init_worker,
+                             initargs=(threads_per_job(2),)) as pool:
+        return pool.submit(_probe).result(timeout=600)
+
+
+def test_every_library_runs_one_thread_in_a_worker(probe):
+    settings, _ = probe
+    assert threads_per_job(1) == threads_per_job(2) == 1
+    assert {"cv2", "numba", "open3d"} <= set(settings)  # open3d was imported by o3d-icp
+    assert settings == {k: 1 for k in settings}, settings
+
+
+@pytest.mark.parametrize("name", MATCHERS)
+def test_cpu_time_of_a_busy_matcher_is_not_more_than_its_wall_time(probe, name):
+    if name not in probe[1]:
+        pytest.skip(f"{name}: its optional library is not installed")
+    cpu, wall = probe[1][name]
+    # One thread cannot use more CPU than wall time; two busy threads would give cpu ≈ 2 × wall.
+    assert cpu <= 1.1 * wall + 0.01, (name, cpu, wall)
+
+
+def test_kiss_icp_and_small_gicp_are_configured_with_one_thread():
+    from tfloc.baselines.kiss_icp import KissIcpMatcher
+
+    assert KissIcpMatcher().config.max_num_threads == 1
+    gicp = pytest.importorskip("tfloc.baselines.gicp")
+    assert gicp.GicpMatcher().config.num_threads == 1

@@ -1,0 +1,113 @@
+"""The side-by-side timing pass (tfloc timing RUN) and the quick run's configuration."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from tests._estimates import frame, row
+from tests.test_harness_runner import cfg, make_dataset
+from tfloc.cli import build_parser
+from tfloc.cli.bench import QUICK_PER_GROUP, config_from_args
+from tfloc.errors import ConfigError
+from tfloc.evaluation.timing import reference_of, timing_summary
+from tfloc.harness.config import MatcherSpec
+from tfloc.harness.runner import run
+from tfloc.harness.timing import TIMING_COLUMNS, run_timing, sample_scans
+
+ROOT = Path(__file__).resolve().parents[1]
+ENV = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "tests"), str(ROOT)])}
+
+
+def _estimates() -> pd.DataFrame:
+    rows = []
+    for d in ("d1", "d2"):
+        for g in ("a", "b", "c"):
+            for i in range(10):
+                for m in ("x", "y"):
+                    status = "timeout" if (d, g, i, m) == ("d1", "a", 0, "y") else "ok"
+                    rows.append(row(m, dataset=d, group=g, scan_id=f"{g}{i}", status=status))
+    return frame(rows)
+
+
+def test_sample_is_stratified_seeded_and_skips_scans_without_an_answer():
+    df = _estimates()
+    s = sample_scans(df, 4, seed=1)
+    assert len(s) == 2 * 3 * 4 and (s.groupby(["dataset", "group"]).size() == 4).all()
+    big = sample_scans(df, 10, seed=1)  # d1/a has only 9 scans every matcher answered (a0 timed out)
+    assert not ((big["dataset"] == "d1") & (big["scan_id"] == "a0")).any()
+    assert len(big) == 59 and ((big["dataset"] == "d2") & (big["scan_id"] == "a0")).any()
+    pd.testing.assert_frame_equal(s, sample_scans(df, 4, seed=1))
+    assert not s.equals(sample_scans(df, 4, seed=2))
+    with pytest.raises(ConfigError):
+        sample_scans(df, 0)
+
+
+def test_summary_ratios_and_the_runs_own_cpu_times():
+    t = pd.DataFrame([{"dataset": "d", "scan_id": f"s{i}", "matcher": m, "cpu_ms": c * (i + 1),
+                       "wall_ms": 2 * c * (i + 1)} for i in range(9) for m, c in (("ref", 2.0), ("m", 6.0))])
+    run_rows = frame([row(m, dataset="d", scan_id=f"s{i}", runtime_s=1.0, cpu_s=c * (i + 1) / 1000.0 * 1.5)
+                      for i in range(9) for m, c in (("ref", 2.0), ("m", 6.0))])
+    s = timing_summary(t, "ref", run_rows).set_index("matcher")
+    assert s.loc["m", "ratio_to_reference"] == pytest.approx(3.0)
+    assert s.loc["m", "ratio_lo"] == pytest.approx(3.0) and s.loc["m", "ratio_hi"] == pytest.approx(3.0)
+    assert s.loc["m", "cpu_median_ms"] == pytest.approx(30.0)
+    assert s.loc["ref", "run_over_quiet"] == pytest.approx(1.5)
+    assert reference_of(["a", "tf-plus"]) == "tf-plus" and reference_of(["a", "b"]) == "a"
+    with pytest.raises(ValueError):
+        reference_of(["a"], "b")
+
+
+@pytest.fixture(scope="module")
+def small_run(tmp_path_factory, test_room, lms200):
+    tmp = tmp_path_factory.mktemp("timing")
+    ds = make_dataset(tmp / "ds", test_room, lms200, n=6)
+    return run(cfg(ds, tmp / "run", MatcherSpec.make("tf-plus"), MatcherSpec.make("o3d-icp"),
+                   MatcherSpec.make("toy_matchers:Stay", label="stay"), jobs=1, timeout_s=60.0),
+               progress=False)
+
+
+def test_timing_pass_interleaves_matchers_and_restores_the_affinity(small_run):
+    before = os.sched_getaffinity(0)
+    rows, info = run_timing(small_run, per_stratum=2, warmup=1)
+    assert os.sched_getaffinity(0) == before
+    assert list(rows.columns) == TIMING_COLUMNS
+    assert len(rows) == 2 * 2 * 3  # 2 groups × 2 scans × 3 matchers
+    # the order rotates scan by scan: each matcher is first on a different scan
+    first = rows[rows["position"] == 0]["matcher"].tolist()
+    assert first == ["tf-plus", "o3d-icp", "stay", "tf-plus"]
+    assert (rows["cpu_ms"] > 0).all() and info["scans"] == 4 and len(info["cores"]) == 1
+
+
+def test_timing_cli_writes_csv_and_markdown_and_the_report_links_it(small_run):
+    r = subprocess.run([sys.executable, "-m", "tfloc.cli", "timing", str(small_run), "--per-stratum", "1",
+                        "--warmup", "1", "--reference", "o3d-icp"], cwd=ROOT, env=ENV, capture_output=True,
+                       text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    md = (small_run / "timing.md").read_text()
+    assert "CPU ratio to `o3d-icp` [95 % CI]" in md and "run / quiet" in md
+    assert len(pd.read_csv(small_run / "timing.csv")) == 2 * 3
+    from tfloc.report.report import write_report
+
+    assert "[timing.md](timing.md)" in write_report(small_run, with_figures=False).report.read_text()
+    bad = subprocess.run([sys.executable, "-m", "tfloc.cli", "timing", str(small_run), "--reference", "nope"],
+                         cwd=ROOT, env=ENV, capture_output=True, text=True, timeout=120)
+    assert bad.returncode == 2 and "reference matcher 'nope'" in bad.stderr
+
+
+def _bench_args(*extra: str) -> argparse.Namespace:
+    return build_parser().parse_args(["bench", str(ROOT / "benchmarks" / "paper-protocol.toml"), *extra])
+
+
+def test_quick_is_a_stratified_subset_into_its_own_directory():
+    c = config_from_args(_bench_args("--quick"))
+    assert c.limit_per_group == QUICK_PER_GROUP and c.out == Path("results/paper-protocol-quick")
+    assert c.name == "paper-protocol-quick"
+    c = config_from_args(_bench_args("--quick", "--limit-per-group", "5", "--out", "x"))
+    assert c.limit_per_group == 5 and c.out == Path("x")

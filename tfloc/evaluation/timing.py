@@ -1,0 +1,60 @@
+"""The summary of a timing pass (:mod:`tfloc.harness.timing`): CPU time per matcher, side by side.
+
+Per matcher over the sampled scans: median CPU ms with a bootstrap 95 % interval, p95 CPU ms,
+median wall ms, the ratio of its median CPU time to the reference matcher's with a paired
+bootstrap interval (resampling scans), and, when the run recorded CPU times, the run's median
+CPU ms on the same scans and its ratio to the quiet re-timing (how far the run's own CPU times
+were inflated by sharing the machine).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from .stats import bootstrap_median, ratio_of_medians
+
+TIMING_SUMMARY_COLUMNS = ["matcher", "n", "cpu_median_ms", "cpu_median_lo_ms", "cpu_median_hi_ms",
+                          "cpu_p95_ms", "wall_median_ms", "ratio_to_reference", "ratio_lo", "ratio_hi",
+                          "run_cpu_median_ms", "run_over_quiet"]
+DEFAULT_REFERENCE = "tf-plus"
+
+
+def reference_of(matchers: list[str], wanted: str | None = None) -> str:
+    """The reference matcher: ``wanted`` if given, else ``tf-plus`` if present, else the first."""
+    if wanted:
+        if wanted not in matchers:
+            raise ValueError(f"reference matcher {wanted!r} is not in the timing pass ({', '.join(matchers)})")
+        return wanted
+    return DEFAULT_REFERENCE if DEFAULT_REFERENCE in matchers else matchers[0]
+
+
+def timing_summary(t: pd.DataFrame, reference: str, run: pd.DataFrame | None = None) -> pd.DataFrame:
+    """One row per matcher (in the order they appear in ``t``), columns :data:`TIMING_SUMMARY_COLUMNS`.
+
+    ``t`` holds the pass's rows (dataset, scan_id, matcher, cpu_ms, wall_ms); ``run`` the run's
+    estimates (for ``cpu_s`` on the same scans), or None."""
+    cpu = t.pivot_table(index=["dataset", "scan_id"], columns="matcher", values="cpu_ms", aggfunc="first")
+    ref = cpu[reference]
+    run_cpu = None
+    if run is not None and "cpu_s" in run and pd.to_numeric(run["cpu_s"], errors="coerce").notna().any():
+        r = run.assign(cpu_ms=1000.0 * pd.to_numeric(run["cpu_s"], errors="coerce"))
+        run_cpu = r.pivot_table(index=["dataset", "scan_id"], columns="matcher", values="cpu_ms", aggfunc="first")
+    rows = []
+    for m in dict.fromkeys(t["matcher"]):
+        g = t[t["matcher"] == m]
+        pair = pd.concat([cpu[m], ref], axis=1, keys=["m", "ref"]).dropna()
+        ratio, lo, hi = ratio_of_medians(pair["m"].to_numpy(), pair["ref"].to_numpy())
+        c_lo, c_hi = bootstrap_median(g["cpu_ms"])
+        row = {"matcher": m, "n": len(g), "cpu_median_ms": float(np.median(g["cpu_ms"])),
+               "cpu_median_lo_ms": c_lo, "cpu_median_hi_ms": c_hi,
+               "cpu_p95_ms": float(np.percentile(g["cpu_ms"], 95)), "wall_median_ms": float(np.median(g["wall_ms"])),
+               "ratio_to_reference": ratio, "ratio_lo": lo, "ratio_hi": hi,
+               "run_cpu_median_ms": np.nan, "run_over_quiet": np.nan}
+        if run_cpu is not None and m in run_cpu:
+            same = run_cpu[m].reindex(cpu.index).dropna()
+            if len(same):
+                row["run_cpu_median_ms"] = float(np.median(same))
+                row["run_over_quiet"] = row["run_cpu_median_ms"] / float(np.median(cpu[m].reindex(same.index)))
+        rows.append(row)
+    return pd.DataFrame(rows, columns=TIMING_SUMMARY_COLUMNS)

@@ -1,0 +1,58 @@
+"""``RUN/timing.md``: the side-by-side timing pass (:mod:`tfloc.harness.timing`) as a table."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+
+from .mdtable import num, table
+
+
+def _load(v: list | None) -> str:
+    return num(v[0], 2) if v else "?"
+
+
+def timing_markdown(run_name: str, summary: pd.DataFrame, reference: str, info: dict) -> str:
+    """The markdown of a timing pass: how it was made, then one row per matcher."""
+    has_run = summary["run_cpu_median_ms"].notna().any()
+    rows = []
+    for r in summary.itertuples():
+        cells = [f"`{r.matcher}`", int(r.n),
+                 f"{num(r.cpu_median_ms, 2)} [{num(r.cpu_median_lo_ms, 2)}–{num(r.cpu_median_hi_ms, 2)}]",
+                 num(r.cpu_p95_ms, 1), num(r.wall_median_ms, 2),
+                 f"{num(r.ratio_to_reference, 2)} [{num(r.ratio_lo, 2)}–{num(r.ratio_hi, 2)}]"]
+        if has_run:
+            cells += [num(r.run_cpu_median_ms, 2), num(r.run_over_quiet, 2)]
+        rows.append(cells)
+    headers = ["Matcher", "scans", "CPU median (ms) [95 % CI]", "CPU p95 (ms)", "wall median (ms)",
+               f"CPU ratio to `{reference}` [95 % CI]"]
+    if has_run:
+        headers += ["run's CPU median, same scans (ms)", "run / quiet"]
+    cores = ", ".join(str(c) for c in info.get("cores", [])) or "not pinned"
+    return "\n".join([
+        f"# Timing pass: {run_name}\n",
+        f"All matchers of the run re-timed side by side on a stratified sample of its scans: "
+        f"{info['per_stratum']} scan(s) per dataset × group ({info['strata']} strata, {info['scans']} scans, "
+        f"seed {info['seed']}), drawn from the scans every matcher answered in the run. One process pinned to "
+        f"core(s) {cores}, every library on one thread; {info['warmup']} untimed warm-up call(s) per dataset "
+        f"and matcher; then scan by scan every matcher once, the order rotated by one per scan. Times are "
+        f"CPU time of the process during `localize` (wall time beside it). Intervals: bootstrap 95 % "
+        f"(medians: resampling times; ratios: resampling scans, paired).\n",
+        f"- Started {info.get('started', '?')}; load average (1 min) at the start {_load(info.get('loadavg_start'))}, "
+        f"at the end {_load(info.get('loadavg_end'))}.",
+        f"- Reference matcher for the ratios: `{reference}`.",
+        "- `run / quiet`: the run's own median CPU time on the same scans over this pass's; near 1 "
+        "when the run's CPU times can be trusted." if has_run else
+        "- The run recorded no CPU times (made before `cpu_s`), so it cannot be compared.",
+        "",
+        table(headers, rows)])
+
+
+def write_timing(run_dir: Path, rows: pd.DataFrame, summary: pd.DataFrame, reference: str,
+                 info: dict, name: str) -> tuple[Path, Path]:
+    """Write ``timing.csv`` (one row per scan × matcher) and ``timing.md``; returns both paths."""
+    csv_path, md_path = run_dir / "timing.csv", run_dir / "timing.md"
+    rows.to_csv(csv_path, index=False, float_format="%.4f")
+    md_path.write_text(timing_markdown(name, summary, reference, info))
+    return csv_path, md_path
