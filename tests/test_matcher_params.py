@@ -17,6 +17,7 @@ from _fuzz import Tally, finish, judge
 
 import tfloc
 from tfloc.core.matcher import available_matchers, get_matcher
+from tfloc.core.params import check_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate
 from tfloc.errors import ParameterError
@@ -76,7 +77,7 @@ def test_every_matcher_has_a_config_with_defaults_that_pass_its_rules() -> None:
     for m in MATCHERS:
         cfg = get_matcher(m).config
         assert dataclasses.is_dataclass(cfg)
-        assert type(get_matcher(m, **{}).config)() == cfg
+        check_params(cfg)
 
 
 def test_every_rule_names_a_parameter() -> None:
@@ -93,6 +94,7 @@ def test_every_rule_names_a_parameter() -> None:
     ("csm-corr", "search_radiuss", 2.0, r"unknown parameter\(s\) search_radiuss; known: block, "),
     ("csm-corr", "resolution", -0.02, r"resolution must be > 0, got -0.02"),
     ("tf", "spacing", 0.0, r"spacing must be > 0"),
+    ("tf-best", "window", None, r"window must be an integer, got None"),
     ("tf-plus", "select", "best", r"select must be one of 'residual', 'tf'"),
     ("tf-plus", "refinement", {"iterations": -1}, r"refinement.iterations must be >= 1"),
     ("o3d-icp", "gates", [1.0, -0.5], r"gates must be all > 0"),

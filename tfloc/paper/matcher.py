@@ -146,10 +146,11 @@ class TfConfig:
 
     def __post_init__(self) -> None:
         if self.err_norm not in _NORMS:
-            raise ParameterError(f"tf: err_norm must be one of {_NORMS}, not {self.err_norm!r}")
+            raise ParameterError(f"tf: err_norm must be one of {_NORMS}, not {self.err_norm!r}", ("err_norm",))
         self.shape  # noqa: B018 - validates the shape parameters
         if not self.heading_clamp > 0:
-            raise ParameterError(f"tf: heading_clamp must be > 0 radians (inf = unbounded), not {self.heading_clamp!r}")
+            raise ParameterError(f"tf: heading_clamp must be > 0 radians (inf = unbounded), not {self.heading_clamp!r}",
+                                 ("heading_clamp",))
 
 
 def _match(config: TfConfig) -> Callable[[TurningFunction, TurningFunction], Match]:

@@ -68,6 +68,10 @@ _RUN_FIELDS = {"config": dict, "git": dict, "machine": dict, "versions": dict, "
                "git.dirty": (bool, type(None)), "config.name": str}
 
 
+def _finite_list(v: list) -> bool:
+    return bool(v) and all(isinstance(x, int | float) and not isinstance(x, bool) and abs(x) < 1e300 for x in v)
+
+
 def _check_run(run: object, path: Path) -> None:
     """A ResultsError naming ``path`` and the field if ``run.json`` is not what the report reads."""
     if not isinstance(run, dict):
@@ -81,7 +85,9 @@ def _check_run(run: object, path: Path) -> None:
             raise ResultsError(f"{path}: field {name} is {type(doc[leaf]).__name__}, not the expected "
                                f"{getattr(kind, '__name__', 'string or null')}")
     ok = all(isinstance(v, str) for v in run.get("datasets", {}).values())
-    ok &= all(isinstance(v, dict) and isinstance(v.get("started", ""), str) for v in run.get("sessions", []))
+    ok &= all(isinstance(v, dict) and isinstance(v.get("started", ""), str)
+              and all(isinstance(v.get(k) or [0], list) and _finite_list(v.get(k) or [0])
+                      for k in ("loadavg_start", "loadavg_end")) for v in run.get("sessions", []))
     ok &= all(isinstance(m, dict) and isinstance(m.get("label"), str) and isinstance(m.get("name"), str)
               and isinstance(m.get("params", {}), dict) for m in run.get("config", {}).get("matchers", []))
     try:
