@@ -74,15 +74,18 @@ def kill_and_resume(tmp_path: Path, ds: Path, scheduler: str | None, kills: int,
         before = rows(est)
         proc = subprocess.Popen(command(ds, out, scheduler), env=ENV, start_new_session=True,
                                 stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-        if rng.random() < 0.3:  # while it starts, or early in the run
-            time.sleep(rng.uniform(0.0, 4.0))
+        if rng.random() < 0.3:  # while it starts, or early in the run (at most 20 rows in)
+            target, deadline = before + 20, time.time() + rng.uniform(0.0, 4.0)
         else:  # after some rows, in the middle of the writing
             target, deadline = before + rng.randint(1, 20), time.time() + 120
-            while rows(est) < target and proc.poll() is None and time.time() < deadline:
-                time.sleep(0.002)
-            time.sleep(rng.uniform(0.0, 0.03))
+        while rows(est) < target and proc.poll() is None and time.time() < deadline:
+            time.sleep(0.002)
+        time.sleep(rng.uniform(0.0, 0.03))
         finished = proc.poll() is not None
-        os.killpg(proc.pid, signal.SIGKILL)
+        try:
+            os.killpg(proc.pid, signal.SIGKILL)
+        except ProcessLookupError:  # it had finished, workers and all
+            pass
         proc.wait()
         assert not finished or proc.returncode == 0, proc.stderr.read().decode()
         done += not finished
