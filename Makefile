@@ -6,7 +6,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.tfloc-installed
 JOBS   ?= 2
 
-.PHONY: install quick bench test test-unit timing lint clean-venv real-data
+.PHONY: install quick bench test test-unit timing lint clean-venv real-data fuzz chaos
 
 $(STAMP): pyproject.toml
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -46,6 +46,16 @@ real-data: $(STAMP)
 test: $(STAMP)
 	$(BIN)/python -m pytest -q tests
 	$(BIN)/python -m pytest -q benchmarks --benchmark-disable
+
+## Every reader against thousands of damaged inputs, and every matcher parameter against bad
+## values (make test runs a few hundred per reader); prints how many inputs each reader tried.
+fuzz: $(STAMP)
+	TFLOC_FUZZ_EXAMPLES=$${TFLOC_FUZZ_EXAMPLES:-3000} TFLOC_FUZZ_RANDOM=1 $(BIN)/python -m pytest -q -s \
+		tests/test_fuzz_readers.py tests/test_matcher_params.py
+
+## The long kill tests: runs of 240 tasks killed with SIGKILL 10 times (local pool and Dask).
+chaos: $(STAMP)
+	$(BIN)/python -m pytest -q -m slow tests/test_chaos.py
 
 ## Full pytest-benchmark timing (pinned to 2 cores); not part of CI.
 timing: $(STAMP)

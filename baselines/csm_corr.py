@@ -37,14 +37,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 from scipy.optimize import least_squares
 
-from tfloc.core.params import resolve_params
+from tfloc.core.params import Configured
 from tfloc.core.pose import Pose, wrap_angle
 from tfloc.core.problem import Estimate, Problem
-from tfloc.errors import ParameterError
 
 from .likelihood import LikelihoodField, likelihood_field
 
@@ -52,6 +52,11 @@ from .likelihood import LikelihoodField, likelihood_field
 @dataclass(frozen=True)
 class Config:
     """Parameters of :class:`CorrelativeMatcher` (metres, degrees where named)."""
+
+    RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params)
+        "> 0": ("resolution", "sigma", "rot_step_deg", "refine_scale"),
+        ">= 0": ("window_xy", "window_theta_deg", "min_mean_likelihood"),
+        ">= 1": ("xy_step_cells", "block", "expand_batch", "refine_max_evals")}
 
     resolution: float = 0.02
     sigma: float = 0.10
@@ -75,16 +80,11 @@ class _Grid:
     block_starts: np.ndarray  # (B,) offsets of each block's first translation, in cells
 
 
-class CorrelativeMatcher:
+class CorrelativeMatcher(Configured):
     """Olson's real-time correlative scan matcher over the protocol's window (see the module docstring)."""
 
     name = "csm-corr"
-
-    def __init__(self, config: Config | None = None, **overrides: object) -> None:
-        self.config = resolve_params(Config, config, overrides)
-        c = self.config
-        if c.resolution <= 0 or c.sigma <= 0 or c.xy_step_cells < 1 or c.block < 1 or c.rot_step_deg <= 0:
-            raise ParameterError(f"resolution, sigma, rot_step_deg must be > 0 and xy_step_cells, block ≥ 1: {c}")
+    CONFIG = Config
 
     def _field(self, problem: Problem) -> LikelihoodField:
         c = self.config

@@ -108,6 +108,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import cv2
 import numpy as np
@@ -125,6 +126,13 @@ from ._corner_thin import drop_straight_corners
 @dataclass(frozen=True)
 class Config:
     """Parameters of :class:`CvCornersMatcher` (metres, degrees where named)."""
+
+    RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params)
+        "> 0": ("corner_spacing", "inlier_tol", "fine_tol"),
+        ">= 0": ("straight_tol", "length_tol", "min_pair_length", "max_angle_deg", "max_shift",
+                 "max_scale_error", "step_xy_tol", "step_theta_tol_deg", "seed"),
+        ">= 1": ("max_hypotheses", "ransac_max_iters", "max_iterations"),
+        "(0, 1)": ("confidence", "ransac_confidence",)}
 
     corner_spacing: float = 0.02
     straight_tol: float = 0.03

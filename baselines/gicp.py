@@ -61,6 +61,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -84,6 +85,14 @@ _NORMAL_VARIANCE = 1e-3  # small_gicp's regularised variance along a covariance'
 @dataclass(frozen=True)
 class Config:
     """Parameters of :class:`GicpMatcher` (metres)."""
+
+    RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params); VGICP: see the module docstring
+        "> 0": ("gates", "map_spacing"),
+        ">= 0": ("rotation_epsilon_rad", "translation_epsilon"),
+        ">= 1": ("max_iterations", "num_threads"),
+        "[0, 1]": ("min_inlier_fraction",),
+        "finite": ("layers",),
+        _TYPES: ("registration_type",)}
 
     registration_type: str = "GICP"
     layers: tuple[float, ...] = (-0.05, 0.0, 0.05)
@@ -141,17 +150,8 @@ class GicpMatcher:
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
         self.config = resolve_params(Config, config, overrides)
-        c = self.config
-        if c.registration_type not in _TYPES:
-            raise ParameterError(f"registration_type must be one of {', '.join(_TYPES)} (VGICP: see the module "
-                            f"docstring), got {c.registration_type!r}")
-        if not c.gates or min(c.gates) <= 0:
-            raise ParameterError(f"gates must be positive metres, got {c.gates}")
-        if not c.layers or not all(math.isfinite(z) for z in c.layers):
-            raise ParameterError(f"layers must be finite heights in metres, got {c.layers}")
-        if c.map_spacing <= 0 or c.num_neighbors < 3 or c.max_iterations < 1 or c.num_threads < 1:
-            raise ParameterError("map_spacing must be > 0, num_neighbors ≥ 3, max_iterations and num_threads ≥ 1: "
-                            f"{c}")
+        if self.config.num_neighbors < 3:
+            raise ParameterError(f"num_neighbors must be >= 3, got {self.config.num_neighbors}", ("num_neighbors",))
 
     def prepare(self, problem: Problem) -> None:
         """Build the map's target cloud, tree and covariances (once per map; untimed by the harness)."""

@@ -69,6 +69,7 @@ from __future__ import annotations
 import math
 import sys
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -93,6 +94,13 @@ except ImportError as _exc:  # one line saying why, reported by tfloc.get_matche
 @dataclass(frozen=True)
 class Config:
     """Parameters of :class:`KartoMatcher` (metres; degrees where named; Karto's own units otherwise)."""
+
+    RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params); the windows: _check_window
+        "> 0": ("coarse_angle_resolution_deg", "fine_angle_resolution_deg", "lattice_spacing",
+                "virtual_beam_deg", "base_radius", "range_threshold"),
+        ">= 0": ("coarse_angle_offset_deg", "lattice_clearance", "distance_variance_penalty",
+                 "minimum_distance_penalty", "angle_variance_penalty", "minimum_angle_penalty",
+                 "min_response")}
 
     coarse_search_size: float = 7.0
     coarse_resolution: float = 0.1
@@ -130,12 +138,13 @@ class _Stage:
     expand: bool
 
 
-def _check_window(name: str, size: float, resolution: float) -> None:
+def _check_window(size_name: str, res_name: str, c: Config) -> None:
     """Karto asserts ``size / resolution`` is a whole number; an odd one gives an even-sized grid."""
+    size, resolution = getattr(c, size_name), getattr(c, res_name)
     cells = size / resolution if resolution > 0 else float("nan")
     if not (size > 0 and resolution > 0 and abs(cells - round(cells)) < 1e-6 and round(cells) % 2 == 0):
-        raise ParameterError(f"{name}_search_size / {name}_resolution must be an even whole number of cells "
-                        f"(both > 0), got {size} / {resolution}")
+        raise ParameterError(f"{size_name} / {res_name} must be an even whole number of cells (both > 0), got "
+                             f"{size} / {resolution}", (size_name, res_name))
 
 
 class KartoMatcher:
@@ -145,18 +154,14 @@ class KartoMatcher:
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
         self.config = resolve_params(Config, config, overrides)
-        c = self.config
-        _check_window("coarse", c.coarse_search_size, c.coarse_resolution)
-        _check_window("fine", c.fine_search_size, c.fine_resolution)
-        _check_window("score", c.score_window, c.fine_resolution)
-        positive = {k: getattr(c, k) for k in ("coarse_angle_resolution_deg", "fine_angle_resolution_deg",
-                                               "lattice_spacing", "virtual_beam_deg", "base_radius")}
-        if any(not v > 0 for v in positive.values()) or c.coarse_angle_offset_deg < 0:
-            raise ParameterError(f"{', '.join(positive)} must be > 0 and coarse_angle_offset_deg ≥ 0: {positive}")
-        if c.coarse_smear_deviation < 0 or c.fine_smear_deviation < 0 or c.lattice_clearance < 0:
-            raise ParameterError("smear deviations and lattice_clearance must be ≥ 0")
-        if c.range_threshold is not None and not c.range_threshold > 0:
-            raise ParameterError(f"range_threshold must be > 0 metres (or None: the laser's range), got {c.range_threshold}")
+        for size, res in (("coarse_search_size", "coarse_resolution"), ("fine_search_size", "fine_resolution"),
+                          ("score_window", "fine_resolution")):
+            _check_window(size, res, self.config)
+        for smear, res in (("coarse_smear_deviation", "coarse_resolution"), ("fine_smear_deviation", "fine_resolution")):
+            v, r = getattr(self.config, smear), getattr(self.config, res)
+            if not 0.5 * r <= v <= 10.0 * r:  # Karto's own bounds, which it raises on at the first scan
+                raise ParameterError(f"{smear} must be within 0.5 and 10 × {res} ({0.5 * r:g}…{10 * r:g}), got {v}",
+                                     (smear,))
         self._wrappers: dict[tuple, object] = {}
 
     # -- Karto objects -------------------------------------------------------------------------------

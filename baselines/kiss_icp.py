@@ -45,6 +45,7 @@ as 1.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 from kiss_icp.mapping import VoxelHashMap
@@ -53,7 +54,6 @@ from kiss_icp.registration import Registration
 from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
-from tfloc.errors import ParameterError
 from tfloc.maps.cache import cached, map_geometry
 
 from ._geometry import embed_z0, matrix_to_pose, pose_to_matrix
@@ -62,6 +62,12 @@ from ._geometry import embed_z0, matrix_to_pose, pose_to_matrix
 @dataclass(frozen=True)
 class Config:
     """Parameters of :class:`KissIcpMatcher` (metres)."""
+
+    RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params)
+        "> 0": ("voxel_sizes", "gate_factor", "kernel_factor", "map_spacing"),
+        ">= 0": ("convergence_criterion",),
+        ">= 1": ("max_points_per_voxel", "max_num_iterations", "max_num_threads"),
+        "[0, 1]": ("min_inlier_fraction",)}
 
     voxel_sizes: tuple[float, ...] = (2.0, 1.0, 0.3, 0.1)
     gate_factor: float = 3.0
@@ -92,8 +98,6 @@ class KissIcpMatcher:
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
         self.config = resolve_params(Config, config, overrides)
-        if not self.config.voxel_sizes or min(self.config.voxel_sizes) <= 0:
-            raise ParameterError(f"voxel_sizes must be positive metres, got {self.config.voxel_sizes}")
         self._registration = Registration(max_num_iterations=self.config.max_num_iterations,
                                           convergence_criterion=self.config.convergence_criterion,
                                           max_num_threads=self.config.max_num_threads)

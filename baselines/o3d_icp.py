@@ -38,13 +38,13 @@ sample within that gate counts as the gate), in metres.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
-from tfloc.core.params import resolve_params
+from tfloc.core.params import Configured
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
-from tfloc.errors import ParameterError
 from tfloc.maps.cache import map_geometry, point_to_line_residuals
 
 from ._geometry import embed_z0, matrix_to_pose, pose_to_matrix
@@ -58,6 +58,12 @@ _reg = o3d.pipelines.registration
 class Config:
     """Parameters of :class:`Open3dIcpMatcher` (metres)."""
 
+    RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params)
+        "> 0": ("gates", "map_spacing"),
+        ">= 0": ("relative_fitness", "relative_rmse", "crop_margin"),
+        ">= 1": ("max_iterations",),
+        "[0, 1]": ("min_fitness",)}
+
     gates: tuple[float, ...] = (2.0, 1.0, 0.5, 0.2, 0.1)
     max_iterations: int = 30
     relative_fitness: float = 1e-6
@@ -67,15 +73,11 @@ class Config:
     min_fitness: float = 0.5
 
 
-class Open3dIcpMatcher:
+class Open3dIcpMatcher(Configured):
     """open3d point-to-line ICP with a coarse-to-fine gate schedule (see the module docstring)."""
 
     name = "o3d-icp"
-
-    def __init__(self, config: Config | None = None, **overrides: object) -> None:
-        self.config = resolve_params(Config, config, overrides)
-        if not self.config.gates or min(self.config.gates) <= 0:
-            raise ParameterError(f"gates must be positive metres, got {self.config.gates}")
+    CONFIG = Config
 
     def prepare(self, problem: Problem) -> None:
         """Build the map's sampled geometry and its KD-tree (once per map; untimed by the harness)."""

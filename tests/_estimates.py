@@ -69,6 +69,12 @@ def synthetic_run(path: Path, truth: bool = True, seed: int = 7, wall_per_cpu: f
                                 score_est=None if succ or not ok else 1.0,
                                 score_true=None if succ or not ok else (0.5 if i % 2 else 2.0),
                                 outcome="", cpu_s=wall / wall_per_cpu))
+    return write_run(path, rows, {d: str(path / "no-such-dir" / d) for d in datasets})
+
+
+def write_run(path: Path, rows: list[dict], datasets: dict[str, str]) -> Path:
+    """A run directory: ``estimates.csv`` of ``rows`` and a ``run.json`` as the runner writes it
+    (matchers tf and csm-corr, thresholds 10 cm / 2°)."""
     path.mkdir(parents=True, exist_ok=True)
     frame(rows).to_csv(path / "estimates.csv", index=False)
     run = {"config": {"name": "synthetic", "matchers": [{"label": "tf", "name": "tf", "params": {}},
@@ -77,7 +83,7 @@ def synthetic_run(path: Path, truth: bool = True, seed: int = 7, wall_per_cpu: f
                       "success": {"dist_m": 0.1, "orient_deg": 2.0}},
            "versions": {"tfloc": "0.1.0"}, "git": {"commit": "abc123", "dirty": False},
            "machine": {"platform": "test", "cpu_count": 2, "python": "3.11"}, "threads_per_job": 1,
-           "datasets": {d: str(path / "no-such-dir" / d) for d in datasets},
+           "datasets": datasets,
            "sessions": [{"started": "2026-01-01T00:00:00+0000", "tasks": 10, "already_done": 0,
                          "loadavg_start": [3.5, 3.0, 2.5], "loadavg_end": [4.25, 3.5, 3.0]}]}
     (path / "run.json").write_text(json.dumps(run))

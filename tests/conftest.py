@@ -29,3 +29,13 @@ def map_yaml(tmp_path_factory) -> Path:
     from tfloc.io.rosmap import write_ros_map
 
     return write_ros_map(room_grid(), tmp_path_factory.mktemp("maps") / "room.yaml")
+
+
+def pytest_collection_modifyitems(config, items) -> None:
+    """Tests marked ``slow`` run only when asked for (``-m slow``, e.g. ``make chaos``)."""
+    if "slow" in (config.getoption("-m") or ""):
+        return
+    skip = pytest.mark.skip(reason="slow: run with -m slow (make chaos)")
+    for item in items:
+        if "slow" in item.keywords:
+            item.add_marker(skip)

@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 
 import tfloc
@@ -137,7 +138,11 @@ def test_cli_bad_input_is_one_line_without_traceback(dataset, tmp_path):
     assert r.returncode == 2 and "bad.geojson" in r.stderr and "Traceback" not in r.stderr
 
 
-def test_cli_pose_outside_map_names_the_row(dataset, tmp_path):
+def test_cli_pose_outside_map_is_an_invalid_row_naming_the_row(dataset, tmp_path):
+    """The data poses no problem for that scan: its row says why (status invalid:…), the others run."""
     corrupt(dataset, 3, lambda s: s.replace(",3.100000,", ",99.000000,", 1))
     r = cli("localize", "--dataset", dataset, "--out", tmp_path / "e.csv")
-    assert r.returncode == 2 and "scans.csv:3" in r.stderr and "outside the map" in r.stderr
+    assert r.returncode == 0 and "invalid 1" in r.stderr, r.stderr
+    df = pd.read_csv(tmp_path / "e.csv")
+    assert df.status.iloc[1].startswith("invalid:") and "scans.csv:3" in df.status.iloc[1]
+    assert "outside the map" in df.status.iloc[1] and df.status.iloc[0] == "ok" and df.est_x.iloc[1] != df.est_x.iloc[1]

@@ -46,7 +46,7 @@ def sorted_rows(df: pd.DataFrame) -> pd.DataFrame:
 def test_local_cluster_gives_the_local_runners_estimates(tmp_path):
     """CLI --scheduler local:2 vs the local process pool: identical rows but for runtime_s, cpu_s."""
     args = ["data/scenarios/detail-1", "--limit-per-group", "1", "--no-progress",
-            "--matchers", "csm-corr,toy_matchers:ThreadsInfo,toy_matchers:TwoMinima"]
+            "--allow-import", "--matchers", "csm-corr,toy_matchers:ThreadsInfo,toy_matchers:TwoMinima"]
     for out, extra in ((tmp_path / "local", []), (tmp_path / "dask", ["--scheduler", "local:2"])):
         r = subprocess.run([sys.executable, "-m", "tfloc.cli", "bench", *args, "--out", str(out),
                             *extra], cwd=ROOT, env=ENV, capture_output=True, text=True, timeout=300)
@@ -115,7 +115,7 @@ def test_resume_after_the_client_is_killed(tmp_path, test_room, lms200):
     ds = make_dataset(tmp_path / "ds", test_room, lms200, n=12)
     out = tmp_path / "run"
     cmd = [sys.executable, "-m", "tfloc.cli", "bench", str(ds), "--out", str(out), "--no-progress",
-           "--matchers", "toy_matchers:SlowStay,toy_matchers:TwoMinima", "--scheduler", "local:2"]
+           "--allow-import", "--matchers", "toy_matchers:SlowStay,toy_matchers:TwoMinima", "--scheduler", "local:2"]
     proc = subprocess.Popen(cmd, env=ENV, start_new_session=True, stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL)
     est = out / "estimates.csv"
@@ -144,3 +144,35 @@ def test_workers_without_the_data_are_named(tmp_path, cluster):
     with pytest.raises(ConfigError, match=r"Dask worker tcp://127\.0\.0\.1:\d+ has no dataset "
                                           r"no/such/dataset"):
         run(cfg, progress=False, executor=elsewhere)
+
+
+def test_a_tls_cluster_gives_the_local_pools_rows(tmp_path):
+    """A LocalCluster that speaks only TLS (throw-away certificates), reached like a remote one by
+    its tls:// address with --tls-* certificate files: the same rows as the local process pool."""
+    pytest.importorskip("cryptography")
+    from distributed.security import Security
+
+    sec = Security.temporary()
+    pem = {"ca.pem": sec.tls_ca_file, "client.pem": sec.tls_client_cert, "client.key": sec.tls_client_key}
+    for name, text in pem.items():
+        (tmp_path / name).write_text(text)
+    args = ["data/scenarios/detail-1", "--limit-per-group", "1", "--no-progress", "--allow-import",
+            "--matchers", "csm-corr,toy_matchers:TwoMinima"]
+    with dask.config.set({"distributed.worker.daemon": False}), \
+            distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                     protocol="tls://", security=sec, dashboard_address=None) as c:
+        assert c.scheduler_address.startswith("tls://127.0.0.1:")
+        tls = ["--scheduler", c.scheduler_address, "--tls-ca-file", str(tmp_path / "ca.pem"),
+               "--tls-cert", str(tmp_path / "client.pem"), "--tls-key", str(tmp_path / "client.key")]
+        for out, extra in ((tmp_path / "local", []), (tmp_path / "tls", tls)):
+            r = subprocess.run([sys.executable, "-m", "tfloc.cli", "bench", *args, "--out", str(out), *extra],
+                               cwd=ROOT, env=ENV, capture_output=True, text=True, timeout=300)
+            assert r.returncode == 0, r.stderr
+        r = subprocess.run([sys.executable, "-m", "tfloc.cli", "bench", *args, "--out", str(tmp_path / "no"),
+                            "--scheduler", c.scheduler_address], cwd=ROOT, env=ENV, capture_output=True,
+                           text=True, timeout=300)
+        assert r.returncode == 2 and "TLS needs a CA file and a client certificate" in r.stderr
+        assert not (tmp_path / "no").exists()
+    local, tls_ = read_estimates(tmp_path / "local"), read_estimates(tmp_path / "tls")
+    assert len(tls_) == 18 and (tls_.status == "ok").all()
+    pd.testing.assert_frame_equal(sorted_rows(tls_), sorted_rows(local))

@@ -9,7 +9,7 @@ import pytest
 
 from tests._estimates import frame, row, synthetic_run
 from tfloc.cli import main
-from tfloc.errors import ConfigError
+from tfloc.errors import ResultsError
 from tfloc.evaluation.metrics import METRIC_COLUMNS
 from tfloc.evaluation.summary import SUMMARY_KEYS
 from tfloc.report.report import write_report
@@ -100,7 +100,7 @@ def test_thresholds_override_rescoring(tmp_path):
 
 
 def test_not_a_run_directory(tmp_path, capsys):
-    with pytest.raises(ConfigError, match="no estimates.csv"):
+    with pytest.raises(ResultsError, match="no estimates.csv"):
         write_report(tmp_path)
     assert main(["report", str(tmp_path)]) == 2
     assert "no estimates.csv" in capsys.readouterr().err
@@ -109,11 +109,11 @@ def test_not_a_run_directory(tmp_path, capsys):
 def test_missing_column_is_named(tmp_path):
     frame([row()]).drop(columns=["dist_err_m"]).to_csv(tmp_path / "estimates.csv", index=False)
     (tmp_path / "run.json").write_text(json.dumps({}))
-    with pytest.raises(ConfigError, match="dist_err_m"):
+    with pytest.raises(ResultsError, match="dist_err_m"):
         write_report(tmp_path)
 
 
 def test_empty_run_is_a_one_line_error(tmp_path):
     frame([]).to_csv(tmp_path / "estimates.csv", index=False)
-    with pytest.raises(ConfigError, match="no results yet"):
+    with pytest.raises(ResultsError, match="no results yet"):
         write_report(tmp_path)

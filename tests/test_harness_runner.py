@@ -76,7 +76,7 @@ def test_resume_after_sigkill_has_every_task_exactly_once(tmp_path, test_room, l
     ds = make_dataset(tmp_path / "ds", test_room, lms200, n=12)
     out = tmp_path / "run"
     cmd = [sys.executable, "-m", "tfloc.cli", "bench", str(ds), "--out", str(out), "--jobs", "2",
-           "--matchers", "toy_matchers:SlowStay,toy_matchers:TwoMinima", "--no-progress", "--timeout", "30"]
+           "--allow-import", "--matchers", "toy_matchers:SlowStay,toy_matchers:TwoMinima", "--no-progress", "--timeout", "30"]
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(TESTS), str(ROOT)])}
     proc = subprocess.Popen(cmd, env=env, start_new_session=True, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE)

@@ -28,9 +28,9 @@ def test_relation_stats() -> None:
 def test_note_uses_estimates_and_falls_back_to_the_guess(tmp_path: Path) -> None:
     scans = read_scans(read_scenario(DATASET))
     ids = [s.scan_id for s in scans]
-    rows = [{"scan_id": i, "matcher": "exact", "dist_err_m": 0.0, "orient_err_rad": 0.0, "runtime_s": 0.01,
+    rows = [{"dataset": "real-csail-relations", "scan_id": i, "matcher": "exact", "dist_err_m": 0.0, "orient_err_rad": 0.0, "runtime_s": 0.01,
              "status": "ok"} for i in ids]
-    rows += [{"scan_id": i, "matcher": "broken", "dist_err_m": np.nan, "orient_err_rad": np.nan,
+    rows += [{"dataset": "real-csail-relations", "scan_id": i, "matcher": "broken", "dist_err_m": np.nan, "orient_err_rad": np.nan,
               "runtime_s": np.nan, "status": "error:boom"} for i in ids]
     pd.DataFrame(rows).to_csv(tmp_path / "estimates.csv", index=False)
     text = write_note(tmp_path, DATASET).read_text()

@@ -14,7 +14,7 @@ import pytest
 from tfloc.cli import main
 from tfloc.core.laser import LaserSpec
 from tfloc.core.pose import Pose, angdiff
-from tfloc.errors import DatasetError, LogFormatError
+from tfloc.errors import DatasetError, LogFormatError, ResultsError
 from tfloc.io.scenario import Scan, read_scans, read_scenario, write_scenario
 from tfloc.io.tum import read_tum, write_tum
 from tfloc.report.export import export_tum
@@ -155,11 +155,11 @@ def test_dataset_named_by_path(tmp_path, monkeypatch) -> None:
 
 
 def test_export_errors(tmp_path) -> None:
-    with pytest.raises(DatasetError, match="no such results file"):
+    with pytest.raises(ResultsError, match="no such results file"):
         export_tum(tmp_path / "none", tmp_path / "tum")
     (tmp_path / "r").mkdir()
     (tmp_path / "r" / "estimates.csv").write_text("dataset,scan_id,matcher\nx,s1,tf\n")
-    with pytest.raises(DatasetError, match=r"estimates.csv:1: header lacks column\(s\) true_x"):
+    with pytest.raises(ResultsError, match=r"estimates.csv:1: header lacks column\(s\) true_x"):
         export_tum(tmp_path / "r", tmp_path / "tum")
     scans = _dataset(tmp_path / "scenarios" / "ds", stamps=True)
     rows = _run(tmp_path / "r3", "ds", scans)

@@ -103,3 +103,13 @@ class TwoMinima:
         t, f = self._at(problem, self.to_true), self._at(problem, self.to_false)
         return min(pose.distance_to(t) + abs(math.remainder(pose.theta - t.theta, math.tau)),
                    pose.distance_to(f) + self.false_value)
+
+
+class Flaky(Stay):
+    """:class:`Stay` that raises while the environment variable ``TFLOC_TOY_FAIL`` is set in its
+    worker (a bug that a fix removes: ``--retry-errors`` then runs its tasks again)."""
+
+    def localize(self, problem: Problem) -> Estimate:
+        if os.environ.get("TFLOC_TOY_FAIL"):
+            raise RuntimeError("toy bug")
+        return super().localize(problem)

@@ -32,7 +32,17 @@ class MatcherError(TflocError):
 
 
 class ParameterError(MatcherError):
-    """A matcher parameter is unknown or has a bad value."""
+    """A matcher parameter is unknown or has a bad value.
+
+    ``names`` are the parameters at fault (so that a run configuration can name its key)."""
+
+    def __init__(self, message: str, names: tuple[str, ...] = ()) -> None:
+        super().__init__(message)
+        self.names = tuple(names)
+
+
+class ResultsError(TflocError):
+    """A run's results (estimates.csv, run.json) are malformed, or cannot be written."""
 
 
 class ConfigError(TflocError):

@@ -1,10 +1,25 @@
 """Run registered matchers over scenario datasets and stream the results to RUN/estimates.csv.
 
 Either name datasets and matchers on the command line, or give a run configuration (TOML,
-see benchmarks/*.toml); options given on the command line override the file. Re-running the
-same command after an interruption (Ctrl-C, kill -9) resumes: finished (scan, matcher) pairs
-are skipped, nothing is repeated or lost. Each task has a time limit; a matcher that raises or
-hangs gets an `error:`/`timeout` row and the run goes on.
+see benchmarks/*.toml); options given on the command line override the file. Every matcher is
+built before anything runs: an unknown parameter or a bad value stops the command at once,
+naming the configuration key. Re-running the same command after an interruption (Ctrl-C,
+kill -9) resumes: finished (scan, matcher) pairs are skipped, nothing is repeated or lost. A run
+directory holds one configuration (run.json records its fingerprint: the datasets' contents, the
+matchers' resolved parameters, the thresholds, the tfloc version); a run with another
+configuration is refused there (use --regenerate or another --out).
+
+Each task has a time limit; a matcher that raises or hangs gets an `error:`/`timeout` row and the
+run goes on; a scan whose problem cannot be posed (e.g. its initial pose lies outside the map)
+gets an `invalid:` row. The end of the run prints the rows per status.
+
+Exit status: 0 the run is complete (rows may be failed, invalid or timeout); 2 nothing was run
+(a bad configuration, dataset or parameter, a run of another configuration in --out, an output
+that cannot be written); 3 the run is complete but some task raised an error (a matcher bug: see
+the `error:` rows; --retry-errors runs them again).
+
+Matchers named `module:Class` (not registered ones) are imported: that runs the module's code.
+Run only configurations you trust; such matchers are refused without --allow-import.
 
 --quick runs a small stratified subset (the first 3 scans of every group of every dataset) into
 RUN-quick: a full report with figures in a few minutes (make quick).
@@ -13,8 +28,9 @@ Examples:
   tfloc bench benchmarks/paper-protocol.toml
   tfloc bench benchmarks/paper-protocol.toml --quick        # → results/paper-protocol-quick
   tfloc bench data/scenarios/detail-1 --matchers tf,csm-corr --out results/try --jobs 2
-  tfloc bench benchmarks/paper-protocol.toml --scheduler tcp://HOST:8786   # on a Dask cluster
   tfloc bench benchmarks/paper-protocol.toml --scheduler local:2           # a local Dask cluster
+  tfloc bench benchmarks/paper-protocol.toml --scheduler tls://HOST:8786 \
+      --tls-ca-file ca.pem --tls-cert client.pem --tls-key client.key      # a Dask cluster over TLS
 """
 
 from __future__ import annotations
@@ -26,7 +42,7 @@ from pathlib import Path
 from tfloc.core.matcher import available_matchers
 from tfloc.errors import ConfigError
 from tfloc.evaluation.outcome import Thresholds
-from tfloc.harness.config import RunConfig, load_config, parse_matchers
+from tfloc.harness.config import RunConfig, check_imports, load_config, parse_matchers
 
 HELP = "run matchers over scenario datasets (resumable), writing RUN/estimates.csv"
 QUICK_PER_GROUP = 3
@@ -45,16 +61,29 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="only the first N scans of each group (smoke runs; default: all)")
     p.add_argument("--success-cm", type=float, help="success threshold on distance error, cm (default 10)")
     p.add_argument("--success-deg", type=float, help="success threshold on orientation error, degrees (default 2)")
-    p.add_argument("--scheduler", metavar="tcp://HOST:PORT | local:N",
+    p.add_argument("--scheduler", metavar="tls://HOST:PORT | local:N",
                    help="run the tasks on a Dask cluster: a running scheduler, or local:N for a "
-                   "LocalCluster of N workers (needs: pip install tfloc[dask]; default: a local "
-                   "process pool of --jobs workers)")
+                   "LocalCluster of N workers on this machine (needs: pip install tfloc[dask]; default: "
+                   "a local process pool of --jobs workers). Anyone who can reach a scheduler can run "
+                   "code on its workers: use tls:// (or tcp:// through an SSH tunnel), never plain "
+                   "tcp:// on a shared network")
+    p.add_argument("--tls-ca-file", metavar="PEM", help="TLS: the certificate authority that signed the "
+                   "scheduler's and workers' certificates (default: the Dask config, distributed.comm.tls)")
+    p.add_argument("--tls-cert", metavar="PEM", help="TLS: this client's certificate")
+    p.add_argument("--tls-key", metavar="PEM", help="TLS: this client's private key (if not in --tls-cert)")
     p.add_argument("--quick", action="store_true",
                    help=f"a quick first run: the first {QUICK_PER_GROUP} scans of each group (unless "
                    "--limit-per-group says otherwise), into OUT-quick (unless --out is given)")
     p.add_argument("--regenerate", action="store_true",
-                   help="if OUT holds a complete run, discard it and run again (an interrupted run "
-                        "is still resumed); make bench uses this to reproduce the committed results")
+                   help="if OUT holds a complete run, or a run of another configuration, discard it and "
+                        "run again (an interrupted run of the same configuration is still resumed); make "
+                        "bench uses this to reproduce the committed results")
+    p.add_argument("--retry-errors", action="store_true",
+                   help="run the tasks whose rows have status error:… or timeout again (their rows are "
+                        "replaced)")
+    p.add_argument("--allow-import", action="store_true",
+                   help="allow matchers named module:Class: they are imported, which runs the module's "
+                        "code; only for configurations you trust")
     prog = p.add_mutually_exclusive_group()
     prog.add_argument("--progress", dest="progress", action="store_true", default=None,
                       help="always show the progress bar (default: only on a terminal)")
@@ -89,13 +118,26 @@ def config_from_args(args: argparse.Namespace) -> RunConfig:
 def run(args: argparse.Namespace) -> int:
     from tfloc.harness.runner import execute_local
     from tfloc.harness.runner import run as run_benchmark
+    from tfloc.io.estimates import status_counts
 
     cfg = config_from_args(args)
+    check_imports(cfg, args.allow_import)
+    tls = {k: getattr(args, k) for k in ("tls_ca_file", "tls_cert", "tls_key") if getattr(args, k)}
+    if tls and not args.scheduler:
+        raise ConfigError("--tls-ca-file/--tls-cert/--tls-key apply to --scheduler tls://… only")
     executor = execute_local
     if args.scheduler:
-        from tfloc.harness.dask_executor import execute_dask
+        from tfloc.harness.dask_executor import execute_dask, security
 
-        executor = execute_dask(args.scheduler)
-    out = run_benchmark(cfg, progress=args.progress, executor=executor, regenerate=args.regenerate)
+        executor = execute_dask(args.scheduler, security(args.scheduler, **tls))
+    out = run_benchmark(cfg, progress=args.progress, executor=executor, regenerate=args.regenerate,
+                        retry_errors=args.retry_errors)
+    counts = status_counts(out / "estimates.csv")
+    print(f"rows: {sum(counts.values())} (" + ", ".join(f"{k} {n}" for k, n in counts.items()) + ")",
+          file=sys.stderr)
     print(f"results: {out / 'estimates.csv'}  (report: tfloc report {out})", file=sys.stderr)
+    if counts["error"]:
+        print(f"tfloc bench: {counts['error']} task(s) raised an error (see the error: rows); after a fix, "
+              "rerun them with --retry-errors", file=sys.stderr)
+        return 3
     return 0

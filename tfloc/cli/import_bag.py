@@ -54,12 +54,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from tfloc.datasets.from_bag import BagImport, import_bag
-    from tfloc.errors import ConfigError
 
-    if args.initial_frames and not args.initial_topic:
-        raise ConfigError("--initial-frames needs --initial-topic")
-    if args.align_initial and not args.initial_topic:
-        raise ConfigError("--align-initial needs --initial-topic")
     cfg = BagImport(args.bag, args.scan_topic, args.pose_topic, args.out, args.map, args.map_topic,
                     args.name, tuple(args.pose_frames) if args.pose_frames else None,
                     args.initial_topic, tuple(args.initial_frames) if args.initial_frames else None,

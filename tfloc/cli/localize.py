@@ -2,11 +2,16 @@
 
 Only the initial pose and the ranges are read; the dataset's true_* fields may be empty.
 Rows are written as scans finish, so a long run can be watched (and its output is never lost).
+The matcher is built before the output is opened: an unknown parameter or a bad value stops the
+command at once (exit 2), naming the --param. A scan whose problem cannot be posed (e.g. its
+initial pose lies outside the map) gets status `invalid:<reason>`; a matcher that raises gets
+`error:<message>` and the command goes on, then exits 3.
 runtime_s is the wall time of each localize call, cpu_s its CPU time (this process, which runs
 every library on one thread); the matcher is warmed up on the first scan before timing.
 
 Example:
   tfloc localize --dataset data/scenarios/office-pool --matcher tf --out estimates.csv
+  tfloc localize --dataset data/scenarios/detail-1 --matcher tf-plus --param grid_step=0.1
 """
 
 from __future__ import annotations
@@ -15,13 +20,16 @@ import argparse
 import csv
 import sys
 import time
+import tomllib
 from pathlib import Path
 
 from tqdm import tqdm
 
-from tfloc.core.matcher import get_matcher
 from tfloc.core.problem import Problem
-from tfloc.harness.task import status_of, warm
+from tfloc.errors import ConfigError, InvalidProblemError
+from tfloc.harness.config import MatcherSpec
+from tfloc.harness.fingerprint import build_matcher
+from tfloc.harness.task import load_matcher, status_of, warm
 from tfloc.harness.threads import limit_threads
 from tfloc.io.scenario import iter_scans, map_for, read_scenario
 
@@ -36,21 +44,45 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--map", type=Path, default=None,
                    help="map file (.geojson or ROS .yaml); default: the map named in scenario.json")
     p.add_argument("--matcher", default="tf", help="registered matcher name (default: tf)")
+    p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
+                   help="a matcher parameter, VALUE in TOML syntax (repeatable): --param spacing=0.5, "
+                        "--param gates=[1.0,0.5], --param select=tf")
     p.add_argument("--out", type=Path, default=Path("estimates.csv"),
                    help="output CSV, one row per scan (default: estimates.csv)")
     p.add_argument("--limit", type=int, default=None, help="only the first N scans")
 
 
+def parse_params(items: list[str]) -> dict:
+    """``KEY=VALUE`` options as a dict; VALUE is read as TOML (a bare word is a string)."""
+    out = {}
+    for item in items:
+        key, eq, value = item.partition("=")
+        if not eq or not key.strip():
+            raise ConfigError(f"--param {item!r}: expected KEY=VALUE")
+        try:
+            out[key.strip()] = tomllib.loads(f"v = {value}")["v"]
+        except tomllib.TOMLDecodeError:
+            out[key.strip()] = value
+    return out
+
+
 def run(args: argparse.Namespace) -> int:
     limit_threads(1)
     scenario = read_scenario(args.dataset)
-    matcher = get_matcher(args.matcher)
+    if ":" in args.matcher:
+        raise ConfigError(f"--matcher {args.matcher}: localize runs registered matchers only")
+    params = parse_params(args.param)
+    spec = MatcherSpec.make(args.matcher, params, where=f"--matcher {args.matcher}",
+                            keys={k: f"--param {k}" for k in params})
+    build_matcher(spec)
+    matcher = load_matcher(spec.name, spec.params_json)
     cache: dict = {}
     if args.map is not None:
         from tfloc.io.maps import load_map
 
         cache[scenario.map_path] = load_map(args.map)
     args.out.parent.mkdir(parents=True, exist_ok=True)
+    counts = {"ok": 0, "failed": 0, "invalid": 0, "error": 0}
     with args.out.open("w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(COLUMNS)
@@ -59,18 +91,31 @@ def run(args: argparse.Namespace) -> int:
                                       disable=not sys.stderr.isatty())):
             if args.limit is not None and n >= args.limit:
                 break
-            where = f"{scenario.scans_path}:{scan.line}"
-            if n == 0:  # untimed; a scan-to-scan map is new for each map_for call, so not warmed here
-                warm(matcher, Problem(map_for(scenario, scan, cache), scenario.laser, scan.ranges,
-                                      scan.initial, where=where))
-            problem = Problem(map_for(scenario, scan, cache), scenario.laser, scan.ranges,
-                              scan.initial, where=where)
-            t0, c0 = time.perf_counter(), time.process_time()
-            est = matcher.localize(problem)
-            dt, cpu = time.perf_counter() - t0, time.process_time() - c0
-            w.writerow([scan.scan_id, matcher.name, f"{est.pose.x:.6f}", f"{est.pose.y:.6f}",
-                        f"{est.pose.theta:.7f}", f"{dt:.6f}", f"{cpu:.6f}", int(est.converged), est.iterations,
-                        est.evaluations, status_of(est)])
+            w.writerow(_localize(matcher, scenario, scan, cache, counts, first=n == 0))
             fh.flush()
-    print(f"wrote {args.out}", file=sys.stderr)
-    return 0
+    print(f"wrote {args.out}: " + ", ".join(f"{k} {v}" for k, v in counts.items()), file=sys.stderr)
+    return 3 if counts["error"] else 0
+
+
+def _localize(matcher, scenario, scan, cache: dict, counts: dict, first: bool) -> list:
+    """One output row: the estimate, or an ``invalid:``/``error:`` status without one."""
+    where = f"{scenario.scans_path}:{scan.line}"
+    try:
+        problem = Problem(map_for(scenario, scan, cache), scenario.laser, scan.ranges, scan.initial, where=where)
+    except InvalidProblemError as exc:
+        counts["invalid"] += 1
+        return [scan.scan_id, matcher.name, *[""] * 8, f"invalid:{exc}"]
+    try:
+        if first:  # untimed; a scan-to-scan map is new for each map_for call, so not warmed here
+            warm(matcher, Problem(map_for(scenario, scan, cache), scenario.laser, scan.ranges, scan.initial,
+                                  where=where))
+        t0, c0 = time.perf_counter(), time.process_time()
+        est = matcher.localize(problem)
+        dt, cpu = time.perf_counter() - t0, time.process_time() - c0
+    except Exception as exc:  # noqa: BLE001 - a failing matcher is a result, as in tfloc bench
+        counts["error"] += 1
+        return [scan.scan_id, matcher.name, *[""] * 8, f"error:{type(exc).__name__}: {exc}".replace("\n", " ")[:300]]
+    status = status_of(est)
+    counts[status] += 1
+    return [scan.scan_id, matcher.name, f"{est.pose.x:.6f}", f"{est.pose.y:.6f}", f"{est.pose.theta:.7f}",
+            f"{dt:.6f}", f"{cpu:.6f}", int(est.converged), est.iterations, est.evaluations, status]

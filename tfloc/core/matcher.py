@@ -73,6 +73,6 @@ def get_matcher(name: str, **params: Any) -> Matcher:
     try:
         return factory(**params)
     except ParameterError as exc:
-        raise ParameterError(f"matcher {name!r}: {exc}") from None
+        raise ParameterError(f"matcher {name!r}: {exc}", exc.names) from None
     except TypeError as exc:  # a third-party factory that rejects a keyword the Python way
         raise ParameterError(f"matcher {name!r}: bad parameters {params}: {exc}") from None

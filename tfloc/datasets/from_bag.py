@@ -11,7 +11,7 @@ import numpy as np
 import yaml
 
 from tfloc.core.pose import Pose
-from tfloc.errors import BagError, DatasetError
+from tfloc.errors import BagError, ConfigError, DatasetError
 from tfloc.io.scenario import Scan, write_scenario
 
 from .interpolate import interpolate_poses
@@ -58,6 +58,20 @@ class BagImport:
     max_pose_gap_s: float = 1.0
     laser_offset: Pose = field(default_factory=Pose)
 
+    def __post_init__(self) -> None:
+        """Argument errors (one type, :class:`ConfigError`, whoever builds the import)."""
+        if (self.map_file is None) == (self.map_topic is None):
+            raise ConfigError("give the map either as a file (--map) or as an OccupancyGrid topic (--map-topic)")
+        if self.every < 1 or self.limit < 0:
+            raise ConfigError(f"--every must be ≥ 1 and --limit ≥ 0, got {self.every} and {self.limit}")
+        if self.initial_frames and not self.initial_topic:
+            raise ConfigError("--initial-frames needs --initial-topic")
+        if self.align_initial and not self.initial_topic:
+            raise ConfigError("--align-initial needs --initial-topic")
+        if not (self.clearance_m >= 0 and self.max_pose_gap_s > 0 and self.laser_offset.is_finite()):
+            raise ConfigError(f"--clearance must be ≥ 0 m, --max-pose-gap > 0 s and --laser-offset finite, got "
+                              f"{self.clearance_m}, {self.max_pose_gap_s} and {self.laser_offset}")
+
 
 @dataclass(frozen=True)
 class ImportSummary:
@@ -77,10 +91,6 @@ def import_bag(cfg: BagImport) -> ImportSummary:
 
     from .protocol import Perturbation, perturb
 
-    if (cfg.map_file is None) == (cfg.map_topic is None):
-        raise BagError("give the map either as a file (--map) or as an OccupancyGrid topic (--map-topic)")
-    if cfg.every < 1 or cfg.limit < 0:
-        raise BagError(f"--every must be ≥ 1 and --limit ≥ 0, got {cfg.every} and {cfg.limit}")
     out = Path(cfg.out)
     if (out / "scenario.json").exists() or (out / "scans.csv").exists():
         raise DatasetError(f"{out}: a dataset exists there already; choose another --out or remove it")

@@ -6,8 +6,9 @@ there are in metres and radians, the metrics here are reported in cm, degrees, m
 Which rows count where (stated in every report):
 
 * **rows with truth**: the true pose is known. They all count in the success rate and in the
-  outcome shares; a scan without an answer (``failed``, ``timeout``, ``error:*``) counts as a
-  failure with outcome ``no-answer``.
+  outcome shares; a scan without an answer (``failed``, ``timeout``, ``error:*``, and
+  ``invalid:*``: the data poses no problem, e.g. the initial pose lies outside the map) counts as
+  a failure with outcome ``no-answer``; invalid rows are counted apart (``n_invalid``), not as errors.
 * **rows with an estimate**: status ``ok`` or ``failed`` with a finite pose, hence finite
   errors. Error and improvement statistics use only these; the others are *excluded* and
   counted in ``n_excluded``.
@@ -60,7 +61,7 @@ DIST_BINS = _labels(DIST_EDGES_CM)
 ANGLE_BINS = _labels(ANGLE_EDGES_DEG)
 UNSCORED = "unscored"  # failed under overridden thresholds but the run recorded no scores
 METRIC_COLUMNS = (
-    "n", "n_truth", "n_est", "n_excluded", "n_timeout", "n_error",
+    "n", "n_truth", "n_est", "n_excluded", "n_timeout", "n_error", "n_invalid",
     "dist_mean_cm", "dist_std_cm", "dist_median_cm", "dist_median_lo_cm", "dist_median_hi_cm",
     "dist_p90_cm", "dist_max_cm",
     "orient_mean_deg", "orient_std_deg", "orient_median_deg", "orient_p90_deg", "orient_max_deg",
@@ -173,7 +174,8 @@ def group_metrics(g: pd.DataFrame) -> dict[str, float]:
     m: dict[str, float] = {
         "n": len(g), "n_truth": n_truth, "n_est": int(g["estimate"].sum()),
         "n_excluded": n_truth - int(g["estimate"].sum()),
-        "n_timeout": int((status == "timeout").sum()), "n_error": int(status.str.startswith("error").sum())}
+        "n_timeout": int((status == "timeout").sum()), "n_error": int(status.str.startswith("error:").sum()),
+        "n_invalid": int(status.str.startswith("invalid:").sum())}
     m.update(_stats(g["dist_err_cm"], "dist", "cm"))
     m.update(_stats(g["orient_err_deg"], "orient", "deg"))
     for k in ("dist", "orient"):

@@ -22,6 +22,11 @@ A run configuration file looks like::
 
 A sweep adds the cartesian product of its grid, in the order the keys and values are written,
 as matchers labelled ``tf[spacing=0.5,straw_t=0.95]``, ``tf[spacing=0.5,straw_t=0.99]``, ...
+
+A matcher may also be named ``module:Class``: running such a configuration imports that module,
+that is, runs its code. :func:`check_imports` refuses it unless the caller allows imports
+(``tfloc bench --allow-import``). Every matcher spec remembers which configuration key set each of
+its parameters, so that a bad one is reported by its key (``[params.csm-corr] search_radiuss``).
 """
 
 from __future__ import annotations
@@ -45,14 +50,24 @@ class MatcherSpec:
     label: str
     name: str
     params_json: str = "{}"
+    where: str = field(default="", compare=False)      # the configuration entry, e.g. "x.toml: matchers[2]"
+    keys_json: str = field(default="{}", compare=False)  # parameter → the configuration key that set it
 
     @property
     def params(self) -> dict[str, Any]:
         return json.loads(self.params_json)
 
     @classmethod
-    def make(cls, name: str, params: dict | None = None, label: str | None = None) -> MatcherSpec:
-        return cls(label or name, name, json.dumps(params or {}, sort_keys=True))
+    def make(cls, name: str, params: dict | None = None, label: str | None = None, where: str = "",
+             keys: dict[str, str] | None = None) -> MatcherSpec:
+        return cls(label or name, name, json.dumps(params or {}, sort_keys=True), where,
+                   json.dumps(keys or {}, sort_keys=True))
+
+    def key_of(self, param: str) -> str:
+        """The configuration key that set ``param`` (``a.b`` and ``a[1]`` were set by ``a``; else
+        the entry that made this spec)."""
+        top = param.split(".")[0].split("[")[0]
+        return json.loads(self.keys_json).get(top) or self.where or f"matcher {self.label}"
 
 
 @dataclass(frozen=True)
@@ -90,15 +105,33 @@ class RunConfig:
                 "success": self.success.to_dict(), **self.extra}
 
 
+def _keys(params: dict, key: str) -> dict[str, str]:
+    return {k: f"{key}{k}" for k in params}
+
+
+def _defaults(defaults: dict[str, dict], name: str, where: str) -> tuple[dict, dict[str, str]]:
+    """``[params.<name>]`` of a configuration, and the keys of its parameters."""
+    params = defaults.get(name, {})
+    if not isinstance(params, dict):
+        raise ConfigError(f"{where}: [params.{name}] must be a table")
+    return params, _keys(params, f"{where}: [params.{name}] ")
+
+
 def parse_matchers(entries: list, defaults: dict[str, dict], where: str) -> tuple[MatcherSpec, ...]:
     """Matcher entries: a registered name, or a table ``{label, name, params}``."""
     specs = []
     for i, e in enumerate(entries):
+        at = f"{where}: matchers[{i}]" if where != "--matchers" else f"--matchers {e}"
         if isinstance(e, str):
-            specs.append(MatcherSpec.make(e, defaults.get(e)))
+            params, keys = _defaults(defaults, e, where)
+            specs.append(MatcherSpec.make(e, params, where=at, keys=keys))
         elif isinstance(e, dict) and isinstance(e.get("name"), str):
-            params = {**defaults.get(e["name"], {}), **e.get("params", {})}
-            specs.append(MatcherSpec.make(e["name"], params, e.get("label")))
+            base, keys = _defaults(defaults, e["name"], where)
+            own = e.get("params", {})
+            if not isinstance(own, dict):
+                raise ConfigError(f"{at}: 'params' must be a table")
+            specs.append(MatcherSpec.make(e["name"], {**base, **own}, e.get("label"), at,
+                                          {**keys, **_keys(own, f"{at}.params.")}))
         else:
             raise ConfigError(f"{where}: matchers[{i}] must be a name or a table with 'name'")
     return tuple(specs)
@@ -131,12 +164,25 @@ def expand_sweeps(sweeps: Any, defaults: dict[str, dict], where: str) -> tuple[M
             if len({json.dumps(v) for v in values}) != len(values):
                 raise ConfigError(f"{at}: grid.{k} lists a value twice")
         prefix = str(sw.get("label", sw["name"]))
+        base, keys = _defaults(defaults, sw["name"], where)
+        keys = {**keys, **_keys(fixed, f"{at}.params.")}
         for point in itertools.product(*grid.values()):
             chosen = dict(zip(grid, point, strict=True))
             label = f"{prefix}[{','.join(f'{k}={_value_text(v)}' for k, v in chosen.items())}]"
-            specs.append(MatcherSpec.make(sw["name"], {**defaults.get(sw["name"], {}), **fixed,
-                                                       **chosen}, label))
+            specs.append(MatcherSpec.make(sw["name"], {**base, **fixed, **chosen}, label, f"{at} point {label}",
+                                          {**keys, **{k: f"{at}.grid.{k} (point {label})" for k in chosen}}))
     return tuple(specs)
+
+
+def check_imports(config: RunConfig, allow: bool) -> None:
+    """Refuse matchers named ``module:Class`` (running them imports the module: its code runs with
+    the rights of whoever starts the run) unless ``allow``."""
+    spec = next((m for m in config.matchers if ":" in m.name), None)
+    if spec is not None and not allow:
+        module = spec.name.partition(":")[0]
+        raise ConfigError(f"{spec.where or 'matchers'}: {spec.name!r} names a Python class; running it "
+                          f"imports module {module!r}, which runs its code: if you trust this "
+                          "configuration, give --allow-import")
 
 
 def load_config(path: str | Path) -> RunConfig:

@@ -1,7 +1,13 @@
 """Run a benchmark's tasks on a Dask cluster: ``tfloc bench ... --scheduler ADDRESS``.
 
-``ADDRESS`` is a running scheduler (``tcp://HOST:8786``) or ``local:N``, a
-:class:`distributed.LocalCluster` of N single-threaded worker processes on 127.0.0.1. Dask does the
+``ADDRESS`` is a running scheduler (``tls://HOST:8786``, or ``tcp://…``) or ``local:N``, a
+:class:`distributed.LocalCluster` of N single-threaded worker processes on 127.0.0.1.
+
+Who may run code: anyone who can reach a scheduler can run arbitrary code on its workers. A
+``tls://`` scheduler is reached with Dask's :class:`~distributed.security.Security`: certificates
+from ``--tls-ca-file/--tls-cert/--tls-key`` or from the Dask configuration
+(``distributed.comm.tls.*``), and with ``require_encryption``; a plain ``tcp://`` scheduler that
+is not on this machine gets a warning (use TLS or an SSH tunnel). Dask does the
 scheduling; tfloc only submits its (scan, matcher) tasks, which carry a dataset path, a scan id
 and a matcher spec (never a map), and writes each row to ``estimates.csv`` as its task finishes.
 The client is the only writer, so every task ends in exactly one row: when a worker dies, Dask
@@ -15,6 +21,7 @@ from __future__ import annotations
 
 import contextlib
 import re
+import sys
 import uuid
 from collections.abc import Callable, Iterator
 
@@ -38,7 +45,41 @@ def parse_scheduler(address: str) -> tuple[str, int | str]:
     if re.fullmatch(r"[a-z+]+://\S+", address):
         return "remote", address
     raise ConfigError(f"--scheduler {address!r}: expected local:N or a scheduler address like "
-                      "tcp://HOST:8786")
+                      "tls://HOST:8786")
+
+
+def security(address: str, tls_ca_file: str | None = None, tls_cert: str | None = None,
+             tls_key: str | None = None):
+    """The :class:`distributed.security.Security` to reach ``address`` with: for ``tls://``, the
+    given certificate files, else those of the Dask configuration (an error if there are none);
+    ``None`` for other addresses (a warning for plain ``tcp://`` to another machine)."""
+    options = (("--tls-ca-file", "tls_ca_file", tls_ca_file), ("--tls-cert", "tls_client_cert", tls_cert),
+               ("--tls-key", "tls_client_key", tls_key))
+    given = {kw: v for _, kw, v in options if v}
+    if not address.startswith("tls://"):
+        if given:
+            raise ConfigError(f"--scheduler {address}: --tls-* options need a tls:// scheduler address")
+        host = address.partition("://")[2].rpartition(":")[0].strip("[]")
+        if address.startswith("tcp://") and host not in ("127.0.0.1", "localhost", "::1"):
+            print(f"tfloc bench: warning: {address} is plain TCP: no encryption, no authentication; anyone "
+                  "who can reach it can run code on the workers. Use tls:// (README: Running on a Dask "
+                  "cluster) or an SSH tunnel", file=sys.stderr)
+        return None
+    _require_distributed()
+    from distributed.security import Security
+
+    for option, _, v in options:
+        try:
+            if v:
+                open(v, "rb").close()
+        except OSError as exc:
+            raise ConfigError(f"{option} {v}: cannot read ({exc.strerror or exc})") from None
+    sec = Security(require_encryption=True, **given)
+    if not (sec.tls_ca_file and sec.tls_client_cert):
+        raise ConfigError(f"--scheduler {address}: TLS needs a CA file and a client certificate: give "
+                          "--tls-ca-file and --tls-cert (and --tls-key), or set distributed.comm.tls.ca-file "
+                          "and distributed.comm.tls.client.cert in the Dask configuration")
+    return sec
 
 
 def _require_distributed() -> None:
@@ -50,9 +91,10 @@ def _require_distributed() -> None:
 
 
 @contextlib.contextmanager
-def connect(address: str) -> Iterator:
+def connect(address: str, sec=None) -> Iterator:
     """A :class:`distributed.Client` for ``address`` (starting and closing a LocalCluster for
-    ``local:N``). Worker processes are started non-daemonic, so that they can run task processes."""
+    ``local:N``), with the :class:`~distributed.security.Security` ``sec`` if given. Worker
+    processes are started non-daemonic, so that they can run task processes."""
     import dask
     from distributed import Client, LocalCluster
 
@@ -66,8 +108,8 @@ def connect(address: str) -> Iterator:
                 yield client
             return
         try:
-            client = Client(where, timeout=30)
-        except (OSError, TimeoutError) as exc:
+            client = Client(where, timeout=30, **({"security": sec} if sec is not None else {}))
+        except (OSError, TimeoutError, ValueError) as exc:
             raise ConfigError(f"--scheduler {where}: cannot connect ({exc})") from None
         with client:
             yield client
@@ -97,9 +139,10 @@ def host_threads(client) -> dict[str, int]:
     return {addr: per_host[w["host"]] for addr, w in workers.items()}
 
 
-def execute_dask(address: str) -> Executor:
+def execute_dask(address: str, sec=None) -> Executor:
     """An :data:`~tfloc.harness.runner.Executor` running tasks on the Dask cluster at ``address``
-    (``local:N`` or ``tcp://HOST:PORT``); ``jobs`` is ignored (the workers set the parallelism)."""
+    (``local:N``, ``tls://HOST:PORT`` with the :class:`~distributed.security.Security` ``sec``, or
+    ``tcp://HOST:PORT``); ``jobs`` is ignored (the workers set the parallelism)."""
     parse_scheduler(address)
     _require_distributed()
 
@@ -110,7 +153,7 @@ def execute_dask(address: str) -> Executor:
 
         from .dask_worker import PLUGIN_NAME, TaskPool, run_on_worker
 
-        with connect(address) as client:
+        with connect(address, sec) as client:
             check_workers(client, tasks)
             client.register_plugin(TaskPool(host_threads(client)), name=PLUGIN_NAME)
             run_id = uuid.uuid4().hex[:12]  # keys never collide with an earlier client's

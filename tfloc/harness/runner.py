@@ -6,6 +6,10 @@ with its worker, which is replaced). Each worker is started with every thread po
 BLAS, numba, OpenCV, open3d; :mod:`tfloc.harness.threads`) limited to one thread, so that a
 task's CPU time is one matcher on one core and ``jobs`` workers use ``jobs`` cores. ``run.json``
 records the load average when a session starts and ends (contention shows in wall time).
+
+Before anything is written, every matcher is built once in this process and the run's
+fingerprint is computed (:mod:`tfloc.harness.fingerprint`); an existing run directory is resumed
+only when its fingerprint is the same.
 """
 
 from __future__ import annotations
@@ -26,10 +30,12 @@ from pathlib import Path
 from pebble import ProcessExpired, ProcessPool
 from tqdm import tqdm
 
-from tfloc.io.estimates import ResultWriter, done_keys
+from tfloc.errors import ConfigError, ResultsError
+from tfloc.io.estimates import ResultWriter, done_keys, drop_rows, sync_dir
 from tfloc.io.scenario import iter_scans, read_scenario
 
 from .config import RunConfig
+from .fingerprint import build_matchers, differences, fingerprint
 from .task import Task, failure_row, run_task, warm_up
 from .threads import limit_threads
 
@@ -91,23 +97,51 @@ def environment() -> dict:
                         "node": platform.node()}}
 
 
-def write_run_json(config: RunConfig, out: Path, n_tasks: int, n_done: int) -> None:
+def read_run_json(out: Path) -> dict | None:
+    """The ``run.json`` of a run directory: ``{}`` if there is none, ``None`` if it is unreadable."""
     path = out / "run.json"
-    previous = json.loads(path.read_text()) if path.exists() else {}
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        return {}
+    except (OSError, ValueError):
+        return None
+    return doc if isinstance(doc, dict) else None
+
+
+def write_run_json(config: RunConfig, out: Path, n_tasks: int, n_done: int, fp: dict | None = None) -> None:
+    """Start a session in ``run.json`` (the configuration, environment and fingerprint)."""
+    previous = read_run_json(out) or {}
     starts = previous.get("sessions", []) + [{"started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
                                               "tasks": n_tasks, "already_done": n_done,
                                               "loadavg_start": load_average()}]
     doc = {"config": config.to_dict(), **environment(), "threads_per_job": threads_per_job(config.jobs),
-           "datasets": {read_scenario(d).name: str(d) for d in config.datasets}, "sessions": starts}
-    path.write_text(json.dumps(doc, indent=2) + "\n")
+           "datasets": {read_scenario(d).name: str(d) for d in config.datasets}, "sessions": starts,
+           "fingerprint": fp}
+    _save_run_json(out, doc)
+
+
+def _save_run_json(out: Path, doc: dict) -> None:
+    """Write ``run.json`` atomically (a kill leaves the old or the new file, never half of one)."""
+    path = out / "run.json"
+    tmp = path.with_name("run.json.tmp")
+    try:
+        with tmp.open("w") as fh:
+            fh.write(json.dumps(doc, indent=2) + "\n")
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+        sync_dir(out)
+    except OSError as exc:
+        raise ResultsError(f"{path}: cannot write ({exc.strerror or exc})") from None
 
 
 def close_session(out: Path) -> None:
     """Record the end time and load average of the last session in ``run.json``."""
-    path = out / "run.json"
-    doc = json.loads(path.read_text())
-    doc["sessions"][-1].update(ended=time.strftime("%Y-%m-%dT%H:%M:%S%z"), loadavg_end=load_average())
-    path.write_text(json.dumps(doc, indent=2) + "\n")
+    doc = read_run_json(out)
+    if doc and doc.get("sessions"):
+        doc["sessions"][-1].update(ended=time.strftime("%Y-%m-%dT%H:%M:%S%z"), loadavg_end=load_average())
+        _save_run_json(out, doc)
 
 
 def execute_local(tasks: list[Task], jobs: int, timeout_s: float,
@@ -116,17 +150,21 @@ def execute_local(tasks: list[Task], jobs: int, timeout_s: float,
     ctx = multiprocessing.get_context("spawn")
     with ProcessPool(max_workers=jobs, context=ctx, initializer=_init_worker,
                      initargs=(threads_per_job(jobs),)) as pool:
-        warm = {}
-        for t in tasks:  # compile kernels and load data outside the timed, time-limited tasks
-            warm.setdefault((t.dataset, t.matcher, t.params_json), t)
-        for f in [pool.schedule(warm_up, args=(t,), timeout=timeout_s) for t in warm.values()]:
-            try:
-                f.result()
-            except Exception:  # noqa: BLE001 - the task itself will report the failure
-                pass
-        futures = {pool.schedule(run_task, args=(t,), timeout=timeout_s): t for t in tasks}
-        for fut in as_completed(futures):
-            on_row(collect(fut, futures[fut]))
+        try:
+            warm = {}
+            for t in tasks:  # compile kernels and load data outside the timed, time-limited tasks
+                warm.setdefault((t.dataset, t.matcher, t.params_json), t)
+            for f in [pool.schedule(warm_up, args=(t,), timeout=timeout_s) for t in warm.values()]:
+                try:
+                    f.result()
+                except Exception:  # noqa: BLE001 - the task itself will report the failure
+                    pass
+            futures = {pool.schedule(run_task, args=(t,), timeout=timeout_s): t for t in tasks}
+            for fut in as_completed(futures):
+                on_row(collect(fut, futures[fut]))
+        except BaseException:  # a failed write, Ctrl-C: stop the workers, do not run the rest
+            pool.stop()
+            raise
 
 
 def collect(fut, task: Task) -> dict:
@@ -144,24 +182,58 @@ def collect(fut, task: Task) -> dict:
 Executor = Callable[[list[Task], int, float, Callable[[dict], None]], None]
 
 
+def _discard(out: Path) -> None:
+    (out / "estimates.csv").unlink(missing_ok=True)
+    (out / "run.json").unlink(missing_ok=True)
+
+
 def run(config: RunConfig, progress: bool | None = None, executor: Executor = execute_local,
-        regenerate: bool = False) -> Path:
+        regenerate: bool = False, retry_errors: bool = False) -> Path:
     """Run (or resume) a benchmark; returns the run directory holding ``estimates.csv``.
 
-    An existing ``estimates.csv`` is resumed: finished tasks are skipped. With ``regenerate``, a
-    *complete* previous run is discarded and run again (an interrupted one is still resumed), so
-    one command both reproduces a committed reference run and survives interruptions.
+    Every matcher is built first, in this process (a bad parameter raises :class:`ConfigError`
+    before anything is written). An existing ``estimates.csv`` is resumed when the run's
+    fingerprint is the same: finished tasks are skipped; another configuration raises
+    :class:`ConfigError` saying what differs. With ``regenerate``, a *complete* previous run or
+    one of another configuration is discarded and run again (an interrupted one is still
+    resumed), so one command both reproduces a committed reference run and survives
+    interruptions. With ``retry_errors``, rows whose status is ``error:…`` or ``timeout`` are
+    removed (the file is rewritten atomically) and their tasks run again.
     """
     out = Path(config.out)
-    out.mkdir(parents=True, exist_ok=True)
+    fp = fingerprint(config, build_matchers(config))
     tasks = make_tasks(config)
-    done = done_keys(out / "estimates.csv")
+    est = out / "estimates.csv"
+    try:
+        done = done_keys(est) if out.is_dir() else set()
+    except ResultsError:  # damaged, or written by another version: only --regenerate goes on
+        if not regenerate:
+            raise
+        _discard(out)
+        done = set()
+    if done:
+        diff = differences((read_run_json(out) or {}).get("fingerprint"), fp)
+        if diff and not regenerate:
+            more = f" (and {len(diff) - 3} more)" if len(diff) > 3 else ""
+            raise ConfigError(f"{out} holds a run of another configuration: {'; '.join(diff[:3])}{more}; "
+                              "to start it over give --regenerate, to keep it choose another --out")
+        if diff:
+            _discard(out)
+            done = set()
     todo = [t for t in tasks if t.key not in done]
     if regenerate and not todo and tasks:
-        (out / "estimates.csv").unlink()
-        (out / "run.json").unlink(missing_ok=True)
+        _discard(out)
         todo = tasks
-    write_run_json(config, out, len(tasks), len(tasks) - len(todo))
+    elif retry_errors and done:
+        keep = done_keys(est, redo=("error", "timeout"))
+        retry = {t.key for t in tasks if t.key in done and t.key not in keep}
+        drop_rows(est, done - retry)
+        todo = [t for t in tasks if t.key not in done or t.key in retry]
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ResultsError(f"{out}: cannot create the run directory ({exc.strerror or exc})") from None
+    write_run_json(config, out, len(tasks), len(tasks) - len(todo), fp)
     if not todo:
         return out
     bar = tqdm(total=len(tasks), initial=len(tasks) - len(todo), unit="task", desc=config.name,
@@ -171,7 +243,7 @@ def run(config: RunConfig, progress: bool | None = None, executor: Executor = ex
         def on_row(row: dict) -> None:
             nonlocal failures
             writer.write(row)
-            failures += row.get("status", "ok") not in ("ok", "failed")
+            failures += str(row.get("status", "ok")).startswith(("error", "timeout"))
             bar.update(1)
             if failures:
                 bar.set_postfix(errors=failures, refresh=False)

@@ -25,6 +25,7 @@ import numpy as np
 from tfloc.core.matcher import get_matcher
 from tfloc.core.pose import Pose, angdiff
 from tfloc.core.problem import Estimate, Problem
+from tfloc.errors import InvalidProblemError, MatcherError
 from tfloc.evaluation.outcome import AMBIGUOUS, NO_ANSWER, Thresholds, outcome
 from tfloc.io.scenario import Scan, Scenario, map_for, read_scans, read_scenario
 
@@ -58,11 +59,16 @@ _MAPS: dict = {}
 
 @lru_cache(maxsize=32)
 def load_matcher(name: str, params_json: str):
-    """A matcher instance, built once per worker; ``module:Class`` names are imported directly."""
+    """A matcher instance, built once per worker; ``module:Class`` names are imported directly
+    (the command line allows them only with ``--allow-import``)."""
     params = json.loads(params_json)
     if ":" in name:
         module, _, attr = name.partition(":")
-        return getattr(__import__(module, fromlist=[attr]), attr)(**params)
+        try:
+            factory = getattr(__import__(module, fromlist=[attr]), attr)
+        except (ImportError, AttributeError) as exc:
+            raise MatcherError(f"matcher {name!r}: cannot import it ({exc})") from None
+        return factory(**params)
     return get_matcher(name, **params)
 
 
@@ -132,13 +138,19 @@ def status_of(est: Estimate) -> str:
 
 
 def run_task(task: Task) -> dict[str, Any]:
-    """Run one task; exceptions from the matcher become an ``error:`` row (never raised)."""
+    """Run one task; exceptions from the matcher become an ``error:`` row (never raised), a
+    problem the data cannot pose (:class:`InvalidProblemError`) an ``invalid:`` row."""
     scenario, scans = load_dataset(task.dataset)
     scan = scans[task.scan_id]
     try:
         matcher = load_matcher(task.matcher, task.params_json)
-        _warm_once(task, matcher, scenario, scan)
         problem = problem_of(scenario, scan)
+    except InvalidProblemError as exc:
+        return failure_row(task, f"invalid:{exc}", scan)
+    except Exception as exc:  # noqa: BLE001 - a failing matcher is a result, not a crash
+        return failure_row(task, f"error:{type(exc).__name__}: {exc}", scan)
+    try:
+        _warm_once(task, matcher, scenario, scan)
         t0, c0 = time.perf_counter(), time.process_time()
         est = matcher.localize(problem)
         runtime, cpu = time.perf_counter() - t0, time.process_time() - c0

@@ -1,13 +1,26 @@
-"""``estimates.csv``: the append-only results file of a run, safe to resume after a kill -9."""
+"""``estimates.csv``: the append-only results file of a run, safe to resume after a kill -9.
+
+One reader for every command (``report``, ``export``, ``real-note``, resume): :func:`read_rows`
+reads strictly through :mod:`tfloc.io.text`; a malformed file is a
+:class:`~tfloc.errors.ResultsError` naming ``file:line``. A row's ``status`` is ``ok``, ``failed``
+(the matcher declined or gave no finite pose), ``invalid:<reason>`` (the data poses no problem,
+e.g. the initial pose lies outside the map), ``timeout`` or ``error:<message>`` (the matcher raised).
+"""
 
 from __future__ import annotations
 
 import csv
+import errno
 import os
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
+
+from tfloc.errors import ResultsError
+
+from .text import csv_rows
 
 COLUMNS = ["dataset", "scan_id", "group", "matcher",
            "true_x", "true_y", "true_theta", "init_x", "init_y", "init_theta",
@@ -15,6 +28,22 @@ COLUMNS = ["dataset", "scan_id", "group", "matcher",
            "init_dist_err_m", "init_orient_err_rad", "runtime_s", "cpu_s", "converged", "iterations",
            "evaluations", "status", "outcome", "score_est", "score_true", "info"]
 KEY = ("dataset", "scan_id", "matcher")
+#: the columns every reader needs (older runs may lack the others)
+REQUIRED = ("dataset", "scan_id", "group", "matcher", "true_x", "true_y", "true_theta", "init_x",
+            "init_y", "init_theta", "est_x", "est_y", "est_theta", "dist_err_m", "orient_err_rad",
+            "init_dist_err_m", "init_orient_err_rad", "runtime_s", "converged", "iterations",
+            "evaluations", "status", "outcome")
+TEXT = ("dataset", "scan_id", "group", "matcher", "status", "outcome", "info")
+STATUS_KINDS = ("ok", "failed", "invalid", "timeout", "error")
+
+
+def status_kind(status: str) -> str | None:
+    """``ok``, ``failed``, ``invalid``, ``timeout`` or ``error`` (``invalid:…``/``error:…`` carry a
+    message); ``None`` for anything else."""
+    kind = status.partition(":")[0]
+    if kind in ("invalid", "error"):
+        return kind if ":" in status else None
+    return kind if kind in STATUS_KINDS else None
 
 
 def repair(path: Path) -> None:
@@ -27,39 +56,122 @@ def repair(path: Path) -> None:
             fh.truncate(data.rfind(b"\n") + 1)
 
 
-def done_keys(path: Path) -> set[tuple[str, str, str]]:
-    """Keys (dataset, scan_id, matcher) already in the results file."""
+def read_rows(path: Path, required: tuple[str, ...] = REQUIRED) -> tuple[list[str], list[tuple[int, dict]]]:
+    """The header and the rows ``(line, row)`` of a results file, checked: every row has the
+    header's fields, a known ``status`` and a key (dataset, scan_id, matcher) no other row has."""
+    header, rows = csv_rows(path, ResultsError, "results file (estimates.csv)", (*KEY, *required))
+    out, seen = [], {}
+    for line, row in rows:
+        extra, missing = row.pop(None, None) or (), sum(v is None for v in row.values())
+        if extra or missing:
+            raise ResultsError(f"{path}:{line}: {len(header) + len(extra) - missing} fields, expected {len(header)}")
+        key = tuple(row[k] for k in KEY)
+        if not all(key):
+            raise ResultsError(f"{path}:{line}: empty {', '.join(k for k, v in zip(KEY, key, strict=True) if not v)}")
+        if key in seen:
+            raise ResultsError(f"{path}:{line}: a second row for {'/'.join(key)} (first at line {seen[key]})")
+        seen[key] = line
+        if "status" in row and status_kind(row["status"]) is None:
+            raise ResultsError(f"{path}:{line}: unknown status {row['status'][:40]!r} "
+                               "(ok, failed, invalid:…, timeout or error:…)")
+        out.append((line, row))
+    return header, out
+
+
+def done_keys(path: Path, redo: tuple[str, ...] = ()) -> set[tuple[str, str, str]]:
+    """Keys (dataset, scan_id, matcher) already in the results file, but for those whose status
+    kind is in ``redo``."""
     repair(path)
     if not path.exists() or path.stat().st_size == 0:
         return set()
-    with path.open(newline="") as fh:
-        return {tuple(r[k] for k in KEY) for r in csv.DictReader(fh)}
+    _, rows = read_rows(path)
+    return {tuple(r[k] for k in KEY) for _, r in rows if status_kind(r["status"]) not in redo}
+
+
+def status_counts(path: Path) -> dict[str, int]:
+    """Rows of the results file per status kind (:data:`STATUS_KINDS`, all present)."""
+    counts = dict.fromkeys(STATUS_KINDS, 0)
+    if path.exists() and path.stat().st_size:
+        for _, r in read_rows(path)[1]:
+            counts[status_kind(r["status"])] += 1
+    return counts
+
+
+def drop_rows(path: Path, keep: set[tuple[str, str, str]]) -> int:
+    """Rewrite the results file with only the rows whose key is in ``keep``, atomically (a kill
+    leaves the old file or the new one, never a mix); returns how many rows were dropped."""
+    header, rows = read_rows(path)
+    kept = [r for _, r in rows if tuple(r[k] for k in KEY) in keep]
+    if len(kept) == len(rows):
+        return 0
+    tmp = path.with_name(path.name + ".tmp")
+    try:
+        with tmp.open("w", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=header, extrasaction="ignore")
+            w.writeheader()
+            w.writerows(kept)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+        sync_dir(path.parent)
+    except OSError as exc:
+        raise ResultsError(f"{path}: cannot rewrite ({exc.strerror or exc}); the file is unchanged") from None
+    return len(rows) - len(kept)
+
+
+def sync_dir(directory: Path) -> None:
+    """fsync a directory, so that a rename in it survives a crash."""
+    fd = os.open(directory, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
 
 
 class ResultWriter:
-    """Appends one row per finished task and makes it durable at once (flush + fsync)."""
+    """Appends one row per finished task and makes it durable at once (flush + fsync).
+
+    A failing write (a full disk, a read-only directory) raises :class:`ResultsError`; the rows
+    written before stay intact (a torn last line is dropped when the run is resumed).
+    """
 
     def __init__(self, path: Path) -> None:
         self.path = Path(path)
-        repair(self.path)
-        new = not self.path.exists() or self.path.stat().st_size == 0
-        header = COLUMNS if new else _header(self.path)  # resuming an older run keeps its columns
-        self._fh = self.path.open("a", newline="")
-        self._w = csv.DictWriter(self._fh, fieldnames=header, extrasaction="ignore")
-        if new:
-            self._w.writeheader()
-            self._sync()
+        self.rows = 0
+        try:
+            repair(self.path)
+            new = not self.path.exists() or self.path.stat().st_size == 0
+            header = COLUMNS if new else _header(self.path)  # resuming an older run keeps its columns
+            self._fh = self.path.open("a", newline="")
+            self._w = csv.DictWriter(self._fh, fieldnames=header, extrasaction="ignore")
+            if new:
+                self._w.writeheader()
+                self._sync()
+        except OSError as exc:
+            raise self._failed(exc) from None
+
+    def _failed(self, exc: OSError) -> ResultsError:
+        why = "the disk is full" if exc.errno == errno.ENOSPC else (exc.strerror or str(exc))
+        return ResultsError(f"{self.path}: cannot write ({why}); the rows written before are kept: "
+                            "free the space or fix the permissions, then run the same command to resume")
 
     def _sync(self) -> None:
         self._fh.flush()
         os.fsync(self._fh.fileno())
 
     def write(self, row: dict[str, Any]) -> None:
-        self._w.writerow({k: _fmt(v) for k, v in row.items()})
-        self._sync()
+        try:
+            self._w.writerow({k: _fmt(v) for k, v in row.items()})
+            self._sync()
+        except OSError as exc:
+            raise self._failed(exc) from None
+        self.rows += 1
 
     def close(self) -> None:
-        self._fh.close()
+        try:
+            self._fh.close()
+        except OSError:
+            pass
 
     def __enter__(self) -> ResultWriter:
         return self
@@ -77,9 +189,25 @@ def _fmt(v: Any) -> Any:
     return f"{v:.9g}" if isinstance(v, float) else v
 
 
-def read_estimates(run_dir: str | Path) -> pd.DataFrame:
-    """The results of a run as a DataFrame (one row per (dataset, scan, matcher))."""
+def read_estimates(run_dir: str | Path, required: tuple[str, ...] = REQUIRED) -> pd.DataFrame:
+    """The results of a run as a DataFrame (one row per (dataset, scan, matcher)): text columns
+    as strings (empty: ``""``), the others as numbers (empty: NaN). A malformed file raises
+    :class:`ResultsError` naming ``file:line``."""
     path = Path(run_dir) / "estimates.csv"
-    repair(path)
-    return pd.read_csv(path, dtype={"scan_id": str, "group": str, "dataset": str, "matcher": str,
-                                    "status": str, "outcome": str, "info": str})
+    if Path(run_dir).is_dir():
+        repair(path)
+    header, rows = read_rows(path, required)
+    df = pd.DataFrame([r for _, r in rows], columns=header, dtype=object)
+    lines = np.array([line for line, _ in rows], dtype=int)
+    for c in header:
+        if c in TEXT:
+            df[c] = df[c].astype(str)
+            continue
+        text = df[c].astype(str).str.strip()
+        num = pd.to_numeric(text.where(text != "", None), errors="coerce")
+        bad = np.flatnonzero(num.isna().to_numpy() & (text != "").to_numpy()
+                             & ~text.str.lower().isin(["nan", "-nan", "+nan"]).to_numpy())
+        if bad.size:
+            raise ResultsError(f"{path}:{lines[bad[0]]}: column {c!r} is not a number: {text.iloc[bad[0]][:40]!r}")
+        df[c] = num.astype(float) if num.dtype == object else num
+    return df

@@ -38,11 +38,13 @@ def read_vector_map(path: str | Path) -> VectorMap:
         try:
             g = shape(f["geometry"])
         except Exception as exc:  # shapely raises several types for bad coordinates
-            raise MapFormatError(f"{where}: bad geometry ({exc})") from None
+            why = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+            raise MapFormatError(f"{where}: bad geometry ({why})") from None
         if g.is_empty or not shapely.is_valid(g) or not shapely.get_coordinates(g).size:
             raise MapFormatError(f"{where}: empty or invalid {g.geom_type} ({shapely.is_valid_reason(g)})")
-        role = (f.get("properties") or {}).get("role")
-        if role is not None and role not in _ROLES:
+        props = f.get("properties") or {}
+        role = props.get("role") if isinstance(props, dict) else None
+        if role is not None and (not isinstance(role, str) or role not in _ROLES):
             raise MapFormatError(f"{where}: unknown role {role!r} (expected one of {sorted(_ROLES)})")
         kind = g.geom_type
         if kind in ("LineString", "MultiLineString"):

@@ -22,3 +22,22 @@ def load_map(path: str | Path) -> Map:
 
         return read_ros_map(path)
     raise MapFormatError(f"{path}: unknown map type {suffix!r} (expected .geojson or .yaml)")
+
+
+def map_files(path: str | Path) -> list[Path]:
+    """The files a map is made of: the file itself, and for a ROS map YAML also its image (if the
+    YAML names one); files that do not exist are left out (loading the map reports them)."""
+    path = Path(path)
+    files = [path]
+    if path.suffix.lower() in (".yaml", ".yml"):
+        import yaml
+
+        from .text import read_text
+
+        try:
+            doc = yaml.safe_load(read_text(path, MapFormatError, "map file"))
+        except (MapFormatError, yaml.YAMLError):
+            doc = None
+        if isinstance(doc, dict) and isinstance(doc.get("image"), str):
+            files.append(path.parent / doc["image"])
+    return [f for f in files if f.is_file()]

@@ -22,14 +22,22 @@ from tfloc.maps.grid import GridMap
 from .text import parse_text
 
 
+def _finite(v: object) -> bool:
+    """A number (not a bool) that is a finite float (an integer too large for a float is not)."""
+    try:
+        return not isinstance(v, bool) and isinstance(v, int | float) and math.isfinite(float(v))
+    except OverflowError:
+        return False
+
+
 def _num(doc: dict, key: str, path: Path, default: float | None = None) -> float:
     if key not in doc:
         if default is None:
             raise MapFormatError(f"{path}: missing key {key!r}")
         return default
     v = doc[key]
-    if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
-        raise MapFormatError(f"{path}: key {key!r} must be a finite number, got {v!r}")
+    if not _finite(v):
+        raise MapFormatError(f"{path}: key {key!r} must be a finite number, got {v!r:.40}")
     return float(v)
 
 
@@ -49,8 +57,8 @@ def read_ros_map(yaml_path: str | Path) -> GridMap:
     negate = _num(doc, "negate", path, 0.0)
     origin = doc.get("origin")
     if (not isinstance(origin, list) or len(origin) != 3
-            or not all(isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v) for v in origin)):
-        raise MapFormatError(f"{path}: 'origin' must be [x, y, yaw] numbers, got {origin!r}")
+            or not all(_finite(v) for v in origin)):
+        raise MapFormatError(f"{path}: 'origin' must be [x, y, yaw] numbers, got {origin!r:.80}")
     if origin[2] != 0:
         raise MapFormatError(f"{path}: rotated maps (origin yaw {origin[2]}) are not supported")
     mode = doc.get("mode", "trinary")
@@ -61,16 +69,20 @@ def read_ros_map(yaml_path: str | Path) -> GridMap:
         with Image.open(img_path) as im:
             im.load()
             if im.mode not in ("L", "LA", "RGB", "RGBA", "I", "I;16", "P", "1"):
-                raise MapFormatError(f"{img_path}: unsupported image mode {im.mode}")
+                raise MapFormatError(f"{img_path}: unsupported image mode {im.mode} (the map image of {path})")
             v = np.asarray(im.convert("L"), dtype=np.float32)
     except FileNotFoundError:
         raise MapFormatError(f"{path}: image {doc['image']!r} not found next to the YAML") from None
     except (UnidentifiedImageError, OSError, SyntaxError, ValueError) as exc:
-        raise MapFormatError(f"{img_path}: cannot read map image ({exc})") from None
+        why = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+        raise MapFormatError(f"{img_path}: cannot read the map image of {path} ({why})") from None
     p = v / 255.0 if negate else (255.0 - v) / 255.0
     occ = np.where((p > occ_t) | (p < free_t), p, np.nan).astype(np.float32)
-    return GridMap(np.flipud(occ), res, (float(origin[0]), float(origin[1])), occ_t, free_t,
-                   name=path.stem)
+    try:
+        return GridMap(np.flipud(occ), res, (float(origin[0]), float(origin[1])), occ_t, free_t,
+                       name=path.stem)
+    except MapFormatError as exc:
+        raise MapFormatError(f"{path}: {str(exc).removeprefix(path.stem + ': ')}") from None
 
 
 def write_ros_map(grid: GridMap, yaml_path: str | Path) -> Path:

@@ -25,6 +25,7 @@ from tfloc.errors import DatasetError
 
 from .text import csv_rows, parse_text
 
+MAX_BEAMS = 1_000_000  # a laser with more beams is a damaged scenario.json, not a scanner
 COLUMNS = ["scan_id", "group", "true_x", "true_y", "true_theta", "init_x", "init_y", "init_theta",
            "ranges"]
 
@@ -71,19 +72,28 @@ def read_scenario(root: str | Path) -> Scenario:
     for key in ("name", "map", "laser"):
         if key not in doc:
             raise DatasetError(f"{path}: missing field {key!r}")
+    if not isinstance(doc["map"], str) or not doc["map"].strip():
+        raise DatasetError(f"{path}: field 'map' must be a path (a string), got {doc['map']!r:.60}")
     las = doc["laser"]
     try:
         laser = LaserSpec.from_degrees(float(las["max_range"]), float(las["fov_deg"]),
                                        float(las["resolution_deg"]),
                                        None if las.get("angle_min_deg") is None else float(las["angle_min_deg"]))
-    except (KeyError, TypeError, ValueError) as exc:
-        raise DatasetError(f"{path}: bad 'laser' field ({exc!r}); needs max_range, fov_deg, "
+    except (KeyError, TypeError, ValueError, OverflowError) as exc:
+        raise DatasetError(f"{path}: bad 'laser' field ({exc!r:.100}); needs max_range, fov_deg, "
                            "resolution_deg[, angle_min_deg]") from None
-    if not (laser.max_range > 0 and laser.resolution > 0 and laser.fov > 0):
-        raise DatasetError(f"{path}: laser max_range, fov_deg and resolution_deg must be positive")
+    if not all(math.isfinite(v) for v in (laser.max_range, laser.fov, laser.resolution, laser.angle_min)):
+        raise DatasetError(f"{path}: laser values must be finite numbers")
+    if not (laser.max_range > 0 and 0 < laser.resolution <= laser.fov <= 2 * math.pi + 1e-9):
+        raise DatasetError(f"{path}: laser max_range must be positive and 0 < resolution_deg ≤ fov_deg ≤ 360")
+    if laser.fov / laser.resolution > MAX_BEAMS:
+        raise DatasetError(f"{path}: laser resolution_deg is too fine: more than {MAX_BEAMS} beams")
     extra = {k: v for k, v in doc.items() if k not in ("name", "map", "laser", "description")}
-    return Scenario(str(doc["name"]), (root / doc["map"]).resolve(), laser,
-                    str(doc.get("description", "")), root, extra)
+    try:
+        map_path = (root / doc["map"]).resolve()
+    except (OSError, ValueError) as exc:
+        raise DatasetError(f"{path}: field 'map' is not a usable path ({exc})") from None
+    return Scenario(str(doc["name"]), map_path, laser, str(doc.get("description", "")), root, extra)
 
 
 def _float(text: str, path: Path, line: int, column: str) -> float:

@@ -13,6 +13,7 @@ import csv
 import gzip
 import io
 import zlib
+from collections import Counter
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TypeVar
@@ -60,11 +61,12 @@ def read_text(path: str | Path, error: type[TflocError], what: str, latin1: bool
 
 def parse_text(path: str | Path, error: type[TflocError], what: str, parse: Callable[[str], T],
                syntax: type[Exception] | tuple[type[Exception], ...], language: str) -> T:
-    """``parse(read_text(path))``, a ``syntax`` error becoming ``error("<path>: not valid <language> (…)")``."""
+    """``parse(read_text(path))``, a ``syntax`` error becoming ``error("<path>: not valid <language> (…)")``
+    (so does a ValueError, e.g. an integer of more digits than Python converts)."""
     text = read_text(path, error, what)
     try:
         return parse(text)
-    except syntax as exc:
+    except (syntax, ValueError) as exc:
         first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise error(f"{path}: not valid {language} ({first})") from None
     except RecursionError:
@@ -80,6 +82,9 @@ def csv_rows(path: str | Path, error: type[TflocError], what: str,
         header = list(reader.fieldnames or [])
     except csv.Error as exc:
         raise error(f"{path}:1: unreadable CSV header ({exc})") from None
+    twice = sorted(c for c, n in Counter(header).items() if n > 1)
+    if twice:
+        raise error(f"{path}:1: header names column(s) {', '.join(map(repr, twice))} more than once")
     missing = [c for c in required if c not in header]
     if missing:
         raise error(f"{path}:1: header lacks column(s) {', '.join(missing)}")

@@ -44,7 +44,6 @@ rotation correction of the heading (the seven orientations alone: 16 %).
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 from .matcher import TfConfig, TurningFunctionMatcher
 
@@ -58,4 +57,4 @@ class TurningFunctionBestMatcher(TurningFunctionMatcher):
     name = "tf-best"
 
     def __init__(self, config: TfConfig | None = None, **overrides) -> None:
-        super().__init__(replace(config or BEST, **overrides))
+        super().__init__(config or BEST, **overrides)

@@ -49,10 +49,11 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
-from tfloc.core.params import resolve_params
+from tfloc.core.params import Configured
 from tfloc.core.pose import Pose, wrap_angle
 from tfloc.core.problem import Estimate, Problem
 from tfloc.errors import ParameterError
@@ -110,6 +111,12 @@ class TfConfig:
         seed: seed of the random initial simplex.
     """
 
+    RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params)
+        "> 0": ("spacing", "simplex_size", "heading_clamp"),
+        ">= 0": ("straw_t", "orientation_step", "err_threshold", "xy_tol", "theta_tol", "penalty", "seed"),
+        ">= 1": ("window", "n_orientations", "max_iterations", "max_outer"),
+        "(0, 1]": ("line_threshold",)}
+
     spacing: float = 1.0
     window: int = 1
     straw_t: float = 0.99
@@ -139,10 +146,11 @@ class TfConfig:
 
     def __post_init__(self) -> None:
         if self.err_norm not in _NORMS:
-            raise ParameterError(f"tf: err_norm must be one of {_NORMS}, not {self.err_norm!r}")
+            raise ParameterError(f"tf: err_norm must be one of {_NORMS}, not {self.err_norm!r}", ("err_norm",))
         self.shape  # noqa: B018 - validates the shape parameters
         if not self.heading_clamp > 0:
-            raise ParameterError(f"tf: heading_clamp must be > 0 radians (inf = unbounded), not {self.heading_clamp!r}")
+            raise ParameterError(f"tf: heading_clamp must be > 0 radians (inf = unbounded), not {self.heading_clamp!r}",
+                                 ("heading_clamp",))
 
 
 def _match(config: TfConfig) -> Callable[[TurningFunction, TurningFunction], Match]:
@@ -256,13 +264,11 @@ def simplex(cost: _Cost, start: Pose, size: float, rng: np.random.Generator) -> 
     return min(pts, key=f), it
 
 
-class TurningFunctionMatcher:
+class TurningFunctionMatcher(Configured):
     """The paper's method (``tf``): turning-function scan matching with a Nelder–Mead simplex."""
 
     name = "tf"
-
-    def __init__(self, config: TfConfig | None = None, **overrides) -> None:
-        self.config = resolve_params(TfConfig, config, overrides)
+    CONFIG = TfConfig
 
     def heading(self, best: float, rot: float, initial: float) -> float:
         """The heading after an outer iteration (radians): the best of the seven orientations,

@@ -59,9 +59,9 @@ class ShapeConfig:
 
     def __post_init__(self) -> None:
         if self.resampling not in _RESAMPLINGS:
-            raise ParameterError(f"resampling must be one of {_RESAMPLINGS}, not {self.resampling!r}")
+            raise ParameterError(f"resampling must be one of {_RESAMPLINGS}, not {self.resampling!r}", ("resampling",))
         if not self.spacing > 0:
-            raise ParameterError(f"spacing must be > 0 metres, not {self.spacing!r}")
+            raise ParameterError(f"spacing must be > 0 metres, not {self.spacing!r}", ("spacing",))
 
 
 def scan_corners(ranges: np.ndarray, laser: LaserSpec, shape: ShapeConfig = ShapeConfig()) -> np.ndarray:

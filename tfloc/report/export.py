@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from tfloc.errors import DatasetError
+from tfloc.io.estimates import read_rows
 from tfloc.io.text import csv_rows
 from tfloc.io.tum import write_tum
 
@@ -38,9 +39,10 @@ class Exported:
 
 
 def _read_rows(path: Path) -> list[dict]:
-    """The rows of an ``estimates.csv`` as strings (export needs no DataFrame; see
-    :func:`tfloc.io.estimates.read_estimates` for that), checking the needed columns exist."""
-    _, rows = csv_rows(path, DatasetError, "results file (is the run directory right?)", NEEDED)
+    """The rows of an ``estimates.csv`` as strings (export needs no DataFrame), read and checked
+    like every command reads them (:func:`tfloc.io.estimates.read_rows`), needing only the pose
+    columns."""
+    _, rows = read_rows(path, NEEDED)
     return [row for _, row in rows]
 
 

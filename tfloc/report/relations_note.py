@@ -15,9 +15,9 @@ import numpy as np
 import pandas as pd
 
 from tfloc.core.pose import angdiff
-from tfloc.errors import DatasetError
 from tfloc.evaluation.outcome import Thresholds
 from tfloc.evaluation.relations import relation_stats
+from tfloc.io.estimates import read_estimates
 from tfloc.io.scenario import read_scans, read_scenario
 
 #: Kümmerle et al. 2009 (Auton. Robots 27:387-407), MIT CSAIL: errors on its 1172 relations of the
@@ -53,11 +53,8 @@ def write_note(results: Path, dataset: Path, thresholds: Thresholds | None = Non
     odo_r = angdiff(I0[:, 2], T[:, 2])
     odo_ok = thresholds.success(odo_t, odo_r)
     est_path = results / "estimates.csv"
-    est = pd.read_csv(est_path) if est_path.is_file() else None
-    if est is not None:
-        need = {"scan_id", "matcher", "dist_err_m", "orient_err_rad", "runtime_s", "status"}
-        if not need <= set(est.columns):
-            raise DatasetError(f"{est_path}: lacks column(s) {', '.join(sorted(need - set(est.columns)))}")
+    need = ("scan_id", "matcher", "dist_err_m", "orient_err_rad", "runtime_s", "status")
+    est = read_estimates(results, need) if est_path.is_file() else None
     all_ids = np.array([s.scan_id for s in scans])
     in_run = np.isin(all_ids, est["scan_id"].astype(str).unique()) if est is not None else np.ones(len(scans), bool)
     cpu = est is not None and "cpu_s" in est.columns and est["cpu_s"].notna().any()

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from tfloc.errors import ConfigError
+from tfloc.errors import ResultsError
 from tfloc.evaluation.metrics import prepare, summarize
 from tfloc.evaluation.outcome import Thresholds
 from tfloc.evaluation.paired import ALPHA, paired_table
@@ -28,7 +28,8 @@ from tfloc.evaluation.summary import (
     summary_table,
     write_summary,
 )
-from tfloc.io.estimates import COLUMNS, read_estimates
+from tfloc.io.estimates import read_estimates, status_kind
+from tfloc.io.text import parse_text
 
 from . import figures as F
 from . import sections as S
@@ -51,24 +52,51 @@ class ReportFiles:
 def load_run(run_dir: Path) -> tuple[pd.DataFrame, dict]:
     """The estimates and the ``run.json`` document (``{}`` when missing) of a run directory."""
     if not (run_dir / "estimates.csv").is_file():
-        raise ConfigError(f"{run_dir}: no estimates.csv (not a run directory? run 'tfloc bench' first)")
-    try:
-        df = read_estimates(run_dir)
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError) as exc:
-        raise ConfigError(f"{run_dir / 'estimates.csv'}: unreadable ({exc})") from None
-    missing = [c for c in COLUMNS if c not in df.columns and c not in ("score_est", "score_true", "info", "cpu_s")]
-    if missing:
-        raise ConfigError(f"{run_dir / 'estimates.csv'}: missing column(s) {', '.join(missing)}")
+        raise ResultsError(f"{run_dir}: no estimates.csv (not a run directory? run 'tfloc bench' first)")
+    df = read_estimates(run_dir)
     if df.empty:
-        raise ConfigError(f"{run_dir / 'estimates.csv'}: no results yet (no task of the run has finished)")
+        raise ResultsError(f"{run_dir / 'estimates.csv'}: no results yet (no task of the run has finished)")
     run_json = run_dir / "run.json"
-    try:
-        run = json.loads(run_json.read_text()) if run_json.is_file() else {}
-    except json.JSONDecodeError as exc:
-        raise ConfigError(f"{run_json}: not valid JSON ({exc})") from None
-    for c in ("status", "outcome", "group"):
-        df[c] = df[c].fillna("")
+    run = parse_text(run_json, ResultsError, "run.json file", json.loads, ValueError, "JSON") if run_json.is_file() else {}
+    _check_run(run, run_json)
     return df, run
+
+
+#: the run.json fields the report reads, and what each must be
+_RUN_FIELDS = {"config": dict, "git": dict, "machine": dict, "versions": dict, "datasets": dict, "sessions": list,
+               "config.success": dict, "config.matchers": list, "git.commit": (str, type(None)),
+               "git.dirty": (bool, type(None)), "config.name": str}
+
+
+def _finite_list(v: list) -> bool:
+    return bool(v) and all(isinstance(x, int | float) and not isinstance(x, bool) and abs(x) < 1e300 for x in v)
+
+
+def _check_run(run: object, path: Path) -> None:
+    """A ResultsError naming ``path`` and the field if ``run.json`` is not what the report reads."""
+    if not isinstance(run, dict):
+        raise ResultsError(f"{path}: expected a JSON object")
+    for name, kind in _RUN_FIELDS.items():
+        *parents, leaf = name.split(".")
+        doc = run
+        for p in parents:
+            doc = doc.get(p, {})
+        if leaf in doc and not isinstance(doc[leaf], kind):
+            raise ResultsError(f"{path}: field {name} is {type(doc[leaf]).__name__}, not the expected "
+                               f"{getattr(kind, '__name__', 'string or null')}")
+    ok = all(isinstance(v, str) for v in run.get("datasets", {}).values())
+    ok &= all(isinstance(v, dict) and isinstance(v.get("started", ""), str)
+              and all(isinstance(v.get(k) or [0], list) and _finite_list(v.get(k) or [0])
+                      for k in ("loadavg_start", "loadavg_end")) for v in run.get("sessions", []))
+    ok &= all(isinstance(m, dict) and isinstance(m.get("label"), str) and isinstance(m.get("name"), str)
+              and isinstance(m.get("params", {}), dict) for m in run.get("config", {}).get("matchers", []))
+    try:
+        thr = Thresholds.from_run(run)
+        ok &= thr.dist_m >= 0 and thr.orient_deg >= 0  # (NaN is not)
+    except (TypeError, ValueError, OverflowError):
+        ok = False
+    if not ok:
+        raise ResultsError(f"{path}: malformed datasets, sessions, config.matchers or config.success")
 
 
 def scan_to_scan_datasets(run: dict, names: list[str]) -> set[str]:
@@ -97,7 +125,7 @@ def header(run_dir: Path, run: dict, df: pd.DataFrame, thr: Thresholds, s2s: set
     lines = [f"# tfloc benchmark report: {cfg.get('name', run_dir.name)}\n",
              f"- Run directory: `{run_dir}`",
              f"- Report generated: {datetime.now(UTC).strftime('%Y-%m-%d %H:%M UTC')}",
-             f"- Run started: {sessions[0]['started'] if sessions else 'unknown'}"
+             f"- Run started: {sessions[0].get('started', 'unknown') if sessions else 'unknown'}"
              + (f" ({len(sessions)} sessions, resumed)" if len(sessions) > 1 else ""),
              f"- Commit: `{commit}`",
              f"- Machine: {mach.get('platform', '?')}, {mach.get('cpu_count', '?')} CPUs, Python "
@@ -118,7 +146,7 @@ def header(run_dir: Path, run: dict, df: pd.DataFrame, thr: Thresholds, s2s: set
         + (", scan-to-scan" if d in s2s else "") + ")" for d in df["dataset"].unique()))
     lines.append(f"- Success thresholds: distance error ≤ {thr.dist_m * 100:g} cm and orientation "
                  f"error ≤ {thr.orient_deg:g}°")
-    st = df["status"].where(~df["status"].str.startswith("error"), "error")
+    st = df["status"].map(lambda s: status_kind(s) or s)
     lines.append(f"- Rows: {len(df)} (" + ", ".join(f"{k}: {v}" for k, v in st.value_counts().items()) + ")")
     starts = [x.get("loadavg_start") for x in sessions]
     end = sessions[-1].get("loadavg_end") if sessions else None
@@ -167,7 +195,8 @@ def definitions(thr: Thresholds) -> str:
 - **Outcome** of each scan: `success`; `local-optimum` (the matcher's own objective is lower at
   the true pose than at its answer: the search stopped short); `ambiguous` (its objective prefers
   the wrong pose); `no-answer` (status `failed`: the matcher declined or returned no finite pose;
-  `timeout`; `error`).
+  `timeout`; `error`; `invalid`: the data poses no problem, e.g. the initial pose lies outside the
+  map, and no matcher ran; counted apart from errors).
 - **Which rows count**: error and improvement statistics use scans with an estimate (status `ok`,
   or `failed` with a finite pose). Timeouts, errors and failed scans without a pose have no error;
   they are **excluded** from those statistics (the `n` column says how many: "(k excl.)") but
@@ -266,6 +295,11 @@ def render(run_dir: Path, run: dict, p: pd.DataFrame, thr: Thresholds, s2s: set[
         parts.append(landscape)
     parts.append("## Tasks without an answer (timeouts, errors)\n")
     parts.append(S.failures(p))
+    if p["status"].str.startswith("invalid:").any():
+        parts.append("## Tasks the data cannot pose (invalid)\n")
+        parts.append("The scan's problem cannot be posed (e.g. its initial pose lies outside the map): no "
+                     "matcher ran. These count as no-answer in the success rate, not as errors.\n")
+        parts.append(S.invalid(p))
     if failures:
         parts.append("## Failure pictures\n")
         parts.append(failures)

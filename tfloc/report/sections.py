@@ -194,7 +194,7 @@ def runtime_only(g: pd.DataFrame) -> str:
 
 def failures(p: pd.DataFrame, limit: int = 5) -> str:
     """Timeouts and errors per matcher, with the most frequent error messages."""
-    bad = p[~p["status"].isin(["ok", "failed"])]
+    bad = p[~p["status"].isin(["ok", "failed"]) & ~p["status"].str.startswith("invalid:")]
     if bad.empty:
         return "No task timed out or raised an error.\n"
     out = []
@@ -219,3 +219,15 @@ def paired(t: pd.DataFrame) -> str:
 
 def _p(p: float) -> str:
     return "<1e-4" if p < 1e-4 else f"{p:.4f}"
+
+
+def invalid(p: pd.DataFrame, limit: int = 5) -> str:
+    """Tasks the data cannot pose (status ``invalid:``), per matcher, with their most frequent
+    reasons (the ``file:line:`` of each is left out, so that equal reasons count together)."""
+    bad = p[p["status"].str.startswith("invalid:")]
+    out = []
+    for matcher, g in bad.groupby("matcher", sort=True):
+        why = g["status"].str.slice(len("invalid:")).str.replace(r"^\S*:\d+: ", "", regex=True)
+        out.append(f"- `{matcher}`: {len(g)} task(s)\n" +
+                   "".join(f"  - {n} × `{s[:160]}`\n" for s, n in why.value_counts().head(limit).items()))
+    return "".join(out)

@@ -47,14 +47,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
 from tfloc.core.map import Map
-from tfloc.core.params import resolve_params
+from tfloc.core.params import Configured
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
-from tfloc.errors import ParameterError
 from tfloc.maps.grid import GridMap
 from tfloc.paper.shape import ShapeConfig, scan_turning_function
 from tfloc.paper.turning import match
@@ -117,6 +117,15 @@ class TfPlusConfig:
             seed and of the ``select="tf"`` Err; the resampling distance is 5 cm (the paper's
             S = 1 m gives edges too coarse for their directions to be a heading estimate).
     """
+
+    RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params)
+        "> 0": ("grid_step", "heading_step", "field_resolution", "field_truncation"),
+        ">= 0": ("search_radius", "clearance", "rotation_seeds", "max_rotation", "heading_span",
+                 "separation", "tie_tolerance", "wall_thickness", "coarse_points"),
+        ">= 1": ("scan_stride", "shortlist", "candidates", "min_returns"),
+        "finite": ("heading_offsets",),
+        ("residual", "virtual", "tf"): ("select",),
+        ("auto", "field", "virtual"): ("refine_to",)}
 
     tf_seed: bool = True
     heading_sweep: bool = True
@@ -209,17 +218,11 @@ def pick(cost: np.ndarray, poses: np.ndarray, vp: Pose, tie_tolerance: float) ->
     return int(tied[np.argmin(near)])
 
 
-class TurningFunctionPlusMatcher:
+class TurningFunctionPlusMatcher(Configured):
     """``tf-plus``: turning-function heading seed, coarse grid, point-to-line refinement."""
 
     name = "tf-plus"
-
-    def __init__(self, config: TfPlusConfig | None = None, **overrides) -> None:
-        self.config = resolve_params(TfPlusConfig, config, overrides)
-        if self.config.select not in ("residual", "virtual", "tf"):
-            raise ParameterError(f"select must be 'residual', 'virtual' or 'tf', not {self.config.select!r}")
-        if self.config.refine_to not in ("auto", "field", "virtual"):
-            raise ParameterError(f"refine_to must be 'auto', 'field' or 'virtual', not {self.config.refine_to!r}")
+    CONFIG = TfPlusConfig
 
     def prepare(self, problem: Problem) -> None:
         """Build the map's view, its pooled copy and the free-space test (once per map; untimed

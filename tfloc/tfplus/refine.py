@@ -47,6 +47,7 @@ real points ``p`` (sensor frame) to ``R(φ) p + t`` in the virtual pose's frame,
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -89,6 +90,11 @@ class RefineConfig:
         face_weight: weight of the surface residuals in phase 2 ...
         cell_weight: ... and of the cell residuals.
     """
+
+    RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params)
+        "> 0": ("gate_start", "gate_end", "inlier_distance"),
+        ">= 0": ("window", "damping", "prune_after"),
+        ">= 1": ("iterations", "inner", "keep")}
 
     iterations: int = 6
     inner: int = 2

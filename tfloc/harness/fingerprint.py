@@ -1,0 +1,128 @@
+"""A run is one configuration: the matchers built before the run, and the run's fingerprint.
+
+:func:`build_matchers` builds every matcher of a run once, in the calling process, before any
+task starts or any file is written: a misspelled parameter or a bad value stops the run with one
+line naming the configuration key (``x.toml: [params.csm-corr] search_radiuss: …``).
+
+:func:`fingerprint` is everything that decides a run's rows: a content hash (SHA-256) of each
+dataset's ``scans.csv``, ``scenario.json`` and map file(s), each matcher label with its *resolved*
+parameters (defaults included, so a changed default shows), the success thresholds and the tfloc
+version. ``run.json`` records it; a run directory is resumed only by a run with the same
+fingerprint (:func:`differences` says what changed). ``jobs``, ``timeout_s`` and
+``limit_per_group`` are not in it: they decide how many tasks run and how fast, not what a
+finished row holds (timed-out rows can be run again with ``--retry-errors``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+from tfloc.errors import ConfigError, MatcherError, ParameterError
+from tfloc.io.maps import map_files
+from tfloc.io.scenario import read_scenario
+
+from .config import MatcherSpec, RunConfig
+from .task import load_matcher
+
+
+def build_matcher(spec: MatcherSpec) -> dict[str, Any]:
+    """Build the matcher of ``spec`` (cached per process) and return its resolved parameters.
+
+    Raises :class:`ConfigError` naming the configuration key of a bad parameter."""
+    try:
+        m = load_matcher(spec.name, spec.params_json)
+    except ParameterError as exc:
+        key = spec.key_of(exc.names[0]) if exc.names else spec.where or f"matcher {spec.label}"
+        raise ConfigError(f"{key}: {exc}") from None
+    except MatcherError as exc:
+        raise ConfigError(f"{spec.where or 'matchers'}: {exc}") from None
+    except Exception as exc:  # noqa: BLE001 - a third-party factory may raise anything
+        raise ConfigError(f"{spec.where or 'matchers'}: matcher {spec.name!r} cannot be built with "
+                          f"{spec.params}: {type(exc).__name__}: {exc}") from None
+    cfg = getattr(m, "config", None)
+    if dataclasses.is_dataclass(cfg) and not isinstance(cfg, type):
+        return json.loads(json.dumps(dataclasses.asdict(cfg), default=str))
+    return spec.params
+
+
+def build_matchers(config: RunConfig) -> dict[str, dict[str, Any]]:
+    """Every matcher of the run built once: label → resolved parameters."""
+    return {m.label: {"name": m.name, "params": build_matcher(m)} for m in config.matchers}
+
+
+def _sha256(path: Path) -> str | None:
+    h = hashlib.sha256()
+    try:
+        with path.open("rb") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                h.update(block)
+    except OSError:
+        return None
+    return h.hexdigest()
+
+
+def dataset_hashes(path: Path) -> dict[str, Any]:
+    """Content hashes of a dataset's files (``map:<name>`` for its map file(s))."""
+    scenario = read_scenario(path)
+    out = {"scenario.json": _sha256(Path(path) / "scenario.json"), "scans.csv": _sha256(scenario.scans_path)}
+    for f in map_files(scenario.map_path):
+        out[f"map:{f.name}"] = _sha256(f)
+    return out
+
+
+def tfloc_version() -> str | None:
+    try:
+        return metadata.version("tfloc")
+    except metadata.PackageNotFoundError:
+        return None
+
+
+def fingerprint(config: RunConfig, matchers: dict[str, dict[str, Any]]) -> dict[str, Any]:
+    """What decides the rows of a run (see the module notes); JSON-serialisable."""
+    return {"tfloc": tfloc_version(),
+            "datasets": {read_scenario(d).name: dataset_hashes(d) for d in config.datasets},
+            "matchers": matchers, "success": config.success.to_dict()}
+
+
+def _flat(d: Any, prefix: str = "") -> dict[str, Any]:
+    if isinstance(d, dict) and d:
+        out: dict[str, Any] = {}
+        for k, v in d.items():
+            out.update(_flat(v, f"{prefix}.{k}" if prefix else str(k)))
+        return out
+    return {prefix: d}
+
+
+def _show(v: Any) -> str:
+    return "(none)" if v is None else json.dumps(v) if not isinstance(v, str) else v
+
+
+def differences(old: dict | None, new: dict) -> list[str]:
+    """What differs between a recorded fingerprint and a new one, one phrase per difference
+    (e.g. ``csm-corr: sigma 0.1 → 0.2``); empty when they are the same."""
+    if not isinstance(old, dict):
+        return ["the run records no fingerprint (made by an older tfloc, or run.json is missing)"]
+    out = []
+    if old.get("tfloc") != new["tfloc"]:
+        out.append(f"tfloc {_show(old.get('tfloc'))} → {_show(new['tfloc'])}")
+    for what, key in (("dataset", "datasets"), ("matcher", "matchers")):
+        a, b = old.get(key) or {}, new[key]
+        out += [f"{what} {k} added" for k in b if k not in a]
+        out += [f"{what} {k} removed" for k in a if k not in b]
+        for k in (k for k in b if k in a and a[k] != b[k]):
+            fa, fb = _flat(a[k]), _flat(b[k])
+            changed = [f for f in dict.fromkeys([*fb, *fa]) if fa.get(f) != fb.get(f)]
+            if what == "dataset":
+                out.append(f"dataset {k}: {', '.join(c.removeprefix('map:') for c in changed)} changed")
+            else:
+                out += [f"{k}: {c.removeprefix('params.')} {_show(fa.get(c))} → {_show(fb.get(c))}"
+                        for c in changed]
+    for k, v in new["success"].items():
+        if (old.get("success") or {}).get(k) != v:
+            out.append(f"success {k} {_show((old.get('success') or {}).get(k))} → {_show(v)}")
+    return out
