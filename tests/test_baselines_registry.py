@@ -145,3 +145,26 @@ def test_missing_matcher_module_is_not_blamed_on_a_library(monkeypatch: pytest.M
     monkeypatch.setitem(registry._registry(), "ghost", "tfloc.baselines.no_such_module:Ghost")
     with pytest.raises(registry.MatcherError, match="its module 'tfloc.baselines.no_such_module' is not part"):
         registry.get_matcher("ghost")
+
+
+_RUN = """
+import sys
+sys.modules["karto_scanmatcher"] = None  # as on Python >= 3.12, where it has no wheel
+from pathlib import Path
+from tfloc.harness.config import MatcherSpec, RunConfig
+from tfloc.harness.runner import run
+from tfloc.io.estimates import read_estimates
+cfg = RunConfig("t", Path({out!r}), (Path({data!r}),), (MatcherSpec.make("karto"), MatcherSpec.make("csm-corr")),
+                jobs=1, limit_per_group=1)
+print(sorted(set(read_estimates(run(cfg, progress=False)).matcher)))
+"""
+
+
+def test_a_run_leaves_out_a_matcher_whose_library_is_missing(tmp_path: Path) -> None:
+    """karto without its library (Python ≥ 3.12): one line says why, every other matcher runs."""
+    code = _RUN.format(out=str(tmp_path / "run"), data=str(ROOT / "data" / "scenarios" / "detail-1"))
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip().splitlines()[-1] == "['csm-corr']"
+    left_out = [line for line in proc.stderr.splitlines() if "left out" in line]
+    assert len(left_out) == 1 and "karto" in left_out[0] and "Python 3.8-3.11 only" in left_out[0]

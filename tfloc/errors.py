@@ -31,6 +31,10 @@ class MatcherError(TflocError):
     """A matcher is unknown, misconfigured or its optional library is missing."""
 
 
+class LibraryMissingError(MatcherError):
+    """A matcher's library is not installed (or fails to import); a run leaves that matcher out."""
+
+
 class ParameterError(MatcherError):
     """A matcher parameter is unknown or has a bad value.
 

@@ -15,7 +15,7 @@ from functools import cache
 from importlib.metadata import entry_points
 from typing import Any, Protocol, runtime_checkable
 
-from tfloc.errors import MatcherError, ParameterError
+from tfloc.errors import LibraryMissingError, MatcherError, ParameterError
 
 from .pose import Pose
 from .problem import Estimate, Problem
@@ -67,7 +67,7 @@ def get_matcher(name: str, **params: Any) -> Matcher:
         if missing and (module == missing or module.startswith(missing + ".")):
             raise MatcherError(f"matcher {name!r}: its module {module!r} is not part of this installation") from None
         lib = f"the library {missing.partition('.')[0]!r}" if missing else "a library"
-        raise MatcherError(
+        raise LibraryMissingError(
             f"matcher {name!r} needs {lib}, which is not installed or failed to import: {exc} "
             f"(install the project with its dependencies: pip install -e .)") from None
     try:

@@ -22,7 +22,7 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
-from tfloc.errors import ConfigError, MatcherError, ParameterError
+from tfloc.errors import ConfigError, LibraryMissingError, MatcherError, ParameterError
 from tfloc.io.maps import map_files
 from tfloc.io.scenario import read_scenario
 
@@ -53,6 +53,26 @@ def build_matcher(spec: MatcherSpec) -> dict[str, Any]:
 def build_matchers(config: RunConfig) -> dict[str, dict[str, Any]]:
     """Every matcher of the run built once: label → resolved parameters."""
     return {m.label: {"name": m.name, "params": build_matcher(m)} for m in config.matchers}
+
+
+def available(config: RunConfig, log=None) -> RunConfig:
+    """``config`` without the matchers whose library is not installed (e.g. ``karto`` on Python
+    ≥ 3.12, where its library has no wheel), each left out with one line to ``log``; the other
+    matchers still run. Raises :class:`ConfigError` if none is left."""
+    keep = []
+    for m in config.matchers:
+        try:
+            load_matcher(m.name, m.params_json)
+        except LibraryMissingError as exc:
+            if log is not None:
+                log(f"matcher {m.label} left out of this run: {exc}")
+            continue
+        except Exception:  # noqa: BLE001 - build_matcher reports every other problem
+            pass
+        keep.append(m)
+    if not keep:
+        raise ConfigError(f"run {config.name!r}: no matcher of the run can be built here")
+    return config if len(keep) == len(config.matchers) else config.with_overrides(matchers=tuple(keep))
 
 
 def _sha256(path: Path) -> str | None:

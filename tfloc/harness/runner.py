@@ -35,7 +35,7 @@ from tfloc.io.estimates import ResultWriter, done_keys, drop_rows, sync_dir
 from tfloc.io.scenario import iter_scans, read_scenario
 
 from .config import RunConfig
-from .fingerprint import build_matchers, differences, fingerprint
+from .fingerprint import available, build_matchers, differences, fingerprint
 from .task import Task, failure_row, run_task, warm_up
 from .threads import limit_threads
 
@@ -200,6 +200,7 @@ def run(config: RunConfig, progress: bool | None = None, executor: Executor = ex
     interruptions. With ``retry_errors``, rows whose status is ``error:…`` or ``timeout`` are
     removed (the file is rewritten atomically) and their tasks run again.
     """
+    config = available(config, log=lambda line: print(line, file=sys.stderr))
     out = Path(config.out)
     fp = fingerprint(config, build_matchers(config))
     tasks = make_tasks(config)
