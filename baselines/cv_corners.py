@@ -51,7 +51,7 @@ Configuration choices and why:
 * **Re-simulation**: the virtual scan is ray-cast again at the new estimate and the match repeated
   (up to ``max_iterations`` = 6; ``converged`` when a step moves < 5 mm and < 0.05°). As the two
   viewpoints coincide, both corner sets see the same occlusions and field-of-view ends.
-* Choices measured on the quick test-room check (``benchmarks/baselines_quick.py``, 90 problems,
+* Choices measured on the quick test-room check (90 problems; a script of the first session, since replaced by the harness's run configurations;
   0–3 m / 0–15°): with the hypothesis window restricted to ±3° / 0.3 m after the first step
   success was 70 %, with the full window at every step 78 % (so the full window is kept);
   ``corner_spacing`` 2 cm vs 5 cm: 78 % vs 80 % and median 17 vs 12 ms per scan, 2 cm kept

@@ -85,3 +85,20 @@ grid = {{ sleep_s = [0.0, 0.001] }}
     assert all(f.is_file() for f in files.figures)
     cfg = json.loads((out / "run.json").read_text())["config"]
     assert [m["params"] for m in cfg["matchers"]] == [{"sleep_s": 0.0}, {"sleep_s": 0.001}]
+
+
+def test_a_dataset_entry_may_skip_the_first_scans_of_each_group(tmp_path):
+    """A held-out selection: the scans after the first N of each group (a development split)."""
+    from tfloc.harness.runner import make_tasks
+
+    pool = Path(__file__).resolve().parents[1] / "data" / "scenarios" / "office-pool"
+    path = tmp_path / "held-out.toml"
+    path.write_text(f'matchers = ["csm-corr"]\ndatasets = [{{ path = "{pool}", skip_per_group = 178 }}]\n')
+    cfg = load_config(path)
+    ids = [t.scan_id for t in make_tasks(cfg)]
+    assert len(ids) == 9 * 2 and all(i.endswith(("-178", "-179")) for i in ids)
+    limited = make_tasks(cfg.with_overrides(limit_per_group=1))
+    assert [t.scan_id for t in limited] == [i for i in ids if i.endswith("-178")]
+    with pytest.raises(ConfigError, match=r"datasets\[0\]\.skip_per_group must be a whole number"):
+        path.write_text(f'matchers = ["tf"]\ndatasets = [{{ path = "{pool}", skip_per_group = -1 }}]\n')
+        load_config(path)

@@ -5,6 +5,8 @@ A run configuration file looks like::
     name = "paper-protocol"
     out = "results/paper-protocol"          # relative paths are relative to where tfloc runs
     datasets = ["data/scenarios/office-pool", "data/scenarios/detail-1"]
+    # a dataset may be a table: { path = "...", skip_per_group = 40 } skips the first 40 scans of
+    # each of its groups (a held-out selection after a development split)
     matchers = ["tf", "csm-corr", { label = "tf-S0.5", name = "tf", params = { spacing = 0.5 } }]
     jobs = 2                 # worker processes
     timeout_s = 60           # per (scan, matcher) task
@@ -82,7 +84,13 @@ class RunConfig:
     timeout_s: float = 60.0
     limit_per_group: int = 0
     success: Thresholds = Thresholds()
+    skip_per_group: tuple[tuple[str, int], ...] = ()
     extra: dict = field(default_factory=dict, compare=False)
+
+    def skip(self, dataset: Path) -> int:
+        """How many of the first scans of each group of ``dataset`` the run skips (a held-out
+        selection: the scans after a development split)."""
+        return dict(self.skip_per_group).get(str(dataset), 0)
 
     def __post_init__(self) -> None:
         if not self.datasets:
@@ -92,7 +100,8 @@ class RunConfig:
         labels = [m.label for m in self.matchers]
         if len(set(labels)) != len(labels):
             raise ConfigError(f"run {self.name!r}: duplicate matcher labels {labels}")
-        if self.jobs < 1 or self.timeout_s <= 0 or self.limit_per_group < 0:
+        if self.jobs < 1 or self.timeout_s <= 0 or self.limit_per_group < 0 or any(
+                n < 0 for _, n in self.skip_per_group):
             raise ConfigError(f"run {self.name!r}: jobs ≥ 1, timeout_s > 0 and limit_per_group ≥ 0 required")
 
     def with_overrides(self, **kw: Any) -> RunConfig:
@@ -102,6 +111,7 @@ class RunConfig:
         return {"name": self.name, "out": str(self.out), "datasets": [str(d) for d in self.datasets],
                 "matchers": [{"label": m.label, "name": m.name, "params": m.params} for m in self.matchers],
                 "jobs": self.jobs, "timeout_s": self.timeout_s, "limit_per_group": self.limit_per_group,
+                **({"skip_per_group": dict(self.skip_per_group)} if self.skip_per_group else {}),
                 "success": self.success.to_dict(), **self.extra}
 
 
@@ -185,6 +195,24 @@ def check_imports(config: RunConfig, allow: bool) -> None:
                           "configuration, give --allow-import")
 
 
+def _skips(entries: list, where: str) -> tuple[tuple[str, int], ...]:
+    """``skip_per_group`` of dataset entries given as tables ``{path, skip_per_group}``."""
+    out = []
+    for i, d in enumerate(entries):
+        if isinstance(d, dict):
+            unknown = sorted(set(d) - {"path", "skip_per_group"})
+            if unknown or not isinstance(d.get("path"), str):
+                raise ConfigError(f"{where}: datasets[{i}] must be a path or a table {{path, skip_per_group}}"
+                                  + (f" (unknown key(s) {', '.join(unknown)})" if unknown else ""))
+            n = d.get("skip_per_group", 0)
+            if isinstance(n, bool) or not isinstance(n, int) or n < 0:
+                raise ConfigError(f"{where}: datasets[{i}].skip_per_group must be a whole number ≥ 0, got {n!r}")
+            out.append((d["path"], n))
+        elif not isinstance(d, str):
+            raise ConfigError(f"{where}: datasets[{i}] must be a path or a table {{path, skip_per_group}}")
+    return tuple(out)
+
+
 def load_config(path: str | Path) -> RunConfig:
     """Read a run configuration TOML file; errors name the file and the key."""
     path = Path(path)
@@ -204,7 +232,8 @@ def load_config(path: str | Path) -> RunConfig:
         return RunConfig(
             name=str(doc.get("name", path.stem)),
             out=Path(doc.get("out", f"results/{doc.get('name', path.stem)}")),
-            datasets=tuple(Path(d) for d in doc["datasets"]),
+            datasets=tuple(Path(d["path"] if isinstance(d, dict) else d) for d in doc["datasets"]),
+            skip_per_group=_skips(doc["datasets"], str(path)),
             matchers=parse_matchers(doc["matchers"], doc.get("params", {}), str(path))
             + expand_sweeps(doc.get("sweep", []), doc.get("params", {}), str(path)),
             jobs=int(doc.get("jobs", 2)), timeout_s=float(doc.get("timeout_s", 60.0)),

@@ -49,9 +49,10 @@ def make_tasks(config: RunConfig) -> list[Task]:
     for d in config.datasets:
         scenario = read_scenario(d)
         per_group: dict[str, int] = {}
+        skip = config.skip(d)
         for scan in iter_scans(scenario):
             n = per_group[scan.group] = per_group.get(scan.group, 0) + 1
-            if config.limit_per_group and n > config.limit_per_group:
+            if n <= skip or (config.limit_per_group and n - skip > config.limit_per_group):
                 continue
             for m in config.matchers:
                 tasks.append(Task(str(d), scenario.name, scan.scan_id, m.label, m.name, m.params_json,
