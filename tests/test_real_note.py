@@ -33,11 +33,15 @@ def test_note_uses_estimates_and_falls_back_to_the_guess(tmp_path: Path) -> None
     rows += [{"dataset": "real-csail-relations", "scan_id": i, "matcher": "broken", "dist_err_m": np.nan, "orient_err_rad": np.nan,
               "runtime_s": np.nan, "status": "error:boom"} for i in ids]
     pd.DataFrame(rows).to_csv(tmp_path / "estimates.csv", index=False)
-    text = write_note(tmp_path, DATASET).read_text()
+    text = write_note(tmp_path, [DATASET]).read_text()
     line = next(s for s in text.splitlines() if s.startswith("| `exact`"))
-    assert "| 1172 | 0.000 ± 0.000 | 0.00 |" in line and "100.0 %" in line
+    n = sum(not s.group.endswith("no-overlap") for s in scans)  # the first table: overlapping relations
+    assert f"| {n} | 0.000 ± 0.000 | 0.00 |" in line and "| 100.0 [" in line
     odo = next(s for s in text.splitlines() if s.startswith("| odometry"))
     broken = next(s for s in text.splitlines() if s.startswith("| `broken`"))
-    assert "1172 not answered" in broken
+    assert f"{n} not answered" in broken
     assert broken.split("|")[3:8] == odo.split("|")[3:8]  # fell back to the odometry guess
     assert "Not like for like" in text
+    both = write_note(tmp_path, [DATASET, DATASET.parent / "real-csail-relations-perturbed"]).read_text()
+    assert "## Protocol: odometry" in both and "## Protocol: perturbation" in both
+    assert "### relations whose scans barely overlap (reported apart)" in both

@@ -301,7 +301,7 @@ def test_every_command_reads_a_damaged_estimates_csv_alike(tmp_path, test_room, 
 
     for command in (lambda: write_report(tmp_path / "run", with_figures=False),
                     lambda: export_tum(tmp_path / "run", tmp_path / "tum"),
-                    lambda: write_note(tmp_path / "run", ROOT / "data" / "scenarios" / "detail-1"),
+                    lambda: write_note(tmp_path / "run", [ROOT / "data" / "scenarios" / "detail-1"]),
                     lambda: run(c, progress=False)):
         with pytest.raises(ResultsError, match=message):
             command()

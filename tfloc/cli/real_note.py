@@ -13,8 +13,9 @@ HELP = "write the MIT CSAIL relations note (relation errors vs published figures
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("results", type=Path, help="run directory (with estimates.csv), e.g. results/real-csail-relations")
-    parser.add_argument("--dataset", type=Path, default=Path("data/scenarios/real-csail-relations"),
-                        help="the relations dataset (default: data/scenarios/real-csail-relations)")
+    parser.add_argument("--dataset", type=Path, action="append", dest="datasets",
+                        help="a relations dataset, one per initial-guess protocol (repeatable; default: "
+                             "data/scenarios/real-csail-relations and real-csail-relations-perturbed)")
     parser.add_argument("--max-dist-cm", type=float, default=10.0, help="success threshold (default 10 cm)")
     parser.add_argument("--max-angle-deg", type=float, default=2.0, help="success threshold (default 2°)")
 
@@ -23,5 +24,7 @@ def run(args: argparse.Namespace) -> int:
     from tfloc.evaluation.outcome import Thresholds
     from tfloc.report.relations_note import write_note
 
-    print(write_note(args.results, args.dataset, Thresholds(args.max_dist_cm / 100.0, args.max_angle_deg)))
+    datasets = args.datasets or [Path("data/scenarios/real-csail-relations"),
+                                 Path("data/scenarios/real-csail-relations-perturbed")]
+    print(write_note(args.results, datasets, Thresholds(args.max_dist_cm / 100.0, args.max_angle_deg)))
     return 0
