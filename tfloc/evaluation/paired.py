@@ -33,12 +33,15 @@ def success_matrix(p: pd.DataFrame) -> pd.DataFrame:
     return s.pivot_table(index=["dataset", "scan_id"], columns="matcher", values="_ok", aggfunc="first")
 
 
-def paired_comparisons(p: pd.DataFrame, alpha: float = ALPHA) -> pd.DataFrame:
+def paired_comparisons(p: pd.DataFrame, alpha: float = ALPHA, reference: str | None = None) -> pd.DataFrame:
     """One row per pair of matchers (``a`` before ``b`` alphabetically) on their common scans,
-    columns :data:`PAIRED_COLUMNS` (percentages in percent, ``diff`` = a − b)."""
+    columns :data:`PAIRED_COLUMNS` (percentages in percent, ``diff`` = a − b). With a
+    ``reference`` (a parameter sweep of many labels), only the pairs (reference, other)."""
     m = success_matrix(p)
     rows = []
-    for a, b in itertools.combinations(sorted(m.columns), 2):
+    pairs = (itertools.combinations(sorted(m.columns), 2) if reference is None else
+             [(reference, b) for b in m.columns if b != reference and reference in m.columns])
+    for a, b in pairs:
         both = m[[a, b]].dropna()
         if both.empty:
             continue
@@ -55,14 +58,16 @@ def paired_comparisons(p: pd.DataFrame, alpha: float = ALPHA) -> pd.DataFrame:
     return out
 
 
-def paired_table(p: pd.DataFrame, scan_to_scan: set[str] = frozenset()) -> pd.DataFrame:
+def paired_table(p: pd.DataFrame, scan_to_scan: set[str] = frozenset(),
+                 reference: str | None = None) -> pd.DataFrame:
     """:func:`paired_comparisons` per dataset, and over all scan-to-map datasets pooled when the
     run has more than one (column ``dataset``; ``all`` for the pooled rows)."""
     t = p[p["truth"]]
-    parts = [paired_comparisons(g).assign(dataset=d) for d, g in t.groupby("dataset", sort=False)]
+    parts = [paired_comparisons(g, reference=reference).assign(dataset=d)
+             for d, g in t.groupby("dataset", sort=False)]
     s2m = t[~t["dataset"].isin(scan_to_scan)]
     if s2m["dataset"].nunique() > 1:
-        parts.append(paired_comparisons(s2m).assign(dataset="all"))
+        parts.append(paired_comparisons(s2m, reference=reference).assign(dataset="all"))
     parts = [x for x in parts if len(x)]
     if not parts:
         return pd.DataFrame(columns=["dataset", *PAIRED_COLUMNS])

@@ -49,6 +49,10 @@ class ReportFiles:
     figures: tuple[Path, ...]
 
 
+#: With more matchers than this (a parameter sweep), pairs are compared with the run's first
+#: matcher only, and only its failures are drawn.
+MANY_MATCHERS = 12
+
 def load_run(run_dir: Path) -> tuple[pd.DataFrame, dict]:
     """The estimates and the ``run.json`` document (``{}`` when missing) of a run directory."""
     if not (run_dir / "estimates.csv").is_file():
@@ -250,9 +254,11 @@ def _scan_to_map_tables(t: pd.DataFrame) -> list[str]:
 
 
 def _paired_section(pt: pd.DataFrame) -> list[str]:
+    sweep = pt["a"].nunique() == 1 and pt["b"].nunique() > MANY_MATCHERS - 1
     out = ["## Paired comparisons (same scans)\n",
-           "Success of every pair of matchers scan by scan (see Definitions; `paired.csv` has every "
-           "row). Difference = a − b in percentage points.\n"]
+           ("Success of every label against the run's first, " if sweep else
+            "Success of every pair of matchers ") + "scan by scan (see Definitions; `paired.csv` has "
+           "every row). Difference = a − b in percentage points.\n"]
     for d, g in pt.groupby("dataset", sort=False):
         out.append(f"### {'scan-to-map datasets pooled' if d == 'all' else d}\n")
         out.append(S.paired(g))
@@ -318,7 +324,10 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
     p = prepare(df, thr)
     s2s = scan_to_scan_datasets(run, list(p["dataset"].unique()))
     summary = write_summary(summary_table(p, s2s), run_dir / "summary.csv")
-    pt = paired_table(p, s2s)
+    order = [m.get("label", m.get("name")) for m in run.get("config", {}).get("matchers", [])]
+    order = [m for m in order if m in set(p["matcher"])] or sorted(p["matcher"].unique())
+    sweep = len(order) > MANY_MATCHERS  # a parameter sweep: compare each label with the first only
+    pt = paired_table(p, s2s, reference=order[0] if sweep else None)
     pt.to_csv(run_dir / "paired.csv", index=False, float_format="%.6g")
     figs: list[Path] = []
     failures = landscape = ""
@@ -329,7 +338,8 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
                 F.fig_basin(p, fd / "basin.png", s2s), F.fig_cdf(p, fd / "error_cdf.png", thr),
                 F.fig_runtime(p, fd / "runtime.png"), F.fig_outcomes(p, fd / "outcomes.png", s2s)]
         figs = [f for f in made if f is not None]
-        failures = failures_section(draw_failures(run_dir, p, run.get("datasets", {})))
+        drawn = p[p["matcher"] == order[0]] if sweep else p
+        failures = failures_section(draw_failures(run_dir, drawn, run.get("datasets", {})))
         landscape = landscape_section(*draw_landscapes(run_dir, p, run.get("datasets", {})))
     report = run_dir / "report.md"
     report.write_text(render(run_dir, run, p, thr, s2s, figs, pt, failures, landscape))
