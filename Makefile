@@ -6,7 +6,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.tfloc-installed
 JOBS   ?= 2
 
-.PHONY: install quick bench test test-unit timing lint clean-venv real-data fuzz chaos
+.PHONY: install quick bench ablation-real test test-unit timing lint clean-venv real-data fuzz chaos
 
 $(STAMP): pyproject.toml
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -25,7 +25,8 @@ quick: $(STAMP)
 	$(BIN)/tfloc report results/paper-protocol-quick
 
 ## The main job: every registered matcher on the bundled scenarios, a side-by-side timing pass
-## of each run (timing.md), and the reports.
+## of each run (timing.md), and the reports; then the reading study of the paper's method and the
+## tf-plus ablation. About an hour on 2 cores (README).
 bench: $(STAMP)
 	$(BIN)/tfloc bench benchmarks/paper-protocol.toml --jobs $(JOBS) --regenerate
 	$(BIN)/tfloc timing results/paper-protocol
@@ -37,6 +38,16 @@ bench: $(STAMP)
 	$(BIN)/tfloc bench benchmarks/real-scan-to-map.toml --jobs $(JOBS) --regenerate
 	$(BIN)/tfloc timing results/real-scan-to-map
 	$(BIN)/tfloc report results/real-scan-to-map
+	$(BIN)/tfloc bench benchmarks/tf-readings.toml --jobs $(JOBS) --regenerate
+	$(BIN)/tfloc report results/tf-readings
+	$(BIN)/tfloc bench benchmarks/tf-readings-heldout.toml --jobs $(JOBS) --regenerate
+	$(BIN)/tfloc report results/tf-readings-heldout
+	$(BIN)/tfloc bench benchmarks/tfplus-ablation.toml --jobs $(JOBS) --regenerate
+	$(BIN)/tfloc report results/tf-plus-ablation
+
+## tf-plus's per-stage ablation on the real logs (results/tf-plus-ablation-real.md; ~20 min).
+ablation-real: $(STAMP)
+	OMP_NUM_THREADS=1 $(BIN)/python benchmarks/tfplus_ablation_real.py --thicken 0 1 2
 
 ## Rebuild the real-log datasets and grid maps from data/real/ (deterministic).
 real-data: $(STAMP)
