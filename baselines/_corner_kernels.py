@@ -15,6 +15,31 @@ from numba import njit
 
 
 @njit(cache=True, nogil=True)
+def _agreeing(lb_sorted: np.ndarray, length: float, length_tol: float) -> tuple[int, int]:
+    """The pairs ``[lo, hi)`` of b (``lb_sorted``: lengths ascending) whose length agrees with
+    ``length`` within ``length_tol``."""
+    lo = np.searchsorted(lb_sorted, length - length_tol, side="left")
+    hi = np.searchsorted(lb_sorted, length + length_tol, side="right")
+    return lo, hi
+
+
+@njit(cache=True, nogil=True)
+def _pair_transform(anga: np.ndarray, ma: np.ndarray, p: int, angb: np.ndarray, mb: np.ndarray,
+                    q: int, max_angle: float, shift2: float) -> tuple[bool, float, float, float, float, float]:
+    """The rigid transform mapping pair ``p`` of a onto pair ``q`` of b (see
+    :func:`pair_transforms`): whether it lies outside the window (``|theta| > max_angle`` or
+    ``‖t‖² > shift2``), ``theta`` (wrapped), its cosine and sine, and ``t``."""
+    d = angb[q] - anga[p]
+    d = (d + math.pi) % (2.0 * math.pi) - math.pi
+    if abs(d) > max_angle:
+        return True, d, 0.0, 0.0, 0.0, 0.0
+    c, s = math.cos(d), math.sin(d)
+    tx = mb[q, 0] - (c * ma[p, 0] - s * ma[p, 1])
+    ty = mb[q, 1] - (s * ma[p, 0] + c * ma[p, 1])
+    return tx * tx + ty * ty > shift2, d, c, s, tx, ty
+
+
+@njit(cache=True, nogil=True)
 def pair_transforms(la: np.ndarray, anga: np.ndarray, ma: np.ndarray,
                     lb_sorted: np.ndarray, angb: np.ndarray, mb: np.ndarray,
                     length_tol: float, max_angle: float, max_shift: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -35,17 +60,10 @@ def pair_transforms(la: np.ndarray, anga: np.ndarray, ma: np.ndarray,
     h = 0
     shift2 = max_shift * max_shift
     for p in range(pa):
-        lo = np.searchsorted(lb_sorted, la[p] - length_tol, side="left")
-        hi = np.searchsorted(lb_sorted, la[p] + length_tol, side="right")
+        lo, hi = _agreeing(lb_sorted, la[p], length_tol)
         for q in range(lo, hi):
-            d = angb[q] - anga[p]
-            d = (d + math.pi) % (2.0 * math.pi) - math.pi
-            if abs(d) > max_angle:
-                continue
-            c, s = math.cos(d), math.sin(d)
-            tx = mb[q, 0] - (c * ma[p, 0] - s * ma[p, 1])
-            ty = mb[q, 1] - (s * ma[p, 0] + c * ma[p, 1])
-            if tx * tx + ty * ty > shift2:
+            outside, d, _, _, tx, ty = _pair_transform(anga, ma, p, angb, mb, q, max_angle, shift2)
+            if outside:
                 continue
             if h == cap:
                 cap *= 2
@@ -195,18 +213,11 @@ def adaptive_search(a: np.ndarray, b: np.ndarray, la: np.ndarray, anga: np.ndarr
         if drawn >= need or scored >= max_hypotheses:
             break
         drawn += 1
-        lo = np.searchsorted(lb_sorted, la[p] - length_tol, side="left")
-        hi = np.searchsorted(lb_sorted, la[p] + length_tol, side="right")
+        lo, hi = _agreeing(lb_sorted, la[p], length_tol)
         improved = False
         for q in range(lo, hi):
-            d = angb[q] - anga[p]
-            d = (d + math.pi) % (2.0 * math.pi) - math.pi
-            if abs(d) > max_angle:
-                continue
-            c, s = math.cos(d), math.sin(d)
-            tx = mb[q, 0] - (c * ma[p, 0] - s * ma[p, 1])
-            ty = mb[q, 1] - (s * ma[p, 0] + c * ma[p, 1])
-            if tx * tx + ty * ty > shift2:
+            outside, d, c, s, tx, ty = _pair_transform(anga, ma, p, angb, mb, q, max_angle, shift2)
+            if outside:
                 continue
             if scored >= max_hypotheses:
                 break

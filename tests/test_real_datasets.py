@@ -11,7 +11,14 @@ import numpy as np
 import pytest
 
 from tfloc.core.pose import angdiff
-from tfloc.datasets.real import ACES_LASER, ACES_NO_RETURN_M, INTEL_LASER, build_all, clean_ranges
+from tfloc.datasets.real import (
+    ACES_LASER,
+    ACES_NO_RETURN_M,
+    INTEL_LASER,
+    NO_RETURN_M,
+    build_all,
+    clean_ranges,
+)
 from tfloc.datasets.relations import build_relations, overlap
 from tfloc.io.carmen import read_carmen
 from tfloc.io.scenario import map_for, read_scans, read_scenario
@@ -33,27 +40,19 @@ def _spacing_analysis():
     return mod
 
 
-def test_intel_spacing_decision_recomputed_on_a_subset() -> None:
-    """data/real/intel/SPACING.md: 1° from -90° lines the corrected scans up best."""
-    log = read_carmen(DATA / "real" / "intel" / "intel-corrected.log.gz")
-    R = np.vstack([clean_ranges(s.ranges) for s in log.lasers[:300]])
+@pytest.mark.parametrize(("log_file", "no_return", "laser"), [
+    ("intel/intel-corrected.log.gz", NO_RETURN_M, INTEL_LASER),
+    ("aces/aces-corrected.log.gz", ACES_NO_RETURN_M, ACES_LASER),
+], ids=["intel", "aces"])
+def test_spacing_decision_recomputed_on_a_subset(log_file: str, no_return: float, laser) -> None:
+    """data/real/{intel,aces}/SPACING.md: 1° from -90° lines the corrected scans up best."""
+    log = read_carmen(DATA / "real" / log_file)
+    R = np.vstack([clean_ranges(s.ranges, no_return) for s in log.lasers[:300]])
     P = log.poses()[:300]
     spacing = _spacing_analysis()
     scores = spacing.compare(R, P, spacing.intel_candidates(50.0))
     assert scores[0].label == "1deg-from-90"
-    assert scores[0].laser == INTEL_LASER
-    assert scores[0].mean_clipped < 0.97 * scores[1].mean_clipped
-
-
-def test_aces_spacing_decision_recomputed_on_a_subset() -> None:
-    """data/real/aces/SPACING.md: 1° from -90° lines the corrected ACES scans up best too."""
-    log = read_carmen(DATA / "real" / "aces" / "aces-corrected.log.gz")
-    R = np.vstack([clean_ranges(s.ranges, ACES_NO_RETURN_M) for s in log.lasers[:300]])
-    P = log.poses()[:300]
-    spacing = _spacing_analysis()
-    scores = spacing.compare(R, P, spacing.intel_candidates(50.0))
-    assert scores[0].label == "1deg-from-90"
-    assert scores[0].laser == ACES_LASER
+    assert scores[0].laser == laser
     assert scores[0].mean_clipped < 0.97 * scores[1].mean_clipped
 
 

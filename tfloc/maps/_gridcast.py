@@ -45,6 +45,18 @@ def _start(x0: float, y0: float, dx: float, dy: float, t0: float, W: int, H: int
 
 
 @njit(cache=True, nogil=True)
+def _step(i: int, j: int, sx: int, sy: int, tdx: float, tdy: float, tx: float, ty: float,
+          W: int, H: int):
+    """One DDA step into the next cell across the nearer of the crossings ``(tx, ty)``: the new
+    ``(i, j, tx, ty)`` and whether that cell lies inside the ``W × H`` grid."""
+    if tx < ty:
+        i += sx
+        return i, j, tx + tdx, ty, 0 <= i < W
+    j += sy
+    return i, j, tx, ty + tdy, 0 <= j < H
+
+
+@njit(cache=True, nogil=True)
 def _march(occ: np.ndarray, x0: float, y0: float, dx: float, dy: float, tmax: float) -> float:
     """Distance (cell units) along the unit ray to the first occupied cell, ``inf`` if none before
     ``tmax``. The hit is the midpoint of the ray's chord through that cell (an unbiased estimate of
@@ -62,16 +74,9 @@ def _march(occ: np.ndarray, x0: float, y0: float, dx: float, dy: float, tmax: fl
             hit = 0.5 * (t + tn)
             return hit if hit <= tmax else np.inf
         t = tn
-        if tx < ty:
-            tx += tdx
-            i += sx
-            if i < 0 or i >= W:
-                break
-        else:
-            ty += tdy
-            j += sy
-            if j < 0 or j >= H:
-                break
+        i, j, tx, ty, inside = _step(i, j, sx, sy, tdx, tdy, tx, ty, W, H)
+        if not inside:
+            break
     return np.inf
 
 
@@ -117,15 +122,7 @@ def carve_grid(passes: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> None
             if i == ie and j == je:
                 break
             passes[j, i] += 1
-            if tx < ty:
-                t = tx
-                tx += tdx
-                i += sx
-                if i < 0 or i >= W:
-                    break
-            else:
-                t = ty
-                ty += tdy
-                j += sy
-                if j < 0 or j >= H:
-                    break
+            t = tx if tx < ty else ty
+            i, j, tx, ty, inside = _step(i, j, sx, sy, tdx, tdy, tx, ty, W, H)
+            if not inside:
+                break

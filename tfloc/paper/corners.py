@@ -80,33 +80,6 @@ def _resample_into(points: np.ndarray, spacing: float, out: np.ndarray) -> int:
 
 
 @njit(cache=True, nogil=True)
-def resample(points: np.ndarray, spacing: float) -> np.ndarray:
-    """Algorithm 1: walk along ``points`` ``(N, 2)`` and emit points exactly ``spacing`` metres
-    apart (chord length from the last emitted point towards the next input point).
-
-    Returns ``(M, 2)``; the first input point is always kept, and the last input point is
-    appended when it lies more than ``spacing/2`` beyond the last emitted point. As written,
-    the walk follows chords, not the input path, so it cuts corners by up to ``spacing``.
-    """
-    n = points.shape[0]
-    if n == 0:
-        return np.empty((0, 2))
-    path = 0.0                 # M ≤ path/spacing + 2 per input point (each emission walks S)
-    for i in range(1, n):
-        dx, dy = points[i, 0] - points[i - 1, 0], points[i, 1] - points[i - 1, 1]
-        path += np.sqrt(dx * dx + dy * dy)
-    cap = 3 * n + 16
-    if np.isfinite(path) and path / spacing < 1e9:
-        cap += int(path / spacing)
-    out = np.empty((cap, 2))
-    m = _resample_into(points, spacing, out)
-    if m < 0:                  # not expected; count exactly and redo
-        out = np.empty((_resample_into(points, spacing, np.empty((0, 2))), 2))
-        m = _resample_into(points, spacing, out)
-    return out[:m]
-
-
-@njit(cache=True, nogil=True)
 def _resample_path_into(points: np.ndarray, spacing: float, out: np.ndarray) -> int:
     """The path walk of :func:`resample_path` written into ``out``; returns the number of points,
     or -1 if ``out`` is too small (``out`` of shape ``(0, 2)`` just counts)."""
@@ -135,6 +108,48 @@ def _resample_path_into(points: np.ndarray, spacing: float, out: np.ndarray) -> 
 
 
 @njit(cache=True, nogil=True)
+def _walk_into(points: np.ndarray, spacing: float, along_path: bool, out: np.ndarray) -> int:
+    """:func:`_resample_path_into` if ``along_path``, else :func:`_resample_into`."""
+    if along_path:
+        return _resample_path_into(points, spacing, out)
+    return _resample_into(points, spacing, out)
+
+
+@njit(cache=True, nogil=True)
+def _walk(points: np.ndarray, spacing: float, along_path: bool) -> np.ndarray:
+    """Algorithm 1's walk (chords, or along the path if ``along_path``) into an array sized from
+    the path length: ``(M, 2)``."""
+    n = points.shape[0]
+    if n == 0:
+        return np.empty((0, 2))
+    path = 0.0                 # M ≤ path/spacing + 2 per input point (each emission walks S)
+    for i in range(1, n):
+        dx, dy = points[i, 0] - points[i - 1, 0], points[i, 1] - points[i - 1, 1]
+        path += np.sqrt(dx * dx + dy * dy)
+    cap = (2 if along_path else 3) * n + 16
+    if np.isfinite(path) and path / spacing < 1e9:
+        cap += int(path / spacing)
+    out = np.empty((cap, 2))
+    m = _walk_into(points, spacing, along_path, out)
+    if m < 0:                  # not expected; count exactly and redo
+        out = np.empty((_walk_into(points, spacing, along_path, np.empty((0, 2))), 2))
+        m = _walk_into(points, spacing, along_path, out)
+    return out[:m]
+
+
+@njit(cache=True, nogil=True)
+def resample(points: np.ndarray, spacing: float) -> np.ndarray:
+    """Algorithm 1: walk along ``points`` ``(N, 2)`` and emit points exactly ``spacing`` metres
+    apart (chord length from the last emitted point towards the next input point).
+
+    Returns ``(M, 2)``; the first input point is always kept, and the last input point is
+    appended when it lies more than ``spacing/2`` beyond the last emitted point. As written,
+    the walk follows chords, not the input path, so it cuts corners by up to ``spacing``.
+    """
+    return _walk(points, spacing, False)
+
+
+@njit(cache=True, nogil=True)
 def resample_path(points: np.ndarray, spacing: float) -> np.ndarray:
     """Algorithm 1 read as Wolin et al.'s RESAMPLE-POINTS: walk along the path through the input
     points ``(N, 2)`` and emit a point every ``spacing`` metres of path length, on the segment
@@ -144,22 +159,7 @@ def resample_path(points: np.ndarray, spacing: float) -> np.ndarray:
     appended when it lies more than ``spacing/2`` (straight distance) beyond the last emitted
     point, as in :func:`resample`.
     """
-    n = points.shape[0]
-    if n == 0:
-        return np.empty((0, 2))
-    path = 0.0
-    for i in range(1, n):
-        dx, dy = points[i, 0] - points[i - 1, 0], points[i, 1] - points[i - 1, 1]
-        path += np.sqrt(dx * dx + dy * dy)
-    cap = 2 * n + 16
-    if np.isfinite(path) and path / spacing < 1e9:
-        cap += int(path / spacing)
-    out = np.empty((cap, 2))
-    m = _resample_path_into(points, spacing, out)
-    if m < 0:                  # not expected; count exactly and redo
-        out = np.empty((_resample_path_into(points, spacing, np.empty((0, 2))), 2))
-        m = _resample_path_into(points, spacing, out)
-    return out[:m]
+    return _walk(points, spacing, True)
 
 
 def straws(points: np.ndarray, window: int = 1) -> np.ndarray:
@@ -246,7 +246,7 @@ def merge_lines(points: np.ndarray, corners: np.ndarray, threshold: float = 0.95
 def _shortstraw(points: np.ndarray, spacing: float, window: int, t: float,
                 line_threshold: float, along_path: bool = False) -> np.ndarray:
     """Algs. 1–3 in one compiled call (see :func:`shortstraw`)."""
-    res = resample_path(points, spacing) if along_path else resample(points, spacing)
+    res = _walk(points, spacing, along_path)
     n = res.shape[0]
     if n <= 2 * window:
         cand = np.arange(n) if n < 2 else np.array([0, n - 1], dtype=np.int64)

@@ -255,28 +255,6 @@ def _pieces(rb: np.ndarray, ra: np.ndarray, vb: np.ndarray, va: np.ndarray, k: i
 
 
 @njit(cache=True, nogil=True)
-def _match(rb: np.ndarray, ra: np.ndarray, vb: np.ndarray, va: np.ndarray) -> tuple[float, float, int]:
-    """(err², rot, shift) of :func:`match`: one merge sweep per cyclic shift, O(n_v·(n_r + n_v))."""
-    n_r, n_v = ra.shape[0], va.shape[0]
-    g_n = n_r + 1 + n_v
-    moved = np.empty(n_v)
-    grid = np.empty(g_n)
-    width = np.empty(g_n - 1)
-    d = np.empty(g_n - 1)
-    d2 = np.empty(g_n - 1)
-    best_err2, best_rot, best_k = np.inf, 0.0, 0
-    for k in range(n_v):
-        _pieces(rb, ra, vb, va, k, moved, grid, width, d)
-        for g in range(g_n - 1):
-            d2[g] = d[g] * d[g]
-        rot = _dot(width, d, g_n - 1)
-        err2 = _dot(width, d2, g_n - 1) - rot * rot
-        if err2 < best_err2:
-            best_err2, best_rot, best_k = err2, rot, k
-    return best_err2, best_rot, best_k
-
-
-@njit(cache=True, nogil=True)
 def _weighted_median(values: np.ndarray, weights: np.ndarray) -> float:
     """A minimiser θ of ``Σ weights·|values − θ|`` (weights ≥ 0, not all 0): the first value at
     which the cumulative weight (in value order) reaches half the total; where it reaches
@@ -296,25 +274,47 @@ def _weighted_median(values: np.ndarray, weights: np.ndarray) -> float:
 
 
 @njit(cache=True, nogil=True)
-def _match_l1(rb: np.ndarray, ra: np.ndarray, vb: np.ndarray, va: np.ndarray) -> tuple[float, float, int]:
-    """(area, rot, shift) of :func:`match_l1`: for each cyclic shift, the weighted median of the
-    pieces' differences is the best rotation, and the area follows; O(n_v·n log n)."""
+def _best_shift(rb: np.ndarray, ra: np.ndarray, vb: np.ndarray, va: np.ndarray,
+                l1: bool) -> tuple[float, float, int]:
+    """The best cyclic shift of the virtual function and its rotation: (err², rot, shift) of
+    :func:`match` (the rotation is the mean difference), or with ``l1`` (area, rot, shift) of
+    :func:`match_l1` (the weighted median). One merge sweep per shift."""
     n_r, n_v = ra.shape[0], va.shape[0]
     g_n = n_r + 1 + n_v
     moved = np.empty(n_v)
     grid = np.empty(g_n)
     width = np.empty(g_n - 1)
     d = np.empty(g_n - 1)
-    best_area, best_rot, best_k = np.inf, 0.0, 0
+    d2 = np.empty(0 if l1 else g_n - 1)
+    best_err, best_rot, best_k = np.inf, 0.0, 0
     for k in range(n_v):
         _pieces(rb, ra, vb, va, k, moved, grid, width, d)
-        rot = _weighted_median(d, width)
-        area = 0.0
-        for g in range(g_n - 1):
-            area += width[g] * abs(d[g] - rot)
-        if area < best_area:
-            best_area, best_rot, best_k = area, rot, k
-    return best_area, best_rot, best_k
+        if l1:
+            rot = _weighted_median(d, width)
+            err = 0.0
+            for g in range(g_n - 1):
+                err += width[g] * abs(d[g] - rot)
+        else:
+            for g in range(g_n - 1):
+                d2[g] = d[g] * d[g]
+            rot = _dot(width, d, g_n - 1)
+            err = _dot(width, d2, g_n - 1) - rot * rot
+        if err < best_err:
+            best_err, best_rot, best_k = err, rot, k
+    return best_err, best_rot, best_k
+
+
+@njit(cache=True, nogil=True)
+def _match(rb: np.ndarray, ra: np.ndarray, vb: np.ndarray, va: np.ndarray) -> tuple[float, float, int]:
+    """(err², rot, shift) of :func:`match`: one merge sweep per cyclic shift, O(n_v·(n_r + n_v))."""
+    return _best_shift(rb, ra, vb, va, False)
+
+
+@njit(cache=True, nogil=True)
+def _match_l1(rb: np.ndarray, ra: np.ndarray, vb: np.ndarray, va: np.ndarray) -> tuple[float, float, int]:
+    """(area, rot, shift) of :func:`match_l1`: for each cyclic shift, the weighted median of the
+    pieces' differences is the best rotation, and the area follows; O(n_v·n log n)."""
+    return _best_shift(rb, ra, vb, va, True)
 
 
 def match(real: TurningFunction, virtual: TurningFunction) -> Match:

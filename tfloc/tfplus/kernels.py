@@ -11,7 +11,7 @@ import math
 import numpy as np
 from numba import njit
 
-from tfloc.maps._gridcast import _entry, _start
+from tfloc.maps._gridcast import _entry, _start, _step
 
 
 @njit(cache=True, nogil=True)
@@ -138,6 +138,27 @@ def pairs_kernel(points: np.ndarray, delta: np.ndarray, q: np.ndarray, normal: n
 
 
 @njit(cache=True, nogil=True)
+def _to_nearest(field: tuple[np.ndarray, float, float, float, np.ndarray], px: float, py: float,
+                c: float, s: float, x: float, y: float) -> tuple[float, float, int, float, float]:
+    """The scan point ``(x, y)`` (sensor frame) at the pose ``(px, py)`` turned by ``(c, s)``,
+    against ``field`` = (nearest, origin x, origin y, 1 / resolution, map points) (see
+    :func:`field_pairs_kernel`): its offset from the sensor ``(ox, oy)`` (world axes), the index
+    ``j`` of its cell's nearest map point (-1: none; cell indices clipped into the lattice) and its
+    offset ``(dx, dy)`` from that point (NaN if none)."""
+    nearest, origin_x, origin_y, inv, map_points = field
+    ny, nx = nearest.shape
+    ox = c * x - s * y
+    oy = s * x + c * y
+    wx, wy = px + ox, py + oy
+    ix = min(max(int(math.floor((wx - origin_x) * inv)), 0), nx - 1)
+    iy = min(max(int(math.floor((wy - origin_y) * inv)), 0), ny - 1)
+    j = nearest[iy, ix]
+    if j < 0:
+        return ox, oy, j, np.nan, np.nan
+    return ox, oy, j, wx - map_points[j, 0], wy - map_points[j, 1]
+
+
+@njit(cache=True, nogil=True)
 def field_pairs_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, resolution: float,
                        map_points: np.ndarray, map_normals: np.ndarray, face_plus: np.ndarray,
                        face_minus: np.ndarray, points: np.ndarray, poses: np.ndarray,
@@ -162,28 +183,21 @@ def field_pairs_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, re
     slack)`` ``(K, M)`` of every point, paired or not (the second term keeps a point beyond the
     end of a wall, on the wall's line, from counting as on it).
     """
-    ny, nx = nearest.shape
     k_n, m = poses.shape[0], points.shape[0]
     hh = np.zeros((k_n, 4, 4))
     gg = np.zeros((k_n, 4))
     res = np.full((k_n, m), np.nan)
     rank = np.empty((k_n, m))
-    inv = 1.0 / resolution
+    field = (nearest, origin_x, origin_y, 1.0 / resolution, map_points)
     jac = np.zeros(4)
     for k in range(k_n):
         px, py = poses[k, 0], poses[k, 1]
         c, s = math.cos(poses[k, 2]), math.sin(poses[k, 2])
         for i in range(m):
-            ox = c * points[i, 0] - s * points[i, 1]
-            oy = s * points[i, 0] + c * points[i, 1]
-            wx, wy = px + ox, py + oy
-            ix = min(max(int(math.floor((wx - origin_x) * inv)), 0), nx - 1)
-            iy = min(max(int(math.floor((wy - origin_y) * inv)), 0), ny - 1)
-            j = nearest[iy, ix]
+            ox, oy, j, dx, dy = _to_nearest(field, px, py, c, s, points[i, 0], points[i, 1])
             if j < 0:
                 rank[k, i] = np.inf
                 continue
-            dx, dy = wx - map_points[j, 0], wy - map_points[j, 1]
             nxj, nyj = map_normals[j, 0], map_normals[j, 1]
             r = nxj * dx + nyj * dy
             dist = math.sqrt(dx * dx + dy * dy)
@@ -218,24 +232,15 @@ def face_depths_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, re
     """How deep (metres) each scan point lies behind its wall's surface on the sensor's side
     (``(K, M)``; NaN if its nearest map point is farther than ``gate``); see
     :func:`field_pairs_kernel` for the arguments."""
-    ny, nx = nearest.shape
     k_n, m = poses.shape[0], points.shape[0]
     out = np.full((k_n, m), np.nan)
-    inv = 1.0 / resolution
+    field = (nearest, origin_x, origin_y, 1.0 / resolution, map_points)
     for k in range(k_n):
         px, py = poses[k, 0], poses[k, 1]
         c, s = math.cos(poses[k, 2]), math.sin(poses[k, 2])
         for i in range(m):
-            ox = c * points[i, 0] - s * points[i, 1]
-            oy = s * points[i, 0] + c * points[i, 1]
-            wx, wy = px + ox, py + oy
-            ix = min(max(int(math.floor((wx - origin_x) * inv)), 0), nx - 1)
-            iy = min(max(int(math.floor((wy - origin_y) * inv)), 0), ny - 1)
-            j = nearest[iy, ix]
-            if j < 0:
-                continue
-            dx, dy = wx - map_points[j, 0], wy - map_points[j, 1]
-            if dx * dx + dy * dy > gate * gate:
+            ox, oy, j, dx, dy = _to_nearest(field, px, py, c, s, points[i, 0], points[i, 1])
+            if j < 0 or dx * dx + dy * dy > gate * gate:
                 continue
             r = map_normals[j, 0] * dx + map_normals[j, 1] * dy
             if map_normals[j, 0] * ox + map_normals[j, 1] * oy > 0.0:
@@ -328,14 +333,7 @@ def see_through_kernel(occ: np.ndarray, origin_x: float, origin_y: float, resolu
                     out[k, b] = True                 # left the first wall before the return
                     break
                 t = min(tx, ty)
-                if tx < ty:
-                    tx += tdx
-                    i += sx
-                    if i < 0 or i >= W:
-                        break
-                else:
-                    ty += tdy
-                    j += sy
-                    if j < 0 or j >= H:
-                        break
+                i, j, tx, ty, inside_grid = _step(i, j, sx, sy, tdx, tdy, tx, ty, W, H)
+                if not inside_grid:
+                    break
     return out
