@@ -4,18 +4,12 @@ import math
 
 import numpy as np
 import pytest
-from shapely.geometry import box
+from _tf_cases import TRUE, corridor_problem, few_returns_problem, noisy_scan
 
 import tfloc
-from tfloc import Pose, Problem, VectorMap
+from tfloc import Pose, Problem
 from tfloc.paper.matcher import TfConfig, TurningFunctionMatcher
 from tfloc.paper.shape import scan_corners
-
-TRUE = Pose(3.0, 3.5, 0.4)
-
-
-def noisy_scan(m, laser, pose, seed=0):
-    return m.raycast(pose, laser) + np.random.default_rng(seed).normal(0, 0.01, laser.n_beams)
 
 
 def test_tf_improves_a_0p3m_5deg_offset(test_room, lms200):
@@ -49,19 +43,14 @@ def test_candidate_inside_a_wall_costs_the_penalty(test_room, lms200):
 def test_scan_with_too_few_corners_is_a_no_answer_not_a_crash(lms200):
     # a scan with only 2 returns: its polygon (origin + 2 corners) is degenerate at most a triangle;
     # a single return gives < 3 edges
-    ranges = np.full(lms200.n_beams, np.inf)
-    ranges[90] = 2.0
-    room = VectorMap(outline=box(0, 0, 4, 3))
-    est = TurningFunctionMatcher().localize(Problem(room, lms200, ranges, Pose(1, 1, 0)))
+    est = TurningFunctionMatcher().localize(few_returns_problem(lms200, 1))
     assert not est.converged and est.info["status"] == "no-answer"
     assert est.pose == Pose(1, 1, 0)
 
 
 def test_search_survives_a_map_with_no_features(lms200):
     # a long corridor seen end-on: few corners, many invalid candidates near the walls
-    corridor = VectorMap(outline=box(0, 0, 30, 1.0))
-    ranges = corridor.raycast(Pose(5, 0.5, 0.0), lms200)
-    est = TurningFunctionMatcher(max_outer=2).localize(Problem(corridor, lms200, ranges, Pose(5.3, 0.5, 0.05)))
+    est = TurningFunctionMatcher(max_outer=2).localize(corridor_problem(lms200))
     assert est.pose.is_finite()
 
 

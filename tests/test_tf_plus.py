@@ -4,6 +4,7 @@ import math
 
 import numpy as np
 import pytest
+from _tf_cases import TRUE, corridor_problem, few_returns_problem, noisy_scan
 from shapely.geometry import box
 
 import tfloc
@@ -13,12 +14,6 @@ from tfloc.paper.shape import ShapeConfig, scan_turning_function
 from tfloc.tfplus.headings import rotation_candidates
 from tfloc.tfplus.matcher import TfPlusConfig, TurningFunctionPlusMatcher
 from tfloc.tfplus.refine import RefineConfig, refine
-
-TRUE = Pose(3.0, 3.5, 0.4)
-
-
-def noisy_scan(m, laser, pose, seed=0):
-    return m.raycast(pose, laser) + np.random.default_rng(seed).normal(0, 0.01, laser.n_beams)
 
 
 def errors(est, true):
@@ -60,18 +55,13 @@ def test_score_prefers_the_truth(test_room, lms200):
 
 @pytest.mark.parametrize("returns", [1, 2])
 def test_scan_with_one_or_two_returns_is_a_no_answer(lms200, returns):
-    ranges = np.full(lms200.n_beams, np.inf)
-    ranges[90:90 + returns] = 2.0
-    room = VectorMap(outline=box(0, 0, 4, 3))
-    est = TurningFunctionPlusMatcher().localize(Problem(room, lms200, ranges, Pose(1, 1, 0)))
+    est = TurningFunctionPlusMatcher().localize(few_returns_problem(lms200, returns))
     assert not est.converged and est.info["status"] == "no-answer"
     assert est.pose == Pose(1, 1, 0)
 
 
 def test_survives_a_corridor_seen_end_on(lms200):
-    corridor = VectorMap(outline=box(0, 0, 30, 1.0))
-    ranges = corridor.raycast(Pose(5, 0.5, 0.0), lms200)
-    est = TurningFunctionPlusMatcher().localize(Problem(corridor, lms200, ranges, Pose(5.3, 0.5, 0.05)))
+    est = TurningFunctionPlusMatcher().localize(corridor_problem(lms200))
     assert est.pose.is_finite()
     assert abs(est.pose.y - 0.5) < 0.05 and abs(tfloc.angdiff(est.pose.theta, 0.0)) < math.radians(1)
 
