@@ -45,9 +45,12 @@ bench: $(STAMP)
 	$(BIN)/tfloc bench benchmarks/tfplus-ablation.toml --jobs $(JOBS) --regenerate
 	$(BIN)/tfloc report results/tf-plus-ablation
 
-## tf-plus's per-stage ablation on the real logs (results/tf-plus-ablation-real.md; ~20 min).
+## tf-plus's per-stage ablation on the real logs, maps as built and thickened (results/tf-plus-ablation-real/; ~5 min quiet).
 ablation-real: $(STAMP)
-	OMP_NUM_THREADS=1 $(BIN)/python benchmarks/tfplus_ablation_real.py --thicken 0 1 2
+	OMP_NUM_THREADS=1 $(BIN)/python benchmarks/tfplus_ablation_real.py --thicken 0 1 2 \
+		--out results/tf-plus-ablation-real/development
+	OMP_NUM_THREADS=1 $(BIN)/python benchmarks/tfplus_ablation_real.py --thicken 0 1 2 \
+		--datasets data/scenarios/real-aces-scan-to-map --out results/tf-plus-ablation-real/held-out-aces
 
 ## Rebuild the real-log datasets and grid maps from data/real/ (deterministic).
 real-data: $(STAMP)

@@ -152,6 +152,14 @@ def markdown(df: pd.DataFrame) -> str:
     return "\n".join(lines)
 
 
+def _shown(path: Path) -> str:
+    """``path`` relative to the repository when it lies inside it."""
+    try:
+        return str(path.resolve().relative_to(ROOT))
+    except ValueError:
+        return str(path)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--datasets", nargs="+", default=list(DEV))
@@ -181,7 +189,8 @@ def main() -> None:
         "# tf-plus ablation on real scan-to-map logs\n\n"
         f"Command: `OMP_NUM_THREADS=1 PYTHONPATH=$PWD python benchmarks/tfplus_ablation_real.py --datasets "
         f"{' '.join(args.datasets)}{f' --limit-per-group {args.limit_per_group}' if args.limit_per_group else ''}"
-        f"{' --thicken ' + ' '.join(map(str, args.thicken)) if args.thicken != [0] else ''}`. "
+        f"{' --thicken ' + ' '.join(map(str, args.thicken)) if args.thicken != [0] else ''}"
+        f" --out {_shown(args.out)}`. "
         "Every scan of each dataset (5 cm grid map built from the corrected log; initial poses in "
         "the paper's 3 × 3 offset bins, 0–3 m × 0–15°), one variant per row (one stage switched off). "
         "Success: ≤ 10 cm and ≤ 2° from the corrected pose. Failures are split by `tf-plus`'s own "
