@@ -51,6 +51,9 @@ ablation-real: $(STAMP)
 		--out results/tf-plus-ablation-real/development
 	OMP_NUM_THREADS=1 $(BIN)/python benchmarks/tfplus_ablation_real.py --thicken 0 1 2 \
 		--datasets data/scenarios/real-aces-scan-to-map --out results/tf-plus-ablation-real/held-out-aces
+	OMP_NUM_THREADS=1 $(BIN)/python benchmarks/tfplus_ablation_real.py --matcher csm-corr --thicken 1 2 \
+		--datasets real-intel-scan-to-map real-csail-scan-to-map real-aces-scan-to-map \
+		--out results/tf-plus-ablation-real/csm-corr-thickened
 
 ## Rebuild the real-log datasets and grid maps from data/real/ (deterministic).
 real-data: $(STAMP)

@@ -171,6 +171,8 @@ def main() -> None:
                     help="extra tf-plus parameters for every variant (Python literals; "
                          "refinement.NAME=VALUE for the refinement's)")
     ap.add_argument("--out", type=Path, default=ROOT / "results/tf-plus-ablation-real")
+    ap.add_argument("--matcher", default="tf-plus",
+                    help="another matcher on the same scans and maps (one row, its defaults), e.g. csm-corr")
     args = ap.parse_args()
     variants = {k: v for k, v in VARIANTS.items() if not args.only or k in args.only}
     import ast
@@ -181,7 +183,10 @@ def main() -> None:
     if sub:
         extra["refinement"] = replace(RefineConfig(), **sub)
     variants = {k: {**extra, **v} for k, v in variants.items()}
-    df = run(args.datasets, variants, args.limit_per_group, thicken=tuple(args.thicken))
+    if args.matcher != "tf-plus":
+        variants = {args.matcher: {}}
+    df = run(args.datasets, variants, args.limit_per_group, matcher=args.matcher,
+             thicken=tuple(args.thicken))
     summary = summarise(df)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     df.to_csv(args.out.with_suffix(".csv"), index=False)
@@ -190,7 +195,7 @@ def main() -> None:
         f"Command: `OMP_NUM_THREADS=1 PYTHONPATH=$PWD python benchmarks/tfplus_ablation_real.py --datasets "
         f"{' '.join(args.datasets)}{f' --limit-per-group {args.limit_per_group}' if args.limit_per_group else ''}"
         f"{' --thicken ' + ' '.join(map(str, args.thicken)) if args.thicken != [0] else ''}"
-        f" --out {_shown(args.out)}`. "
+        f"{' --matcher ' + args.matcher if args.matcher != 'tf-plus' else ''} --out {_shown(args.out)}`. "
         "Every scan of each dataset (5 cm grid map built from the corrected log; initial poses in "
         "the paper's 3 × 3 offset bins, 0–3 m × 0–15°), one variant per row (one stage switched off). "
         "Success: ≤ 10 cm and ≤ 2° from the corrected pose. Failures are split by `tf-plus`'s own "
