@@ -117,3 +117,33 @@ def test_empty_run_is_a_one_line_error(tmp_path):
     frame([]).to_csv(tmp_path / "estimates.csv", index=False)
     with pytest.raises(ResultsError, match="no results yet"):
         write_report(tmp_path)
+
+
+def test_a_sweeps_line_figures_show_the_first_label_and_the_most_successful_others():
+    from tfloc.evaluation.metrics import prepare
+    from tfloc.evaluation.outcome import Thresholds
+    from tfloc.report.report import line_figure_matchers
+
+    order = [f"m{i:02d}" for i in range(20)]          # m00 first; m19 succeeds most often
+    rows = [row(m, dist_m=0.01 if k < i else 1.0, scan_id=f"s{k}")
+            for i, m in enumerate(order) for k in range(20)]
+    p = prepare(frame(rows), Thresholds())
+    shown = line_figure_matchers(p, order, most=8)
+    assert shown == ["m00", "m19", "m18", "m17", "m16", "m15", "m14", "m13"]
+
+
+def test_a_sweeps_bar_figures_turn_horizontal(tmp_path):
+    from matplotlib.image import imread
+
+    from tfloc.evaluation.metrics import prepare
+    from tfloc.evaluation.outcome import Thresholds
+    from tfloc.report.figures import MANY_MATCHERS, fig_outcomes
+
+    many_n = MANY_MATCHERS + 30
+    for n, name in ((3, "few"), (many_n, "many")):
+        rows = [row(f"m{i:02d}", scan_id=f"s{k}") for i in range(n) for k in range(3)]
+        fig_outcomes(prepare(frame(rows), Thresholds()), tmp_path / f"{name}.png")
+    few, many = imread(tmp_path / "few.png"), imread(tmp_path / "many.png")
+    assert few.shape[1] > few.shape[0]                   # wide: matchers along x
+    assert many.shape[0] > many.shape[1]                 # tall: one row per label,
+    assert many.shape[0] / many_n > 20                   # each over 20 pixels high

@@ -23,6 +23,10 @@ SCENARIO_TITLES = {"I": "Scenario I: detail level", "II": "Scenario II: initial 
                    "III": "Scenario III: initial distance offset"}
 SCENARIO_X = {"I": "dataset", "II": "initial angle offset bin (°)", "III": "initial distance offset bin (cm)"}
 DPI = 120
+#: A run of more than this many matcher labels is a parameter sweep: its report compares each
+#: label with the first only and draws the first label's failures only; its line figures show a
+#: few labels, its bar and box figures turn horizontal (one row per label).
+MANY_MATCHERS = 12
 
 
 def colours(matchers: list[str]) -> dict[str, tuple]:
@@ -45,8 +49,9 @@ def _nscans(g: pd.DataFrame) -> int:
 
 
 def _legend_below(fig: Figure, handles: list, labels: list[str]) -> None:
-    fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 6), frameon=False,
-               bbox_to_anchor=(0.5, -0.02))
+    longest = max((len(x) for x in labels), default=0)  # long sweep labels: fewer columns
+    ncol = min(len(labels), 6 if longest <= 24 else 3 if longest <= 48 else 2)
+    fig.legend(handles, labels, loc="outside lower center", ncol=ncol, frameon=False)
 
 
 def fig_scenarios(sc: pd.DataFrame, path: Path) -> Path | None:
@@ -84,7 +89,6 @@ def fig_scenarios(sc: pd.DataFrame, path: Path) -> Path | None:
             else:
                 ax.set_xlabel(SCENARIO_X[s])
     _legend_below(fig, list(handles.values()), list(handles.keys()))
-    fig.get_layout_engine().set(rect=(0, 0.05, 1, 0.95))
     fig.suptitle("Mean errors per scenario (log scale; dashed: the paper's published tf values)")
     return _save(fig, path)
 
@@ -133,7 +137,6 @@ def fig_basin(p: pd.DataFrame, path: Path, scan_to_scan: set[str] = frozenset())
             ax.set_ylabel("success rate (%)")
             ax.set_title(f"{name} ({_nscans(t)} scans)", fontsize=10)
     _legend_below(fig, list(handles.values()), list(handles.keys()))
-    fig.get_layout_engine().set(rect=(0, 0.06 / len(fams), 1, 1 - 0.04 / len(fams)))
     fig.suptitle("Convergence basin: success rate against initial offset")
     return _save(fig, path)
 
@@ -164,7 +167,6 @@ def fig_cdf(p: pd.DataFrame, path: Path, thr: Thresholds) -> Path | None:
         ax.set_xlabel(xl + f"; dotted: success threshold {limit:g}")
         ax.set_ylabel("fraction of scans with error ≤ x")
     _legend_below(fig, list(handles.values()), list(handles.keys()))
-    fig.get_layout_engine().set(rect=(0, 0.08, 1, 0.93))
     fig.suptitle(f"Error CDF over all scans with ground truth ({_nscans(t)} scans; "
                  f"values < {specs[0][2]:g} cm / {specs[1][2]:g}° drawn at that floor)")
     return _save(fig, path)
@@ -179,19 +181,30 @@ def fig_runtime(p: pd.DataFrame, path: Path) -> Path | None:
         return None
     matchers = sorted(t["matcher"].unique())
     col = colours(list(p["matcher"].unique()))
-    fig = Figure(figsize=(max(5.0, 1.3 * len(matchers) + 2), 4.4), layout="constrained")
+    wide = len(matchers) > MANY_MATCHERS  # a sweep: one row per label, names on the y axis
+    size = (9.0, 0.25 * len(matchers) + 1.5) if wide else (max(5.0, 1.3 * len(matchers) + 2), 4.4)
+    fig = Figure(figsize=size, layout="constrained")
     ax = fig.subplots()
     data = [np.maximum(t.loc[t["matcher"] == m, metric].to_numpy(), 1e-3) for m in matchers]
     bp = ax.boxplot(data, positions=range(len(matchers)), whis=(5, 95), showfliers=True, patch_artist=True,
-                    medianprops={"color": "black"}, flierprops={"markersize": 2.5, "alpha": 0.5})
-    ax.set_xticks(range(len(matchers)), matchers)
+                    vert=not wide, medianprops={"color": "black"},
+                    flierprops={"markersize": 2.5, "alpha": 0.5})
     for patch, m in zip(bp["boxes"], matchers, strict=True):
         patch.set_facecolor(col[m])
         patch.set_alpha(0.6)
-    ax.set_yscale("log")
-    ax.grid(True, which="both", axis="y", alpha=0.3)
-    ax.set_ylabel(f"{kind.split(' (')[0]} per scan (ms)")
-    ax.set_xlabel("matcher")
+    label = f"{kind.split(' (')[0]} per scan (ms)"
+    if wide:
+        ax.set_yticks(range(len(matchers)), matchers, fontsize=7)
+        ax.invert_yaxis()
+        ax.set_xscale("log")
+        ax.grid(True, which="both", axis="x", alpha=0.3)
+        ax.set_xlabel(label)
+    else:
+        ax.set_xticks(range(len(matchers)), matchers)
+        ax.set_yscale("log")
+        ax.grid(True, which="both", axis="y", alpha=0.3)
+        ax.set_ylabel(label)
+        ax.set_xlabel("matcher")
     ax.set_title(f"{kind[0].upper() + kind[1:]} per scan (box: quartiles, whiskers: p5–p95)")
     return _save(fig, path)
 
@@ -208,23 +221,37 @@ def fig_outcomes(p: pd.DataFrame, path: Path, scan_to_scan: set[str] = frozenset
         if len(g):
             panels.append((f"initial offset {b} cm", g))
     matchers = sorted(t["matcher"].unique())
-    fig = Figure(figsize=(max(8.0, 0.55 * len(matchers) * len(panels) + 2), 4.6), layout="constrained")
+    wide = len(matchers) > MANY_MATCHERS  # a sweep: horizontal bars, one row per label
+    size = ((3.0 * len(panels) + 5.0, 0.22 * len(matchers) + 2.0) if wide
+            else (max(8.0, 0.55 * len(matchers) * len(panels) + 2), 4.6))
+    fig = Figure(figsize=size, layout="constrained")
     axes = fig.subplots(1, len(panels), sharey=True, squeeze=False)[0]
+    pos = np.arange(len(matchers))
     for ax, (title, g) in zip(axes, panels, strict=True):
         bottom = np.zeros(len(matchers))
         for o in OUTCOMES:
             share = np.array([100.0 * (g.loc[g["matcher"] == m, "outcome_eval"] == o).mean()
                               if (g["matcher"] == m).any() else 0.0 for m in matchers])
-            ax.bar(range(len(matchers)), share, bottom=bottom, color=OUTCOME_COLOURS[o], label=o,
-                   edgecolor="white", lw=0.5)
+            if wide:
+                ax.barh(pos, share, left=bottom, color=OUTCOME_COLOURS[o], label=o, edgecolor="white", lw=0.5)
+            else:
+                ax.bar(pos, share, bottom=bottom, color=OUTCOME_COLOURS[o], label=o, edgecolor="white", lw=0.5)
             bottom += share
-        ax.set_xticks(range(len(matchers)), matchers, rotation=45, ha="right")
         ax.set_title(f"{title}\n(n={_nscans(g)} scans)", fontsize=10)
-        ax.set_ylim(0, 100)
-        ax.grid(True, axis="y", alpha=0.3)
-    axes[0].set_ylabel("share of scans (%)")
+        if wide:
+            ax.set_xlim(0, 100)
+            ax.grid(True, axis="x", alpha=0.3)
+            ax.set_xlabel("share of scans (%)")
+        else:
+            ax.set_xticks(pos, matchers, rotation=45, ha="right")
+            ax.set_ylim(0, 100)
+            ax.grid(True, axis="y", alpha=0.3)
+    if wide:
+        axes[0].set_yticks(pos, matchers, fontsize=7)
+        axes[0].invert_yaxis()
+    else:
+        axes[0].set_ylabel("share of scans (%)")
     h, lab = axes[0].get_legend_handles_labels()
     _legend_below(fig, h, lab)
-    fig.get_layout_engine().set(rect=(0, 0.07, 1, 0.93))
     fig.suptitle("Outcomes per matcher (success / local-optimum / ambiguous / no-answer)")
     return _save(fig, path)

@@ -34,6 +34,7 @@ from tfloc.io.text import parse_text
 from . import figures as F
 from . import sections as S
 from .failures import draw_failures, failures_section
+from .figures import MANY_MATCHERS
 from .landscape import draw_landscapes, landscape_section
 from .mdtable import num
 
@@ -49,9 +50,6 @@ class ReportFiles:
     figures: tuple[Path, ...]
 
 
-#: With more matchers than this (a parameter sweep), pairs are compared with the run's first
-#: matcher only, and only its failures are drawn.
-MANY_MATCHERS = 12
 
 def load_run(run_dir: Path) -> tuple[pd.DataFrame, dict]:
     """The estimates and the ``run.json`` document (``{}`` when missing) of a run directory."""
@@ -311,8 +309,28 @@ def render(run_dir: Path, run: dict, p: pd.DataFrame, thr: Thresholds, s2s: set[
         parts.append(failures)
     if figs:
         parts.append("## Figures\n")
+        if len(p["matcher"].unique()) > MANY_MATCHERS:
+            shown = ", ".join(f"`{m}`" for m in line_figure_matchers(p, label_order(run, p)))
+            parts.append(f"A parameter sweep: the line figures (scenario errors, basin, error CDF) "
+                         f"show the first label and the seven most successful others ({shown}); "
+                         "the runtime and outcome figures show every label.\n")
         parts += [f"![{f.stem}](figures/{f.name})\n" for f in figs]
     return "\n".join(parts)
+
+
+def label_order(run: dict, p: pd.DataFrame) -> list[str]:
+    """The run's matcher labels in the order of its configuration (sorted without run.json)."""
+    order = [m.get("label", m.get("name")) for m in run.get("config", {}).get("matchers", [])]
+    return [m for m in order if m in set(p["matcher"])] or sorted(p["matcher"].unique())
+
+
+def line_figure_matchers(p: pd.DataFrame, order: list[str], most: int = 8) -> list[str]:
+    """The labels a sweep's line figures show (a line per label is unreadable beyond a dozen):
+    the run's first label and the ``most`` − 1 others with the highest success rate."""
+    t = p[p["truth"] & p["matcher"].isin(order[1:])]
+    rate = (t["outcome_eval"] == "success").groupby(t["matcher"]).mean()
+    best = sorted(rate.index, key=lambda m: (-rate[m], order.index(m)))[:most - 1]
+    return [order[0], *best]
 
 
 def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
@@ -324,8 +342,7 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
     p = prepare(df, thr)
     s2s = scan_to_scan_datasets(run, list(p["dataset"].unique()))
     summary = write_summary(summary_table(p, s2s), run_dir / "summary.csv")
-    order = [m.get("label", m.get("name")) for m in run.get("config", {}).get("matchers", [])]
-    order = [m for m in order if m in set(p["matcher"])] or sorted(p["matcher"].unique())
+    order = label_order(run, p)
     sweep = len(order) > MANY_MATCHERS  # a parameter sweep: compare each label with the first only
     pt = paired_table(p, s2s, reference=order[0] if sweep else None)
     pt.to_csv(run_dir / "paired.csv", index=False, float_format="%.6g")
@@ -333,9 +350,10 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
     failures = landscape = ""
     if with_figures:
         fd = run_dir / "figures"
-        sc = scenario_summary(p[p["truth"]])
+        lines = p[p["matcher"].isin(line_figure_matchers(p, order))] if sweep else p
+        sc = scenario_summary(lines[lines["truth"]])
         made = [F.fig_scenarios(sc, fd / "scenario_errors.png") if len(sc) else None,
-                F.fig_basin(p, fd / "basin.png", s2s), F.fig_cdf(p, fd / "error_cdf.png", thr),
+                F.fig_basin(lines, fd / "basin.png", s2s), F.fig_cdf(lines, fd / "error_cdf.png", thr),
                 F.fig_runtime(p, fd / "runtime.png"), F.fig_outcomes(p, fd / "outcomes.png", s2s)]
         figs = [f for f in made if f is not None]
         drawn = p[p["matcher"] == order[0]] if sweep else p
