@@ -187,7 +187,7 @@ def fig_runtime(p: pd.DataFrame, path: Path) -> Path | None:
     ax = fig.subplots()
     data = [np.maximum(t.loc[t["matcher"] == m, metric].to_numpy(), 1e-3) for m in matchers]
     bp = ax.boxplot(data, positions=range(len(matchers)), whis=(5, 95), showfliers=True, patch_artist=True,
-                    vert=not wide, medianprops={"color": "black"},
+                    orientation="horizontal" if wide else "vertical", medianprops={"color": "black"},
                     flierprops={"markersize": 2.5, "alpha": 0.5})
     for patch, m in zip(bp["boxes"], matchers, strict=True):
         patch.set_facecolor(col[m])
