@@ -264,8 +264,9 @@ def _paired_section(pt: pd.DataFrame) -> list[str]:
 
 
 def render(run_dir: Path, run: dict, p: pd.DataFrame, thr: Thresholds, s2s: set[str],
-           figs: list[Path], pt: pd.DataFrame | None = None, failures: str = "", landscape: str = "") -> str:
-    """The whole report.md text."""
+           figs: list[Path], pt: pd.DataFrame | None = None, failures: str = "", landscape: str = "",
+           line_labels: list[str] | None = None) -> str:
+    """The whole report.md text (``line_labels``: the labels a sweep's line figures show)."""
     parts = [header(run_dir, run, p, thr, s2s), definitions(thr)]
     truth = p[p["truth"]]
     sc = scenario_summary(truth)
@@ -309,8 +310,8 @@ def render(run_dir: Path, run: dict, p: pd.DataFrame, thr: Thresholds, s2s: set[
         parts.append(failures)
     if figs:
         parts.append("## Figures\n")
-        if len(p["matcher"].unique()) > MANY_MATCHERS:
-            shown = ", ".join(f"`{m}`" for m in line_figure_matchers(p, label_order(run, p)))
+        if line_labels:
+            shown = ", ".join(f"`{m}`" for m in line_labels)
             parts.append(f"A parameter sweep: the line figures (scenario errors, basin, error CDF) "
                          f"show the first label and the seven most successful others ({shown}); "
                          "the runtime and outcome figures show every label.\n")
@@ -348,9 +349,10 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
     pt.to_csv(run_dir / "paired.csv", index=False, float_format="%.6g")
     figs: list[Path] = []
     failures = landscape = ""
+    line_labels = line_figure_matchers(p, order) if sweep and with_figures else None
     if with_figures:
         fd = run_dir / "figures"
-        lines = p[p["matcher"].isin(line_figure_matchers(p, order))] if sweep else p
+        lines = p[p["matcher"].isin(line_labels)] if line_labels else p
         sc = scenario_summary(lines[lines["truth"]])
         made = [F.fig_scenarios(sc, fd / "scenario_errors.png") if len(sc) else None,
                 F.fig_basin(lines, fd / "basin.png", s2s), F.fig_cdf(lines, fd / "error_cdf.png", thr),
@@ -360,6 +362,6 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
         failures = failures_section(draw_failures(run_dir, drawn, run.get("datasets", {})))
         landscape = landscape_section(*draw_landscapes(run_dir, p, run.get("datasets", {})))
     report = run_dir / "report.md"
-    report.write_text(render(run_dir, run, p, thr, s2s, figs, pt, failures, landscape))
+    report.write_text(render(run_dir, run, p, thr, s2s, figs, pt, failures, landscape, line_labels))
     return ReportFiles(report, summary, tuple(figs))
 
