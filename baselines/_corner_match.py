@@ -52,11 +52,10 @@ def pair_hypotheses(a: np.ndarray, b: np.ndarray, length_tol: float, min_length:
     return Hypotheses(theta, t)
 
 
-def transform(theta: np.ndarray, t: np.ndarray, a: np.ndarray, batched: bool = False) -> np.ndarray:
-    """Apply ``(H,)`` rotations and ``(H, 2)`` translations to points ``(N, 2)`` (or, if
-    ``batched``, to per-hypothesis points ``(H, N, 2)``) → ``(H, N, 2)``."""
+def transform(theta: np.ndarray, t: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """Apply ``(H,)`` rotations and ``(H, 2)`` translations to points ``(N, 2)`` → ``(H, N, 2)``."""
     c, s = np.cos(theta)[:, None], np.sin(theta)[:, None]
-    ax, ay = (a[..., 0], a[..., 1]) if batched else (a[None, :, 0], a[None, :, 1])
+    ax, ay = a[None, :, 0], a[None, :, 1]
     x = c * ax - s * ay + t[:, None, 0]
     y = s * ax + c * ay + t[:, None, 1]
     return np.stack((x, y), axis=-1)

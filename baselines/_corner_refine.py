@@ -73,7 +73,7 @@ def _refine(corners: np.ndarray, points: np.ndarray, idx: np.ndarray, trim: floa
 
 def refine_corners(corners: np.ndarray, points: np.ndarray, trim: float = 0.05, min_points: int = 4,
                    max_rms: float = 0.03, min_angle: float = np.radians(30.0),
-                   max_move: float = 0.2, idx: np.ndarray | None = None) -> np.ndarray:
+                   max_move: float = 0.2) -> np.ndarray:
     """Move each interior corner (metres, ``(K, 2)``, in scan order) to the intersection of the lines
     fitted to the raw scan points ``(N, 2)`` (in beam order) before and after it.
 
@@ -81,13 +81,11 @@ def refine_corners(corners: np.ndarray, points: np.ndarray, trim: float = 0.05, 
     more than ``trim`` metres from both its corners and fit a line with RMS ≤ ``max_rms``. A corner
     moves only if both neighbouring pieces give lines meeting at ≥ ``min_angle`` radians and the
     intersection lies within ``max_move`` metres; otherwise (jump edges, field-of-view ends, curved
-    pieces) it stays where ShortStraw put it. ``idx``: the corners' raw point indices
-    (:func:`tfloc.baselines._corner_thin.corner_indices`), if already known.
+    pieces) it stays where ShortStraw put it.
     """
     corners = np.ascontiguousarray(corners, dtype=float)
     if len(corners) < 3 or len(points) < min_points:
         return corners.copy()
     points = np.ascontiguousarray(points, dtype=float)
-    idx = corner_indices(corners, points) if idx is None else idx
-    return _refine(corners, points, idx, float(trim), int(min_points), float(max_rms), float(min_angle),
+    return _refine(corners, points, corner_indices(corners, points), float(trim), int(min_points), float(max_rms), float(min_angle),
                    float(max_move))

@@ -34,7 +34,8 @@ median CPU.
   layers (a 1 m voxel merges the walls of a corner into one Gaussian; a layer on a voxel boundary
   at z = 0 flickers between voxels).
 * **Target = the map's sampled geometry** (``map.sample_points`` every ``map_spacing`` = 5 cm,
-  the whole map), stacked, with its ``KdTree`` and covariances built once per map and cached
+  the whole map; the samples of :func:`tfloc.maps.cache.map_geometry`, shared with ``o3d-icp`` and
+  ``kiss-icp``), stacked, with its ``KdTree`` and covariances built once per map and cached
   (:mod:`tfloc.maps.cache`). 2 cm samples: 48.3 % at 5.0 instead of 3.7 ms.
 * **Coarse-to-fine correspondence gates** ``gates`` = 2.0 → 1.0 → 0.5 → 0.2 → 0.1 m (``o3d-icp``'s
   schedule), each stage from the last result. A single 1 m gate (small_gicp's default) gave
@@ -69,7 +70,7 @@ from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
 from tfloc.errors import ParameterError
-from tfloc.maps.cache import cached
+from tfloc.maps.cache import cached, map_geometry
 
 from ._geometry import matrix_to_pose, pose_to_matrix
 
@@ -134,8 +135,7 @@ def _target(problem_map: object, cfg: Config) -> _Target:
     """The cached target of ``problem_map`` for this spacing, layering and neighbourhood size."""
 
     def build() -> _Target:
-        pts, _ = problem_map.sample_points(cfg.map_spacing)
-        cloud, tree = _cloud(pts, cfg)
+        cloud, tree = _cloud(map_geometry(problem_map, cfg.map_spacing).points, cfg)
         covs = np.asarray(cloud.covs(), dtype=float).reshape(-1, 4, 4)[:, :3, :3]
         return _Target(cloud, tree, np.ascontiguousarray(covs))
 
