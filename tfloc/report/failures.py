@@ -22,7 +22,8 @@ from matplotlib.figure import Figure
 from tfloc.core.pose import Pose
 from tfloc.errors import TflocError
 from tfloc.evaluation.outcome import OUTCOMES
-from tfloc.io.scenario import Scan, Scenario, map_for, read_scans, read_scenario
+from tfloc.harness.task import load_dataset
+from tfloc.io.scenario import Scan, Scenario, map_for
 
 FAILURES = tuple(OUTCOMES[1:])  # local-optimum, ambiguous, no-answer
 WINDOW_MARGIN_M = 1.0
@@ -109,8 +110,7 @@ def draw_failures(run_dir: Path, p: pd.DataFrame, datasets: dict[str, str]) -> l
             name = r["dataset"]
             if name not in loaded:
                 try:
-                    sc = read_scenario(datasets[name])
-                    loaded[name] = (sc, {s.scan_id: s for s in read_scans(sc)})
+                    loaded[name] = load_dataset(str(datasets[name]))
                 except (KeyError, OSError, TflocError):
                     loaded[name] = None
             if loaded[name] is None or r["scan_id"] not in loaded[name][1]:

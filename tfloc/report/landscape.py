@@ -21,9 +21,8 @@ from matplotlib.figure import Figure
 from scipy.stats import spearmanr
 
 from tfloc.core.pose import Pose
-from tfloc.core.problem import Problem
 from tfloc.errors import TflocError
-from tfloc.io.scenario import map_for, read_scans, read_scenario
+from tfloc.harness.task import load_dataset, problem_of
 from tfloc.paper.landscape import err_landscape, local_minima
 
 HALF_WIDTH_M = 3.0
@@ -61,11 +60,11 @@ def draw_landscapes(run_dir: Path, p: pd.DataFrame, datasets: dict[str, str]) ->
     panels, stats = [], []
     for _, r in chosen.iterrows():
         try:
-            sc = read_scenario(datasets[r["dataset"]])
-            scan = next(s for s in read_scans(sc) if s.scan_id == r["scan_id"])
-        except (KeyError, StopIteration, OSError, TflocError):
+            sc, scans = load_dataset(str(datasets[r["dataset"]]))
+            scan = scans[r["scan_id"]]
+            problem = problem_of(sc, scan)
+        except (KeyError, OSError, TflocError):
             continue
-        problem = Problem(map_for(sc, scan), sc.laser, scan.ranges, scan.initial)
         try:
             land = err_landscape(problem, scan.true, HALF_WIDTH_M, GRID)
         except ValueError:
