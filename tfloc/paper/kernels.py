@@ -43,7 +43,7 @@ def scan_turning(ranges: np.ndarray, directions: np.ndarray, max_range: float, s
 @njit(cache=True, nogil=True)
 def wrap_rotation(rot: float) -> float:
     """``(rot + π) % 2π − π``: numba's float ``%`` is CPython's (``fmod``, then the sign fix), so
-    this equals :func:`tfloc.paper.turning.wrap_rotation` bit for bit."""
+    this equals :func:`tfloc.core.pose.wrap_angle` bit for bit."""
     return (rot + np.pi) % TWO_PI - np.pi
 
 

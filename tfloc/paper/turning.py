@@ -329,11 +329,6 @@ def match(real: TurningFunction, virtual: TurningFunction) -> Match:
     return Match(math.sqrt(max(err2, 0.0)), rotation, int(k))
 
 
-def wrap_rotation(rot: float) -> float:
-    """A rotation offset (radians) wrapped into [-π, π)."""
-    return (float(rot) + np.pi) % TWO_PI - np.pi
-
-
 def match_l1(real: TurningFunction, virtual: TurningFunction) -> Match:
     """Sec. 4.3 read as written: min over starting vertex and rotation of the *area* between the
     two graphs, ``∫₀¹ |Θ_R − Θ_V − θ| ds`` (the sum of the rectangles between them).
@@ -344,4 +339,4 @@ def match_l1(real: TurningFunction, virtual: TurningFunction) -> Match:
     ``Match.distance`` is the area (radians × unit arc length).
     """
     area, rot, k = _match_l1(real.breaks, real.angles, virtual.breaks, virtual.angles)
-    return Match(float(area), wrap_rotation(rot), int(k))
+    return Match(float(area), wrap_angle(float(rot)), int(k))

@@ -53,6 +53,7 @@ import numpy as np
 
 from tfloc.core.laser import LaserSpec
 from tfloc.core.map import Map
+from tfloc.core.pose import wrap_angle
 
 from .kernels import face_depths_kernel, field_pairs_kernel, pairs_kernel, refine_field_kernel
 from .view import MapView
@@ -139,20 +140,14 @@ def _compose(poses: np.ndarray, delta: np.ndarray) -> np.ndarray:
     c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
     return np.column_stack((poses[:, 0] + c * delta[:, 0] - s * delta[:, 1],
                             poses[:, 1] + s * delta[:, 0] + c * delta[:, 1],
-                            (poses[:, 2] + delta[:, 2] + np.pi) % (2 * np.pi) - np.pi))
-
-
-def line_residuals(map_: Map, laser: LaserSpec, points: np.ndarray, poses: np.ndarray,
-                   window: int = 6, gate: float = 1.0) -> np.ndarray:
-    """Point-to-line distances ``(K, M)`` (metres) of the real ``points`` ``(M, 2)`` at ``poses``
-    ``(K, 3)`` against their virtual scans; NaN where a point has no virtual neighbour within
-    ``gate``."""
-    return residuals_to(map_.raycast(poses, laser), laser, points, window, gate)
+                            wrap_angle(poses[:, 2] + delta[:, 2])))
 
 
 def residuals_to(virtual: np.ndarray, laser: LaserSpec, points: np.ndarray, window: int = 6,
                  gate: float = 1.0) -> np.ndarray:
-    """:func:`line_residuals` against given virtual scans ``(K, n_beams)`` (ranges, metres)."""
+    """Point-to-line distances ``(K, M)`` (metres) of the real ``points`` ``(M, 2)`` (sensor frame)
+    against virtual scans ``(K, n_beams)`` (ranges, metres); NaN where a point has no virtual
+    neighbour within ``gate``."""
     q, normal = _virtual_geometry(virtual, laser)
     _, _, r = pairs_kernel(np.ascontiguousarray(points, dtype=float), np.zeros((len(virtual), 3)),
                            q, normal, laser.angle_min, laser.resolution, window, gate)

@@ -12,7 +12,7 @@ normal is the wall's, and walls have no thickness.
 
 The attribute names are those the compiled kernels take (:mod:`tfloc.tfplus.kernels`): ``table``
 (distances, metres), ``origin`` (the outer corner of cell ``(0, 0)``), ``resolution``,
-``truncation``, ``points``/``normals``/``nearest``, ``face_plus``/``face_minus``, ``faces``.
+``points``/``normals``/``nearest``, ``face_plus``/``face_minus``, ``faces``.
 """
 
 from __future__ import annotations
@@ -50,10 +50,6 @@ class MapView:
     @property
     def resolution(self) -> float:
         return self.field.resolution
-
-    @property
-    def truncation(self) -> float:
-        return self.field.cap
 
     @property
     def points(self) -> np.ndarray:
