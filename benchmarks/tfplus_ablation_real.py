@@ -33,10 +33,12 @@ import pandas as pd
 
 import tfloc
 from tfloc import GridMap, Problem
+from tfloc.evaluation.outcome import Thresholds, failure_kind
 from tfloc.io.scenario import map_for, read_scans, read_scenario
 from tfloc.tfplus.refine import RefineConfig
 
 ROOT = Path(__file__).resolve().parents[1]
+SUCCESS = Thresholds()  # ≤ 10 cm and ≤ 2°, the project's one success rule
 DEV = ("real-intel-scan-to-map", "real-csail-scan-to-map")
 
 #: tf-plus as it was before the real logs (issue 15): refinement and selection against ray-cast
@@ -114,10 +116,8 @@ def run(datasets: list[str], variants: dict[str, dict], limit_per_group: int = 0
                 cpu = time.process_time() - c0
                 d_err = e.pose.distance_to(true)
                 o_err = abs(tfloc.angdiff(e.pose.theta, true.theta))
-                outcome = "success"
-                if d_err > 0.10 or o_err > math.radians(2):
-                    better = m.score(p, true) < m.score(p, e.pose)
-                    outcome = "local-optimum" if better else "ambiguous"
+                outcome = ("success" if SUCCESS.success(d_err, o_err)
+                           else failure_kind(m.score(p, e.pose), m.score(p, true)))
                 rows.append({"dataset": name, "variant": label, "scan_id": sid, "group": group,
                              "outcome": outcome, "dist_err_cm": 100 * d_err,
                              "orient_err_deg": math.degrees(o_err), "cpu_ms": 1000 * cpu,

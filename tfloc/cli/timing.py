@@ -59,7 +59,7 @@ def run(args: argparse.Namespace) -> int:
         bar.update(done - bar.n)
 
     rows, info = run_timing(args.run, args.per_stratum, SEED if args.seed is None else args.seed, args.cores,
-                            args.warmup, progress)
+                            args.warmup, progress, run=(df, doc))
     bar.close()
     summary = timing_summary(rows, reference, df)
     csv_path, md_path = write_timing(args.run, rows, summary, reference, info,

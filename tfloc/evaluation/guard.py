@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .metrics import summarize
+from .metrics import prepare, summarize
 from .outcome import Thresholds
 
 CONFIG = Path("benchmarks/regression.toml")
@@ -57,8 +57,9 @@ GUARDED = ["n", *(r.metric for r in RULES)]
 
 def guard_summary(estimates: pd.DataFrame, thresholds: Thresholds) -> pd.DataFrame:
     """The guarded metrics per matcher and group, plus an ``all`` row per matcher."""
-    per_group = summarize(estimates, by=["matcher", "group"], thresholds=thresholds)
-    overall = summarize(estimates, by=["matcher"], thresholds=thresholds).assign(group="all")
+    p = prepare(estimates, thresholds)  # once: summarize takes prepared rows as they are
+    per_group = summarize(p, by=["matcher", "group"], thresholds=thresholds)
+    overall = summarize(p, by=["matcher"], thresholds=thresholds).assign(group="all")
     out = pd.concat([per_group, overall], ignore_index=True)[[*KEY, *GUARDED]]
     return out.sort_values(list(KEY), ignore_index=True)
 

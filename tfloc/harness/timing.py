@@ -90,13 +90,15 @@ def pin(cores: Sequence[int]) -> list[int]:
 
 
 def run_timing(run_dir: Path, per_stratum: int = 4, seed: int = SEED, cores: Sequence[int] | None = None,
-               warmup: int = 2, progress: Callable[[int, int], None] | None = None) -> tuple[pd.DataFrame, dict]:
+               warmup: int = 2, progress: Callable[[int, int], None] | None = None,
+               run: tuple[pd.DataFrame, dict] | None = None) -> tuple[pd.DataFrame, dict]:
     """Re-time a stratified sample of the run in ``run_dir`` (see the module docstring), pinned
     to ``cores`` (default: the last core this process may run on).
 
     Returns the rows (``TIMING_COLUMNS``; times in ms) and a provenance dict (cores, load
-    averages, sample size, seed)."""
-    df, doc = read_run(run_dir)
+    averages, sample size, seed). ``run``: the run's estimates and ``run.json`` if the caller
+    has already read them (:func:`read_run`)."""
+    df, doc = read_run(run_dir) if run is None else run
     specs = [m for m in doc["config"]["matchers"] if m["label"] in set(df["matcher"])]
     paths = doc["datasets"]
     sample = sample_scans(df, per_stratum, seed)

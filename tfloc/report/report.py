@@ -251,8 +251,7 @@ def _scan_to_map_tables(t: pd.DataFrame) -> list[str]:
             S.success_by(t, "angle_bin", "°")]
 
 
-def _paired_section(pt: pd.DataFrame) -> list[str]:
-    sweep = pt["a"].nunique() == 1 and pt["b"].nunique() > MANY_MATCHERS - 1
+def _paired_section(pt: pd.DataFrame, sweep: bool) -> list[str]:
     out = ["## Paired comparisons (same scans)\n",
            ("Success of every label against the run's first, " if sweep else
             "Success of every pair of matchers ") + "scan by scan (see Definitions; `paired.csv` has "
@@ -265,8 +264,9 @@ def _paired_section(pt: pd.DataFrame) -> list[str]:
 
 def render(run_dir: Path, run: dict, p: pd.DataFrame, thr: Thresholds, s2s: set[str],
            figs: list[Path], pt: pd.DataFrame | None = None, failures: str = "", landscape: str = "",
-           line_labels: list[str] | None = None) -> str:
-    """The whole report.md text (``line_labels``: the labels a sweep's line figures show)."""
+           line_labels: list[str] | None = None, sweep: bool = False) -> str:
+    """The whole report.md text (``sweep``: a parameter sweep, see :data:`MANY_MATCHERS`;
+    ``line_labels``: the labels its line figures show)."""
     parts = [header(run_dir, run, p, thr, s2s), definitions(thr)]
     truth = p[p["truth"]]
     sc = scenario_summary(truth)
@@ -292,7 +292,7 @@ def render(run_dir: Path, run: dict, p: pd.DataFrame, thr: Thresholds, s2s: set[
                          "under a millimetre, which makes the improvement meaningless.\n")
         parts += _scan_to_map_tables(s2m)
     if pt is not None and len(pt):
-        parts += _paired_section(pt)
+        parts += _paired_section(pt, sweep)
     if (run_dir / "timing.md").is_file():
         parts.append("## Quiet re-timing\n\nA side-by-side timing pass of a stratified sample of this "
                      "run's scans in one pinned process: [timing.md](timing.md).\n")
@@ -362,6 +362,6 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
         failures = failures_section(draw_failures(run_dir, drawn, run.get("datasets", {})))
         landscape = landscape_section(*draw_landscapes(run_dir, p, run.get("datasets", {})))
     report = run_dir / "report.md"
-    report.write_text(render(run_dir, run, p, thr, s2s, figs, pt, failures, landscape, line_labels))
+    report.write_text(render(run_dir, run, p, thr, s2s, figs, pt, failures, landscape, line_labels, sweep))
     return ReportFiles(report, summary, tuple(figs))
 
