@@ -127,18 +127,6 @@ def check_workers(client, tasks: list[Task]) -> None:
         raise ConfigError(f"Dask worker {w} {'; '.join(problems)}{more}")
 
 
-def host_threads(client) -> dict[str, int]:
-    """Worker address → the Dask threads of all workers on the same machine."""
-    try:
-        workers = client.scheduler_info(n_workers=-1)["workers"]
-    except TypeError:  # distributed < 2025: every worker is listed anyway
-        workers = client.scheduler_info()["workers"]
-    per_host: dict[str, int] = {}
-    for w in workers.values():
-        per_host[w["host"]] = per_host.get(w["host"], 0) + int(w["nthreads"])
-    return {addr: per_host[w["host"]] for addr, w in workers.items()}
-
-
 def execute_dask(address: str, sec=None) -> Executor:
     """An :data:`~tfloc.harness.runner.Executor` running tasks on the Dask cluster at ``address``
     (``local:N``, ``tls://HOST:PORT`` with the :class:`~distributed.security.Security` ``sec``, or
@@ -155,7 +143,7 @@ def execute_dask(address: str, sec=None) -> Executor:
 
         with connect(address, sec) as client:
             check_workers(client, tasks)
-            client.register_plugin(TaskPool(host_threads(client)), name=PLUGIN_NAME)
+            client.register_plugin(TaskPool(), name=PLUGIN_NAME)
             run_id = uuid.uuid4().hex[:12]  # keys never collide with an earlier client's
             futures = client.map(run_on_worker, tasks, timeout_s=timeout_s, pure=False,
                                  key=[f"tfloc-{run_id}-{i}" for i in range(len(tasks))])

@@ -29,11 +29,8 @@ PLUGIN_NAME = "tfloc-task-pool"
 class TaskPool(WorkerPlugin):
     """A per-worker process pool that runs tasks with a time limit and keeps data caches warm."""
 
-    def __init__(self, host_threads: dict[str, int] | None = None) -> None:
-        """``host_threads``: worker address → Dask threads of all workers on its machine, so
-        that the task processes of a machine share its cores (a worker not listed counts only
-        its own threads). Sent to the workers by pickle: no pool, no lock yet."""
-        self.host_threads = dict(host_threads or {})
+    def __init__(self) -> None:
+        """Sent to the workers by pickle: no pool, no lock yet."""
         self.pool: ProcessPool | None = None
 
     def setup(self, worker) -> None:  # noqa: ANN001 - distributed.Worker
@@ -43,9 +40,8 @@ class TaskPool(WorkerPlugin):
         if multiprocessing.current_process().daemon:
             self.pool = None  # a daemonic process cannot have children: see preflight()
             return
-        on_host = max(n, int(self.host_threads.get(worker.address, n)))
         self.pool = ProcessPool(max_workers=n, context=multiprocessing.get_context("spawn"),
-                                initializer=_init_worker, initargs=(threads_per_job(on_host),))
+                                initializer=_init_worker, initargs=(threads_per_job(n),))
 
     def teardown(self, worker) -> None:  # noqa: ANN001
         if self.pool is not None:
