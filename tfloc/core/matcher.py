@@ -7,6 +7,14 @@ A third party adds a matcher with one line in its own ``pyproject.toml``::
 
 The entry point names a class (or factory) that takes keyword overrides of its configuration
 and returns an object with ``name``, ``localize(problem)`` and ``score(problem, pose)``.
+
+Two optional declarations tell the harness which kinds of task a matcher takes:
+
+* ``solves_global = True``: it answers *global* problems (``problem.initial is None``: no guess,
+  the whole map is searched); a local matcher given one gets an ``invalid:`` row, nothing runs
+  (:func:`check_solvable`);
+* a *tracker* (:mod:`tfloc.core.tracker`) has ``start``/``step`` instead of ``localize`` (e.g.
+  AMCL, a filter with no single-scan mode): it runs on sequence datasets only.
 """
 
 from __future__ import annotations
@@ -15,7 +23,7 @@ from functools import cache
 from importlib.metadata import entry_points
 from typing import Any, Protocol, runtime_checkable
 
-from tfloc.errors import LibraryMissingError, MatcherError, ParameterError
+from tfloc.errors import InvalidProblemError, LibraryMissingError, MatcherError, ParameterError
 
 from .pose import Pose
 from .problem import Estimate, Problem
@@ -35,6 +43,19 @@ class Matcher(Protocol):
     def score(self, problem: Problem, pose: Pose) -> float:
         """The matcher's own objective at ``pose`` (lower is better); used to classify failures."""
         ...
+
+
+def solves_global(matcher: object) -> bool:
+    """Whether ``matcher`` declares that it answers global problems (no initial guess)."""
+    return bool(getattr(matcher, "solves_global", False))
+
+
+def check_solvable(matcher: object, problem: Problem) -> None:
+    """Raise :class:`InvalidProblemError` when ``problem`` is global and ``matcher`` is local
+    (the harness turns it into an ``invalid:`` row; no matcher runs)."""
+    if problem.is_global and not solves_global(matcher):
+        raise InvalidProblemError(f"{problem.where}: a global problem (no initial pose), and matcher "
+                                  f"{getattr(matcher, 'name', type(matcher).__name__)!r} solves local problems only")
 
 
 @cache

@@ -49,17 +49,26 @@ class Problem:
         map: the known map (:class:`~tfloc.core.map.Map`).
         laser: the scanner that took ``ranges``.
         ranges: the real scan, metres, shape ``(laser.n_beams,)``; inf/nan/≥ max_range = no return.
-        initial: the initial pose guess (VP), metres/radians, world frame.
+        initial: the initial pose guess (VP), metres/radians, world frame; ``None`` poses a
+            *global* problem (no guess: the answer is searched over the whole map), which only
+            matchers that declare ``solves_global = True`` take (:func:`tfloc.core.matcher.check_solvable`).
     """
 
     map: Map
     laser: LaserSpec
     ranges: np.ndarray
-    initial: Pose
+    initial: Pose | None
     where: str = "scan"
+
+    @property
+    def is_global(self) -> bool:
+        """No initial guess: the pose is searched over the whole map."""
+        return self.initial is None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "ranges", check_ranges(self.ranges, self.laser, self.where))
+        if self.initial is None:
+            return
         if not self.initial.is_finite():
             raise InvalidProblemError(f"{self.where}: initial pose is not finite: {self.initial}")
         if not bool(self.map.in_bounds(np.array([[self.initial.x, self.initial.y]]))[0]):
@@ -82,6 +91,8 @@ class Estimate:
         iterations: outer iterations of the method.
         evaluations: objective evaluations (for ``tf``: turning-function cost evaluations).
         info: method-specific extras (JSON-serialisable values).
+        hypotheses: a global matcher's ranked answers, best first (``pose`` is the first); local
+            matchers leave it empty. The harness scores the first five (top-5 success).
     """
 
     pose: Pose
@@ -89,3 +100,4 @@ class Estimate:
     iterations: int = 0
     evaluations: int = 0
     info: dict[str, Any] = field(default_factory=dict)
+    hypotheses: tuple[Pose, ...] = ()

@@ -3,7 +3,18 @@
 ``scans.csv`` columns: ``scan_id,group,true_x,true_y,true_theta,init_x,init_y,init_theta,ranges``
 (metres, radians). ``true_*`` may be empty (truth unknown). ``ranges`` holds space-separated
 floats; ``inf``, ``nan`` or values ≥ max_range mean no return. Optional columns: ``stamp``
-(the scan's time in seconds, e.g. from a ROS bag; may be empty) and ``ref_ranges``.
+(the scan's time in seconds, e.g. from a ROS bag; may be empty), ``ref_ranges`` and
+``odom_x, odom_y, odom_theta`` (the robot's raw odometry pose, odometry frame).
+
+The dataset's **mode** (``scenario.json`` ``"mode"``, :data:`MODES`) says what kind of task its
+scans pose:
+
+* ``single`` (default): every row is one problem with its own initial guess (``init_*``);
+* ``scan-to-scan``: the same, the map being each row's reference scan (``ref_ranges``; older
+  datasets say ``"scan_to_scan": true``);
+* ``sequence``: the rows are one trajectory in time order: ``stamp`` strictly increasing,
+  ``odom_*`` on every row, ``init_*`` on the first row only (where the robot starts);
+* ``global``: no row has an initial guess: each pose is searched over the whole map.
 """
 
 from __future__ import annotations
@@ -28,6 +39,9 @@ from .text import csv_rows, parse_text
 MAX_BEAMS = 1_000_000  # a laser with more beams is a damaged scenario.json, not a scanner
 COLUMNS = ["scan_id", "group", "true_x", "true_y", "true_theta", "init_x", "init_y", "init_theta",
            "ranges"]
+ODOM_COLUMNS = ["odom_x", "odom_y", "odom_theta"]
+SINGLE, SCAN_TO_SCAN, SEQUENCE, GLOBAL = "single", "scan-to-scan", "sequence", "global"
+MODES = (SINGLE, SCAN_TO_SCAN, SEQUENCE, GLOBAL)
 
 
 @dataclass(frozen=True, eq=False)
@@ -37,11 +51,12 @@ class Scan:
     scan_id: str
     group: str
     ranges: np.ndarray
-    initial: Pose
+    initial: Pose | None  # None: a global problem, or a sequence row after the first
     true: Pose | None = None
     line: int = 0  # 1-based line in scans.csv, for messages
     ref_ranges: np.ndarray | None = None  # scan-to-scan datasets: the reference scan (see map_for)
     stamp: float | None = None  # seconds (optional ``stamp`` column), e.g. the ROS header stamp
+    odom: Pose | None = None  # sequences: the raw odometry pose at this scan (odometry frame)
 
 
 @dataclass(frozen=True, eq=False)
@@ -58,6 +73,13 @@ class Scenario:
     @property
     def scans_path(self) -> Path:
         return self.root / "scans.csv"
+
+    @property
+    def mode(self) -> str:
+        """What kind of task the scans pose (:data:`MODES`; see the module notes)."""
+        if self.extra.get("scan_to_scan"):
+            return SCAN_TO_SCAN
+        return str(self.extra.get("mode", SINGLE))
 
 
 def read_scenario(root: str | Path) -> Scenario:
@@ -89,6 +111,8 @@ def read_scenario(root: str | Path) -> Scenario:
     if laser.fov / laser.resolution > MAX_BEAMS:
         raise DatasetError(f"{path}: laser resolution_deg is too fine: more than {MAX_BEAMS} beams")
     extra = {k: v for k, v in doc.items() if k not in ("name", "map", "laser", "description")}
+    if extra.get("mode", SINGLE) not in MODES:
+        raise DatasetError(f"{path}: field 'mode' must be one of {', '.join(MODES)}, got {extra['mode']!r:.40}")
     try:
         map_path = (root / doc["map"]).resolve()
     except (OSError, ValueError) as exc:
@@ -134,13 +158,21 @@ def _is_float(s: str) -> bool:
 
 
 def iter_scans(scenario: Scenario) -> Iterator[Scan]:
-    """Yield the scans of ``scans.csv`` one by one, validating each row; errors name file:line."""
+    """Yield the scans of ``scans.csv`` one by one, validating each row and the dataset's mode
+    (a sequence's order, odometry and starting pose; a global dataset's missing guesses);
+    errors name file:line."""
     path = scenario.scans_path
     if not path.is_file():
         raise DatasetError(f"{scenario.root}: missing scans.csv")
-    _, rows = csv_rows(path, DatasetError, "scans.csv file", COLUMNS)
+    mode = scenario.mode
+    header, rows = csv_rows(path, DatasetError, "scans.csv file", COLUMNS)
+    if mode == SEQUENCE:
+        missing = [c for c in ("stamp", *ODOM_COLUMNS) if c not in header]
+        if missing:
+            raise DatasetError(f"{path}: a sequence needs the column(s) {', '.join(missing)}")
     seen: set[str] = set()
-    for line, row in rows:
+    last_stamp: float | None = None
+    for n, (line, row) in enumerate(rows):
         if None in row or any(row[c] is None for c in COLUMNS):
             raise DatasetError(f"{path}:{line}: wrong number of fields (expected {len(COLUMNS)})")
         sid = row["scan_id"].strip()
@@ -150,13 +182,30 @@ def iter_scans(scenario: Scenario) -> Iterator[Scan]:
             raise DatasetError(f"{path}:{line}: duplicate scan_id {sid!r}")
         seen.add(sid)
         ref = row.get("ref_ranges")
-        stamp = (row.get("stamp") or "").strip()
+        stamp_text = (row.get("stamp") or "").strip()
+        stamp = _stamp(stamp_text, path, line) if stamp_text else None
+        initial = _pose(row, "init", path, line, optional=mode in (SEQUENCE, GLOBAL))
+        odom = _pose(row, "odom", path, line, optional=True) if "odom_x" in row else None
+        if mode == SEQUENCE:
+            if n == 0 and initial is None:
+                raise DatasetError(f"{path}:{line}: a sequence's first row needs init_x/y/theta (where the robot starts)")
+            if stamp is None:
+                raise DatasetError(f"{path}:{line}: a sequence needs a stamp on every row")
+            if last_stamp is not None and not stamp > last_stamp:
+                raise DatasetError(f"{path}:{line}: stamp {stamp_text} is not after the previous row's "
+                                   f"({last_stamp:.6f}): a sequence's rows are in time order")
+            if odom is None:
+                raise DatasetError(f"{path}:{line}: a sequence needs odom_x/y/theta on every row")
+            last_stamp = stamp
+        elif mode == GLOBAL and initial is not None:
+            raise DatasetError(f"{path}:{line}: a global dataset has no initial pose (init_* must be empty)")
         yield Scan(sid, row["group"].strip(),
                    parse_ranges(row["ranges"], scenario.laser, path, line),
-                   _pose(row, "init", path, line, optional=False),
-                   _pose(row, "true", path, line, optional=True), line,
+                   initial, _pose(row, "true", path, line, optional=True), line,
                    parse_ranges(ref, scenario.laser, path, line) if ref else None,
-                   _stamp(stamp, path, line) if stamp else None)
+                   stamp, odom)
+    if mode == SEQUENCE and not seen:
+        raise DatasetError(f"{path}: a sequence with no scans")
 
 
 def _stamp(text: str, path: Path, line: int) -> float:
@@ -191,6 +240,10 @@ def _fmt(v: float) -> str:
     return "inf" if math.isinf(v) else ("nan" if math.isnan(v) else f"{v:.4f}".rstrip("0").rstrip("."))
 
 
+def _pose_text(p: Pose | None) -> list[str]:
+    return ["", "", ""] if p is None else [f"{p.x:.6f}", f"{p.y:.6f}", f"{p.theta:.7f}"]
+
+
 def write_scenario(root: str | Path, name: str, map_path: str | Path, laser: LaserSpec,
                    scans: Iterable[Scan], description: str = "", **extra) -> Path:
     """Write a dataset directory (``scenario.json`` + ``scans.csv``); ``map_path`` is stored
@@ -207,14 +260,16 @@ def write_scenario(root: str | Path, name: str, map_path: str | Path, laser: Las
     scans = list(scans)
     with_ref = any(s.ref_ranges is not None for s in scans)
     with_stamp = any(s.stamp is not None for s in scans)
+    with_odom = any(s.odom is not None for s in scans)
     with (root / "scans.csv").open("w", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow(COLUMNS + (["stamp"] if with_stamp else []) + (["ref_ranges"] if with_ref else []))
+        w.writerow(COLUMNS + (["stamp"] if with_stamp else []) + (ODOM_COLUMNS if with_odom else [])
+                   + (["ref_ranges"] if with_ref else []))
         for s in scans:
-            t = ["", "", ""] if s.true is None else [f"{s.true.x:.6f}", f"{s.true.y:.6f}", f"{s.true.theta:.7f}"]
             ref = [] if not with_ref else [" ".join(_fmt(v) for v in s.ref_ranges)
                                            if s.ref_ranges is not None else ""]
             stamp = [] if not with_stamp else ["" if s.stamp is None else f"{s.stamp:.6f}"]
-            w.writerow([s.scan_id, s.group, *t, f"{s.initial.x:.6f}", f"{s.initial.y:.6f}",
-                        f"{s.initial.theta:.7f}", " ".join(_fmt(v) for v in s.ranges), *stamp, *ref])
+            odom = [] if not with_odom else _pose_text(s.odom)
+            w.writerow([s.scan_id, s.group, *_pose_text(s.true), *_pose_text(s.initial),
+                        " ".join(_fmt(v) for v in s.ranges), *stamp, *odom, *ref])
     return root
