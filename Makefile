@@ -47,11 +47,11 @@ bench: $(STAMP)
 
 ## tf-plus's per-stage ablation on the real logs, maps as built and thickened (results/tf-plus-ablation-real/; ~5 min quiet).
 ablation-real: $(STAMP)
-	OMP_NUM_THREADS=1 $(BIN)/python benchmarks/tfplus_ablation_real.py --thicken 0 1 2 \
+	OMP_NUM_THREADS=1 $(BIN)/python scripts/tfplus_ablation_real.py --thicken 0 1 2 \
 		--out results/tf-plus-ablation-real/development
-	OMP_NUM_THREADS=1 $(BIN)/python benchmarks/tfplus_ablation_real.py --thicken 0 1 2 \
+	OMP_NUM_THREADS=1 $(BIN)/python scripts/tfplus_ablation_real.py --thicken 0 1 2 \
 		--datasets data/scenarios/real-aces-scan-to-map --out results/tf-plus-ablation-real/held-out-aces
-	OMP_NUM_THREADS=1 $(BIN)/python benchmarks/tfplus_ablation_real.py --matcher csm-corr --thicken 1 2 \
+	OMP_NUM_THREADS=1 $(BIN)/python scripts/tfplus_ablation_real.py --matcher csm-corr --thicken 1 2 \
 		--datasets real-intel-scan-to-map real-csail-scan-to-map real-aces-scan-to-map \
 		--out results/tf-plus-ablation-real/csm-corr-thickened
 

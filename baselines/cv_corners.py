@@ -38,11 +38,7 @@ Configuration choices and why:
   once a pair supporting the best match so far would have been drawn with probability
   ``confidence`` (w = that match's supporting pairs / all real pairs, n ≥ log(1 − c)/log(1 − w)),
   and in any case after ``max_hypotheses`` = 5000 scored transforms per step (at most 6 × 5000
-  per scan). ``confidence`` = 1 scores every hypothesis (up to the cap). Before, every
-  hypothesis was scored up to an evenly strided 5000: on real scans every step hit the cap
-  (0.7–77 s CPU per CSAIL relation scan, median 4 s; 25 s per CSAIL scan-to-map scan; 97 % of
-  it generating and scoring hypotheses); now a CSAIL relation scores a median of 916 (max 8061)
-  in all steps together (every 10th local relation).
+  per scan). ``confidence`` = 1 scores every hypothesis (up to the cap).
 * **Refinement by OpenCV**: the best hypothesis's inlier pairs go to
   ``cv2.estimateAffinePartial2D`` with RANSAC (reprojection threshold ``inlier_tol`` on the first
   step, when the two viewpoints still differ, then ``fine_tol`` = 3 cm; OpenCV's default
@@ -51,49 +47,8 @@ Configuration choices and why:
 * **Re-simulation**: the virtual scan is ray-cast again at the new estimate and the match repeated
   (up to ``max_iterations`` = 6; ``converged`` when a step moves < 5 mm and < 0.05°). As the two
   viewpoints coincide, both corner sets see the same occlusions and field-of-view ends.
-* Choices measured on the quick test-room check (90 problems; a script of the first session, since replaced by the harness's run configurations;
-  0–3 m / 0–15°): with the hypothesis window restricted to ±3° / 0.3 m after the first step
-  success was 70 %, with the full window at every step 78 % (so the full window is kept);
-  ``corner_spacing`` 2 cm vs 5 cm: 78 % vs 80 % and median 17 vs 12 ms per scan, 2 cm kept
-  because its estimates settle (converge) where 5 cm ones keep jittering by a few mm;
-  without corner refinement (2 cm): 71 %. With the noise-corner filter and the adaptive search: 80 %.
-* ``straight_tol`` and ``confidence`` were chosen on a development subset, CPU ms per scan
-  (``benchmarks/cv_corners_real.py``, one process): real-csail-relations rows 0–19 of each
-  group, real-csail-scan-to-map and real-intel-scan-to-map rows 0–1 of each offset cell,
-  office-pool rows 100–119 of each cell, detail-1 and detail-3 rows 40–49 of each cell.
-  Success / CPU ms median (p95); "rms" rows test the RMS distance from the chord instead of the
-  largest one:
-
-  ===============  =================  =================  ==========  ========  ==========
-  straight_tol,    CSAIL relations    CSAIL scan-to-map  Intel       office    detail-1/3
-  confidence       (40, 7 invalid)    (18)               (18)        (180)     (180)
-  ===============  =================  =================  ==========  ========  ==========
-  off, 1           62.5 % 119 (309)   94.4 % 267 (433)   66.7 % 6.5  70.6 %    64.4 %
-  off, 0.999       65.0 % 34 (252)    88.9 % 219 (436)   66.7 % 5.0  68.9 %    65.0 %
-  rms 1 cm, 0.999  65.0 % 30 (176)    94.4 % 119 (238)   66.7 % 4.1  70.0 %    65.6 %
-  rms 2 cm, 0.999  67.5 % 16 (55)     94.4 % 34 (74)     55.6 % 3.9  70.0 %    67.2 %
-  rms 3 cm, 0.999  67.5 % 13 (34)     83.3 % 22 (45)     61.1 % 4.3  68.9 %    67.2 %
-  2 cm, 0.999      67.5 % 25 (128)    94.4 % 74 (154)    66.7 % 3.8  70.0 %    66.7 %
-  3 cm, 0.99       70.0 % 14 (61)     94.4 % 33 (79)     61.1 % 3.6  69.4 %    67.2 %
-  3 cm, 0.999      70.0 % 16 (87)     88.9 % 44 (93)     61.1 % 3.9  70.6 %    68.3 %
-  3 cm, 0.9999     70.0 % 17 (93)     88.9 % 47 (127)    66.7 % 3.6  70.6 %    67.8 %
-  4 cm, 0.999      65.0 % 16 (45)     88.9 % 32 (58)     55.6 % 3.9  69.4 %    67.8 %
-  5 cm, 0.999      62.5 % 17 (38)     83.3 % 22 (57)     72.2 % 4.2  69.4 %    67.2 %
-  ===============  =================  =================  ==========  ========  ==========
-
-  3 cm (largest deviation), 0.999: the best success on the CSAIL relations and the office sets,
-  p95 under 100 ms, and on the real development scans found by every variant (94 scans, adding
-  rows 10–13 of both scan-to-map sets) the best distance error, mean 3.65 cm (no filter 3.94 cm,
-  rms 2 cm 4.71 cm); 0.999 is the usual RANSAC confidence with a margin for the
-  supporting-pair estimate. Checked on scans not used for tuning: the paper-protocol smoke set
-  (office-pool and detail-2 rows 0–19 of each cell) succeeds 63.9 % (61.7 % before; 0–1 m
-  84.2 %, 1–2 m 68.3 %, 2–3 m 39.2 %), median error of the scans that succeed in both 0.95 →
-  0.82 cm and 0.127 → 0.124°; all 3240 paper-protocol scans 66.5 % (65.8 %; the 2880 outside the
-  development subset 66.2 %, 65.6 % before), paired errors unchanged; real held-out scans (CSAIL
-  relations rows 20–49, every 20th local relation from row 50, scan-to-map rows 2–9 of each
-  cell): median 4–21 ms, max 77 ms per scan. The seeded draw order matters on real scans: Intel
-  rows 0–9 (90 scans) succeed 66 % with ``seed`` 0, 74 % and 72 % with seeds 1 and 2, 70 %
-  scoring every hypothesis (70 % before).
+* ``straight_tol`` = 3 cm and ``confidence`` = 0.999 were chosen on a development subset and checked
+  on held-out scans: the measurements are in ``docs/baselines/cv-corners.md``.
 * Fewer than 2 corners in either scan, no hypothesis, fewer than 2 inliers or a rejected scale on
   the first step is a ``no-answer``: the initial pose is returned with ``converged=False`` and
   ``info["status"] = "no-answer"`` (never an exception). A later step that fails keeps the last

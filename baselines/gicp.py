@@ -3,51 +3,22 @@
 Inputs are the map, the laser spec, the real scan and the initial pose (never the truth). It calls
 ``small_gicp.align`` (GICP, Segal et al. 2009) on ``small_gicp.PointCloud``/``KdTree`` objects whose
 covariances small_gicp estimates itself; small_gicp's internals are not rewritten. Its Python API is
-3D only. Configuration choices and why, measured on the development split (office-pool scans
-100–139 of each of the nine offset cells, 360 scans, disjoint from the benchmark's scans 0–19;
-success ≤ 10 cm and ≤ 2°; success by offset bin 0–1 / 1–2 / 2–3 m; CPU ms = ``time.process_time``
-per ``localize``; the variants' table: ``python benchmarks/peers_dev.py gicp``). This
-configuration: 48.1 % (92.5 / 44.2 / 7.5), median 0.14 cm / 0.024° when successful, 3.7 ms
-median CPU.
+3D only. Configuration choices, in short (the measurements behind each, on a development split
+disjoint from the benchmark's scans: ``docs/baselines/gicp.md``; the variants: ``benchmarks/dev/gicp.toml``):
 
-* **The 2D points are stacked in three layers** ``layers`` = z −0.05, 0, +0.05 m (scan and map alike).
-  small_gicp regularises each covariance to eigenvalues (1e-3, 1, 1) along its eigenvectors,
-  smallest first. On points all at z = 0 the smallest eigenvalue is z (exactly 0) or, on the
-  noise-free map samples, a tie between z and the in-plane normal, so the "surface normal" is z
-  or arbitrary and GICP degenerates towards point-to-point ICP in the plane. With small_gicp's own
-  preprocessing (``align`` on raw points, 0.25 m downsampling) and offsets of 0–1 m (120 scans),
-  z = 0 gave GICP 67.5 % and PLANE_ICP 37.5 %, three layers at ±0.2 m 86.7 % and 85.8 %. With this
-  module's pipeline (no downsampling, dense map samples) z = 0 still succeeds as often (47.5 %)
-  but less precisely (median 0.22 cm / 0.055° against 0.14 cm / 0.024°). The layers give every
-  neighbourhood a vertical extent, so the flat direction is the in-plane normal: a vertical wall,
-  which is what a 2D wall is. The gap must be small enough that the ``num_neighbors`` = 10
-  nearest neighbours reach the other layers: with 5 cm map samples ±0.05 m puts 96 % of the map's
-  normals in the plane (|n_z| < 0.1), ±0.2 m 75 %; on the scans 87 % and 55 %. Success: ±0.05 m
-  48.1 %, ±0.1 m 47.2 %, ±0.2 m 43.9 %; 20 neighbours 46.1 %.
-* **Registration type GICP**, through the ``KdTree`` overload of ``align``. With the layers:
-  ICP 46.9 %, PLANE_ICP 48.3 %, GICP 48.1 %; at z = 0: 46.9 %, 47.5 %, 47.5 %. These differ by at
-  most five scans of 360: the type does not decide success at these offsets, the basin does
-  (all ~90–96 % at 0–1 m, 40–44 % at 1–2 m, ≤ 9 % at 2–3 m). GICP is kept because it is what
-  small_gicp is used for (PLANE_ICP with in-plane normals is what ``o3d-icp`` already is) and it
-  is as precise (ICP: 0.27 cm / 0.094°). **VGICP is not offered**: it failed on 94–98 % of the
-  development scans with voxels of 0.25–1 m or a 2 → 0.25 m voxel schedule, with or without
-  layers (a 1 m voxel merges the walls of a corner into one Gaussian; a layer on a voxel boundary
-  at z = 0 flickers between voxels).
-* **Target = the map's sampled geometry** (``map.sample_points`` every ``map_spacing`` = 5 cm,
-  the whole map; the samples of :func:`tfloc.maps.cache.map_geometry`, shared with ``o3d-icp`` and
-  ``kiss-icp``), stacked, with its ``KdTree`` and covariances built once per map and cached
-  (:mod:`tfloc.maps.cache`). 2 cm samples: 48.3 % at 5.0 instead of 3.7 ms.
+* **The 2D points are stacked in three layers** ``layers`` = z −0.05, 0, +0.05 m (scan and map
+  alike), so that small_gicp's covariances have an in-plane normal (on points all at z = 0 the
+  flattest direction is z, and GICP degenerates towards point-to-point ICP in the plane).
+* **Registration type GICP** (what small_gicp is for; ICP and PLANE_ICP succeed as often, the
+  basin decides success, not the type). VGICP is not offered: it failed on most development scans.
+* **Target = the map's sampled geometry** every ``map_spacing`` = 5 cm
+  (:func:`tfloc.maps.cache.map_geometry`, shared with ``o3d-icp`` and ``kiss-icp``), with its
+  ``KdTree`` and covariances built once per map.
 * **Coarse-to-fine correspondence gates** ``gates`` = 2.0 → 1.0 → 0.5 → 0.2 → 0.1 m (``o3d-icp``'s
-  schedule), each stage from the last result. A single 1 m gate (small_gicp's default) gave
-  40.6 %, a schedule from 1 m 42.5 %, from 3 m 48.6 % (two scans more than from 2 m, at a 34 %
-  longer p95 time: not kept).
-* **Projected onto SE(2) after every stage** (z, roll and pitch are free in small_gicp's 6-DoF
-  solve; the projection keeps them at zero).
-* small_gicp's defaults otherwise: ``max_iterations`` = 20 per stage (50: no change), its
-  rotation / translation convergence thresholds (0.1°, 1 mm), ``num_threads`` = 1 (the harness
-  runs one worker per core).
-* ``converged`` = at least ``min_inlier_fraction`` = 0.5 of the stacked scan points have a map
-  partner within the last gate at the result (small_gicp's ``num_inliers``); a self-check.
+  schedule), each stage from the last result, **projected onto SE(2) after every stage**.
+* small_gicp's defaults otherwise (``max_iterations`` = 20 per stage, its convergence thresholds,
+  ``num_threads`` = 1). ``converged`` = at least ``min_inlier_fraction`` = 0.5 of the stacked scan
+  points have a map partner within the last gate (a self-check).
 
 **Amortised per map** (``prepare``): the stacked map samples, their ``KdTree`` and covariances.
 **Per scan**: the scan's own cloud, tree and covariances, and the five ``align`` calls.

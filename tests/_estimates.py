@@ -82,7 +82,7 @@ def write_run(path: Path, rows: list[dict], datasets: dict[str, str]) -> Path:
                       "jobs": 2, "timeout_s": 10.0, "limit_per_group": 0,
                       "success": {"dist_m": 0.1, "orient_deg": 2.0}},
            "versions": {"tfloc": "0.1.0"}, "git": {"commit": "abc123", "dirty": False},
-           "machine": {"platform": "test", "cpu_count": 2, "python": "3.11"}, "threads_per_job": 1,
+           "machine": {"platform": "test", "cpu_count": 2, "python": "3.11"},
            "datasets": datasets,
            "sessions": [{"started": "2026-01-01T00:00:00+0000", "tasks": 10, "already_done": 0,
                          "loadavg_start": [3.5, 3.0, 2.5], "loadavg_end": [4.25, 3.5, 3.0]}]}

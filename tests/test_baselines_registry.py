@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
 import os
@@ -12,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _registry import BASELINES, kind, single_scan
 from tfloc.baselines._geometry import matrix_to_pose, pose_to_matrix
 from tfloc.baselines.o3d_icp import Config as O3dConfig
 
@@ -103,37 +103,30 @@ class _ProtocolOnlyMap:
         return self._inner.bounds
 
 
-def _needs(module: str) -> pytest.MarkDecorator:
-    return pytest.mark.skipif(importlib.util.find_spec(module) is None, reason=f"{module} is not installed")
-
-
-NAMES = ["o3d-icp", "kiss-icp", "csm-corr", "cv-corners",
-         pytest.param("gicp", marks=_needs("small_gicp")),
-         pytest.param("karto", marks=_needs("karto_scanmatcher"))]
-
-
-@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("name", BASELINES)
 def test_uses_only_the_map_protocol(name: str) -> None:
     from _baseline_cases import make_problem
 
     import tfloc
+    matcher = single_scan(name)
     problem, true = make_problem()
-    wrapped = tfloc.Problem(_ProtocolOnlyMap(problem.map), problem.laser, problem.ranges, problem.initial)
-    est = tfloc.get_matcher(name).localize(wrapped)
+    wrapped = tfloc.Problem(_ProtocolOnlyMap(problem.map), problem.laser, problem.ranges,
+                            None if kind(matcher) == "global" else problem.initial)
+    est = matcher.localize(wrapped)
     assert est.pose.distance_to(true) < 0.02
 
 
-@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("name", BASELINES)
 @pytest.mark.parametrize("n_returns", [1, 3])
 def test_tiny_scans_do_not_crash(name: str, n_returns: int) -> None:
     from _baseline_cases import make_problem
 
     import tfloc
+    matcher = single_scan(name)
     problem, _ = make_problem()
     ranges = np.full_like(problem.ranges, np.inf)
     ranges[80:80 + n_returns] = problem.ranges[80:80 + n_returns]
     tiny = tfloc.Problem(problem.map, problem.laser, ranges, problem.initial)
-    matcher = tfloc.get_matcher(name)
     est = matcher.localize(tiny)
     assert est.pose.is_finite()
     assert np.isfinite(matcher.score(tiny, est.pose))

@@ -29,11 +29,11 @@ SCEN = DATA / "scenarios"
 
 
 def _spacing_analysis():
-    """data/real/spacing.py: the analysis behind SPACING.md (kept with the data, not in the package)."""
+    """scripts/spacing.py: the analysis behind SPACING.md (a research script, not in the package)."""
     import importlib.util
     import sys
 
-    spec = importlib.util.spec_from_file_location("real_spacing", DATA / "real" / "spacing.py")
+    spec = importlib.util.spec_from_file_location("real_spacing", DATA.parent / "scripts" / "spacing.py")
     mod = importlib.util.module_from_spec(spec)
     sys.modules[spec.name] = mod  # dataclasses look their module up while the class is made
     spec.loader.exec_module(mod)

@@ -19,19 +19,25 @@ from __future__ import annotations
 import argparse
 import csv
 import sys
-import time
 import tomllib
 from pathlib import Path
 
 from tqdm import tqdm
 
-from tfloc.core.problem import Problem
+from tfloc.core.matcher import check_solvable
 from tfloc.errors import ConfigError, InvalidProblemError
 from tfloc.harness.config import MatcherSpec
 from tfloc.harness.fingerprint import build_matcher
-from tfloc.harness.task import load_matcher, status_of, warm
 from tfloc.harness.threads import limit_threads
-from tfloc.io.scenario import iter_scans, map_for, read_scenario
+from tfloc.harness.workspace import (
+    load_matcher,
+    problem_of,
+    status_of,
+    timed_localize,
+    use_map,
+    warm,
+)
+from tfloc.io.scenario import iter_scans, read_scenario
 
 HELP = "localize the scans of a dataset with one matcher (no scoring)"
 COLUMNS = ["scan_id", "matcher", "est_x", "est_y", "est_theta", "runtime_s", "cpu_s", "converged",
@@ -76,11 +82,10 @@ def run(args: argparse.Namespace) -> int:
                             keys={k: f"--param {k}" for k in params})
     build_matcher(spec)
     matcher = load_matcher(spec.name, spec.params_json)
-    cache: dict = {}
     if args.map is not None:
         from tfloc.io.maps import load_map
 
-        cache[scenario.map_path] = load_map(args.map)
+        use_map(scenario, load_map(args.map))
     args.out.parent.mkdir(parents=True, exist_ok=True)
     counts = {"ok": 0, "failed": 0, "invalid": 0, "error": 0}
     with args.out.open("w", newline="") as fh:
@@ -91,31 +96,29 @@ def run(args: argparse.Namespace) -> int:
                                       disable=not sys.stderr.isatty())):
             if args.limit is not None and n >= args.limit:
                 break
-            w.writerow(_localize(matcher, scenario, scan, cache, counts, first=n == 0))
+            w.writerow(_localize(matcher, scenario, scan, counts, first=n == 0))
             fh.flush()
     print(f"wrote {args.out}: " + ", ".join(f"{k} {v}" for k, v in counts.items()), file=sys.stderr)
     return 3 if counts["error"] else 0
 
 
-def _localize(matcher, scenario, scan, cache: dict, counts: dict, first: bool) -> list:
+def _localize(matcher, scenario, scan, counts: dict, first: bool) -> list:
     """One output row: the estimate, or an ``invalid:``/``error:`` status without one."""
-    where = f"{scenario.scans_path}:{scan.line}"
     try:
-        problem = Problem(map_for(scenario, scan, cache), scenario.laser, scan.ranges, scan.initial, where=where)
+        problem = problem_of(scenario, scan)
+        check_solvable(matcher, problem)
     except InvalidProblemError as exc:
         counts["invalid"] += 1
         return [scan.scan_id, matcher.name, *[""] * 8, f"invalid:{exc}"]
     try:
-        if first:  # untimed; a scan-to-scan map is new for each map_for call, so not warmed here
-            warm(matcher, Problem(map_for(scenario, scan, cache), scenario.laser, scan.ranges, scan.initial,
-                                  where=where))
-        t0, c0 = time.perf_counter(), time.process_time()
-        est = matcher.localize(problem)
-        dt, cpu = time.perf_counter() - t0, time.process_time() - c0
+        if first:  # untimed; a scan-to-scan map is new for each problem, so not warmed here
+            warm(matcher, problem_of(scenario, scan))
+        t = timed_localize(matcher, problem)
     except Exception as exc:  # noqa: BLE001 - a failing matcher is a result, as in tfloc bench
         counts["error"] += 1
         return [scan.scan_id, matcher.name, *[""] * 8, f"error:{type(exc).__name__}: {exc}".replace("\n", " ")[:300]]
+    est = t.estimate
     status = status_of(est)
     counts[status] += 1
     return [scan.scan_id, matcher.name, f"{est.pose.x:.6f}", f"{est.pose.y:.6f}", f"{est.pose.theta:.7f}",
-            f"{dt:.6f}", f"{cpu:.6f}", int(est.converged), est.iterations, est.evaluations, status]
+            f"{t.wall_s:.6f}", f"{t.cpu_s:.6f}", int(est.converged), est.iterations, est.evaluations, status]

@@ -16,15 +16,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--dataset", type=Path, action="append", dest="datasets",
                         help="a relations dataset, one per initial-guess protocol (repeatable; default: "
                              "data/scenarios/real-csail-relations and real-csail-relations-perturbed)")
-    parser.add_argument("--max-dist-cm", type=float, default=10.0, help="success threshold (default 10 cm)")
-    parser.add_argument("--max-angle-deg", type=float, default=2.0, help="success threshold (default 2°)")
+    parser.add_argument("--max-dist-cm", type=float, help="success threshold on distance, cm (default: the run's)")
+    parser.add_argument("--max-angle-deg", type=float, help="success threshold on orientation, degrees (default: the run's)")
 
 
 def run(args: argparse.Namespace) -> int:
     from tfloc.evaluation.outcome import Thresholds
+    from tfloc.io.rundir import RunDir
     from tfloc.report.relations_note import write_note
 
     datasets = args.datasets or [Path("data/scenarios/real-csail-relations"),
                                  Path("data/scenarios/real-csail-relations-perturbed")]
-    print(write_note(args.results, datasets, Thresholds(args.max_dist_cm / 100.0, args.max_angle_deg)))
+    run = RunDir(args.results).info().thresholds
+    thr = Thresholds(run.dist_m if args.max_dist_cm is None else args.max_dist_cm / 100.0,
+                     run.orient_deg if args.max_angle_deg is None else args.max_angle_deg)
+    print(write_note(args.results, datasets, thr))
     return 0

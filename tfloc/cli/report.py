@@ -30,11 +30,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from tfloc.evaluation.outcome import Thresholds
-    from tfloc.report.report import load_run, write_report
+    from tfloc.io.rundir import RunDir
+    from tfloc.report.report import write_report
 
     thr = None
     if args.success_cm is not None or args.success_deg is not None:
-        base = Thresholds.from_run(load_run(args.run)[1])
+        base = RunDir(args.run).info().thresholds
         thr = Thresholds(base.dist_m if args.success_cm is None else args.success_cm / 100.0,
                          base.orient_deg if args.success_deg is None else args.success_deg)
     files = write_report(args.run, thr, with_figures=not args.no_figures)

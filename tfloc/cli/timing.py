@@ -47,9 +47,9 @@ def run(args: argparse.Namespace) -> int:
     from tfloc.harness.timing import SEED, read_run, run_timing
     from tfloc.report.timing import write_timing
 
-    df, doc = read_run(args.run)
+    df, run_info = read_run(args.run)
     try:
-        reference = reference_of([m["label"] for m in doc["config"]["matchers"]], args.reference)
+        reference = reference_of([m["label"] for m in run_info.matchers], args.reference)
     except ValueError as exc:
         raise ConfigError(str(exc)) from None
     bar = tqdm(unit="scan", desc="timing", disable=not sys.stderr.isatty())
@@ -59,11 +59,11 @@ def run(args: argparse.Namespace) -> int:
         bar.update(done - bar.n)
 
     rows, info = run_timing(args.run, args.per_stratum, SEED if args.seed is None else args.seed, args.cores,
-                            args.warmup, progress, run=(df, doc))
+                            args.warmup, progress, run=(df, run_info))
     bar.close()
     summary = timing_summary(rows, reference, df)
     csv_path, md_path = write_timing(args.run, rows, summary, reference, info,
-                                     doc["config"].get("name", args.run.name))
+                                     run_info.name or args.run.name)
     print(summary[["matcher", "cpu_median_ms", "ratio_to_reference", "run_over_quiet"]].to_string(
         index=False, float_format=lambda v: f"{v:.2f}"), file=sys.stderr)
     print(f"timing: {md_path} ({csv_path.name})", file=sys.stderr)

@@ -70,27 +70,41 @@ def available_matchers() -> list[str]:
     return sorted(_registry())
 
 
-def get_matcher(name: str, **params: Any) -> Matcher:
-    """Instantiate the registered matcher ``name`` with configuration overrides ``params``.
-
-    Raises :class:`MatcherError` for an unknown name or a missing optional library, and its
-    subclass :class:`ParameterError` for an unknown parameter or a bad value.
-    """
-    reg = _registry()
-    if name not in reg:
-        raise MatcherError(f"unknown matcher {name!r}; registered: {', '.join(sorted(reg))}")
-    module, _, attr = reg[name].partition(":")
+def _factory(name: str, target: str, registered: bool) -> Any:
+    """The class (or factory) ``target`` (``module:attr``) of matcher ``name``: one import path for
+    registered matchers and ``module:Class`` names alike."""
+    module, _, attr = target.partition(":")
     try:
-        mod = __import__(module, fromlist=[attr])
-        factory = getattr(mod, attr)
+        return getattr(__import__(module, fromlist=[attr]), attr)
     except ImportError as exc:
         missing = exc.name or ""
+        if not registered:
+            raise MatcherError(f"matcher {name!r}: cannot import it ({exc})") from None
         if missing and (module == missing or module.startswith(missing + ".")):
             raise MatcherError(f"matcher {name!r}: its module {module!r} is not part of this installation") from None
         lib = f"the library {missing.partition('.')[0]!r}" if missing else "a library"
         raise LibraryMissingError(
             f"matcher {name!r} needs {lib}, which is not installed or failed to import: {exc} "
             f"(install the project with its dependencies: pip install -e .)") from None
+    except AttributeError as exc:
+        raise MatcherError(f"matcher {name!r}: cannot import it ({exc})") from None
+
+
+def get_matcher(name: str, **params: Any) -> Matcher:
+    """Instantiate the registered matcher ``name`` (or the class ``module:Class``: its module is
+    imported, so its code runs; the command line allows that only with ``--allow-import``) with
+    configuration overrides ``params``.
+
+    Raises :class:`MatcherError` for an unknown name or a missing optional library, and its
+    subclass :class:`ParameterError` for an unknown parameter or a bad value.
+    """
+    if ":" in name:
+        factory = _factory(name, name, registered=False)
+    else:
+        reg = _registry()
+        if name not in reg:
+            raise MatcherError(f"unknown matcher {name!r}; registered: {', '.join(sorted(reg))}")
+        factory = _factory(name, reg[name], registered=True)
     try:
         return factory(**params)
     except ParameterError as exc:

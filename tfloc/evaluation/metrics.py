@@ -39,11 +39,11 @@ from tfloc.datasets.protocol import ANGLE_BINS_DEG, DIST_BINS_M
 from .outcome import (
     DIVERGED,
     NEAR,
-    NO_ANSWER,
     OUTCOMES,
     SUCCESS,
+    UNSCORED,
     Thresholds,
-    failure_kind,
+    outcome,
     search_outcome,
 )
 from .stats import bootstrap_median, wilson
@@ -59,7 +59,6 @@ def _labels(edges: tuple[float, ...]) -> tuple[str, ...]:
 
 DIST_BINS = _labels(DIST_EDGES_CM)
 ANGLE_BINS = _labels(ANGLE_EDGES_DEG)
-UNSCORED = "unscored"  # failed under overridden thresholds but the run recorded no scores
 METRIC_COLUMNS = (
     "n", "n_truth", "n_est", "n_excluded", "n_timeout", "n_error", "n_invalid",
     "dist_mean_cm", "dist_std_cm", "dist_median_cm", "dist_median_lo_cm", "dist_median_hi_cm",
@@ -107,23 +106,16 @@ def has_estimate(df: pd.DataFrame) -> pd.Series:
 
 
 def classify(df: pd.DataFrame, thr: Thresholds) -> pd.Series:
-    """The outcome of each row under thresholds ``thr`` (the runner's rule, recomputed).
-
-    No truth → missing; status not ``ok`` → ``no-answer``; within both thresholds →
-    ``success``; otherwise ``local-optimum`` if the matcher scored the truth lower than its
-    answer, ``ambiguous`` if not. A row that failed only under stricter thresholds than the
-    run's has no recorded scores: it keeps a recorded failure outcome, else ``unscored``.
-    """
-    d = pd.to_numeric(df["dist_err_m"], errors="coerce")
-    o = pd.to_numeric(df["orient_err_rad"], errors="coerce")
+    """The outcome of each row under thresholds ``thr``: :func:`tfloc.evaluation.outcome.outcome`,
+    the rule the worker applied, on the recorded errors and scores (missing without truth).
+    A row that failed only under stricter thresholds than the run's has no recorded scores: it
+    keeps a recorded failure outcome, else it is ``unscored``."""
     nan = pd.Series(np.nan, index=df.index)
-    s_est = pd.to_numeric(df.get("score_est", nan), errors="coerce")
-    s_true = pd.to_numeric(df.get("score_true", nan), errors="coerce")
+    num = {c: pd.to_numeric(df.get(c, nan), errors="coerce")
+           for c in ("dist_err_m", "orient_err_rad", "score_est", "score_true")}
     recorded = df.get("outcome", pd.Series("", index=df.index)).fillna("").astype(str)
-    scored = s_est.notna() & s_true.notna()
-    fail = np.where(scored, failure_kind(s_est, s_true),
-                    np.where(recorded.isin(OUTCOMES[1:3]), recorded, UNSCORED))
-    out = np.where(df["status"] != "ok", NO_ANSWER, np.where(thr.success(d, o), SUCCESS, fail))
+    out = outcome(df["status"] == "ok", num["dist_err_m"], num["orient_err_rad"], num["score_est"],
+                  num["score_true"], thr, recorded.to_numpy(dtype=object))
     return pd.Series(np.where(has_truth(df), out, None), index=df.index, dtype=object)
 
 

@@ -18,53 +18,19 @@ Inputs are metres and radians; the functions are vectorised (scalars or arrays a
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+
+from tfloc.core.thresholds import Thresholds
 
 SUCCESS, LOCAL_OPTIMUM, AMBIGUOUS, NO_ANSWER = "success", "local-optimum", "ambiguous", "no-answer"
 OUTCOMES = (SUCCESS, LOCAL_OPTIMUM, AMBIGUOUS, NO_ANSWER)
 NEAR, DIVERGED, OTHER = "near", "diverged", "other"
 SEARCH_OUTCOMES = (SUCCESS, NEAR, DIVERGED, OTHER)
 NEAR_DIST_M, NEAR_ORIENT_DEG = 0.30, 5.0
-
-
-@dataclass(frozen=True)
-class Thresholds:
-    """Success: distance error ≤ ``dist_m`` (metres) and orientation error ≤ ``orient_deg`` (°)."""
-
-    dist_m: float = 0.10
-    orient_deg: float = 2.0
-
-    @property
-    def orient_rad(self) -> float:
-        """The orientation threshold in radians."""
-        return math.radians(self.orient_deg)
-
-    def success(self, dist_err_m: Any, orient_err_rad: Any) -> Any:
-        """Whether errors (metres, radians; the sign of the angle is ignored) are a success.
-        NaN errors are not."""
-        d = np.asarray(dist_err_m, dtype=float)
-        o = np.degrees(np.abs(np.asarray(orient_err_rad, dtype=float)))
-        ok = (d <= self.dist_m) & (o <= self.orient_deg)
-        return bool(ok) if ok.ndim == 0 else ok
-
-    def to_dict(self) -> dict[str, float]:
-        """The ``[success]`` table of a run configuration and of ``run.json``."""
-        return {"dist_m": self.dist_m, "orient_deg": self.orient_deg}
-
-    @classmethod
-    def from_dict(cls, doc: dict | None) -> Thresholds:
-        """Read a ``[success]`` table (defaults for missing keys)."""
-        doc = doc or {}
-        return cls(float(doc.get("dist_m", cls.dist_m)), float(doc.get("orient_deg", cls.orient_deg)))
-
-    @classmethod
-    def from_run(cls, run: dict) -> Thresholds:
-        """The thresholds recorded in a ``run.json`` document (defaults if absent)."""
-        return cls.from_dict(run.get("config", {}).get("success"))
+NEAR_THRESHOLDS = Thresholds(NEAR_DIST_M, NEAR_ORIENT_DEG)
+UNSCORED = "unscored"  # failed under thresholds stricter than the run's, which recorded no scores
 
 
 def failure_kind(score_est: Any, score_true: Any) -> Any:
@@ -76,16 +42,24 @@ def failure_kind(score_est: Any, score_true: Any) -> Any:
 
 
 def outcome(answered: Any, dist_err_m: Any, orient_err_rad: Any, score_est: Any, score_true: Any,
-            thresholds: Thresholds) -> Any:
-    """The outcome of each localization (see the module notes); scores may be NaN for successes."""
+            thresholds: Thresholds, recorded: Any = "") -> Any:
+    """The outcome of each localization (see the module notes): the one rule, applied by the worker
+    when it writes a row and by the metrics when a report re-reads rows (maybe under other
+    thresholds). Scores are NaN where they were not taken (a success, or a row whose matcher
+    could not score): such a failure keeps its ``recorded`` failure outcome (``local-optimum`` or
+    ``ambiguous``), else it is ``unscored``."""
+    s_est, s_true = np.asarray(score_est, dtype=float), np.asarray(score_true, dtype=float)
+    rec = np.asarray(recorded, dtype=object)
+    scored = ~np.isnan(s_est) & ~np.isnan(s_true)
+    fail = np.where(scored, failure_kind(s_est, s_true),
+                    np.where(np.isin(rec, (LOCAL_OPTIMUM, AMBIGUOUS)), rec, UNSCORED))
     out = np.where(~np.asarray(answered, dtype=bool), NO_ANSWER,
-                   np.where(thresholds.success(dist_err_m, orient_err_rad), SUCCESS,
-                            failure_kind(score_est, score_true)))
+                   np.where(thresholds.success(dist_err_m, orient_err_rad), SUCCESS, fail))
     return str(out) if out.ndim == 0 else out
 
 
 def search_outcome(dist_err_m: Any, orient_err_rad: Any, init_dist_err_m: Any, thresholds: Thresholds,
-                   near: Thresholds = Thresholds(NEAR_DIST_M, NEAR_ORIENT_DEG)) -> Any:
+                   near: Thresholds = NEAR_THRESHOLDS) -> Any:
     """Where each search ended (:data:`SEARCH_OUTCOMES`, the first rule that holds): ``success``
     (within ``thresholds``), ``near`` (within ``near``), ``diverged`` (farther from the true
     position than the initial guess), else ``other``; NaN errors (no answer) give ``other``."""

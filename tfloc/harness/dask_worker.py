@@ -20,7 +20,7 @@ from typing import Any
 from distributed import WorkerPlugin, get_worker
 from pebble import ProcessPool
 
-from .runner import _init_worker, collect, threads_per_job
+from .runner import _init_worker, collect
 from .task import Task, run_task, warm_up
 
 PLUGIN_NAME = "tfloc-task-pool"
@@ -41,7 +41,7 @@ class TaskPool(WorkerPlugin):
             self.pool = None  # a daemonic process cannot have children: see preflight()
             return
         self.pool = ProcessPool(max_workers=n, context=multiprocessing.get_context("spawn"),
-                                initializer=_init_worker, initargs=(threads_per_job(n),))
+                                initializer=_init_worker)
 
     def teardown(self, worker) -> None:  # noqa: ANN001
         if self.pool is not None:

@@ -27,7 +27,7 @@ from tfloc.io.maps import map_files
 from tfloc.io.scenario import read_scenario
 
 from .config import MatcherSpec, RunConfig
-from .task import load_matcher
+from .workspace import load_matcher
 
 
 def build_matcher(spec: MatcherSpec) -> dict[str, Any]:

@@ -14,13 +14,11 @@ only when its fingerprint is the same.
 
 from __future__ import annotations
 
-import json
 import multiprocessing
 import os
 import platform
 import subprocess
 import sys
-import time
 from collections.abc import Callable
 from concurrent.futures import TimeoutError as FutureTimeout
 from concurrent.futures import as_completed
@@ -31,7 +29,8 @@ from pebble import ProcessExpired, ProcessPool
 from tqdm import tqdm
 
 from tfloc.errors import ConfigError, ResultsError
-from tfloc.io.estimates import ResultWriter, done_keys, drop_rows, sync_dir
+from tfloc.io.estimates import ResultWriter, done_keys, drop_rows
+from tfloc.io.rundir import RunDir
 from tfloc.io.scenario import iter_scans, read_scenario
 
 from .config import RunConfig
@@ -60,13 +59,8 @@ def make_tasks(config: RunConfig) -> list[Task]:
     return tasks
 
 
-def threads_per_job(jobs: int) -> int:
-    """Threads per worker: always 1, so CPU time per task is one matcher on one core."""
-    return 1
-
-
-def _init_worker(threads: int) -> None:
-    limit_threads(threads)
+def _init_worker() -> None:
+    limit_threads(1)
 
 
 def load_average() -> list[float] | None:
@@ -98,59 +92,18 @@ def environment() -> dict:
                         "node": platform.node()}}
 
 
-def read_run_json(out: Path) -> dict | None:
-    """The ``run.json`` of a run directory: ``{}`` if there is none, ``None`` if it is unreadable."""
-    path = out / "run.json"
-    try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        return {}
-    except (OSError, ValueError):
-        return None
-    return doc if isinstance(doc, dict) else None
-
-
-def write_run_json(config: RunConfig, out: Path, n_tasks: int, n_done: int, fp: dict | None = None) -> None:
-    """Start a session in ``run.json`` (the configuration, environment and fingerprint)."""
-    previous = read_run_json(out) or {}
-    starts = previous.get("sessions", []) + [{"started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-                                              "tasks": n_tasks, "already_done": n_done,
-                                              "loadavg_start": load_average()}]
-    doc = {"config": config.to_dict(), **environment(), "threads_per_job": threads_per_job(config.jobs),
-           "datasets": {read_scenario(d).name: str(d) for d in config.datasets}, "sessions": starts,
-           "fingerprint": fp}
-    _save_run_json(out, doc)
-
-
-def _save_run_json(out: Path, doc: dict) -> None:
-    """Write ``run.json`` atomically (a kill leaves the old or the new file, never half of one)."""
-    path = out / "run.json"
-    tmp = path.with_name("run.json.tmp")
-    try:
-        with tmp.open("w") as fh:
-            fh.write(json.dumps(doc, indent=2) + "\n")
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-        sync_dir(out)
-    except OSError as exc:
-        raise ResultsError(f"{path}: cannot write ({exc.strerror or exc})") from None
-
-
-def close_session(out: Path) -> None:
-    """Record the end time and load average of the last session in ``run.json``."""
-    doc = read_run_json(out)
-    if doc and doc.get("sessions"):
-        doc["sessions"][-1].update(ended=time.strftime("%Y-%m-%dT%H:%M:%S%z"), loadavg_end=load_average())
-        _save_run_json(out, doc)
+def session_doc(config: RunConfig, fp: dict | None) -> dict:
+    """What ``run.json`` records of a session besides the sessions themselves: the configuration,
+    the environment, the datasets (name → directory) and the fingerprint."""
+    return {"config": config.to_dict(), **environment(),
+            "datasets": {read_scenario(d).name: str(d) for d in config.datasets}, "fingerprint": fp}
 
 
 def execute_local(tasks: list[Task], jobs: int, timeout_s: float,
                   on_row: Callable[[dict], None]) -> None:
     """Run ``tasks`` on a local process pool; every task ends in exactly one ``on_row`` call."""
     ctx = multiprocessing.get_context("spawn")
-    with ProcessPool(max_workers=jobs, context=ctx, initializer=_init_worker,
-                     initargs=(threads_per_job(jobs),)) as pool:
+    with ProcessPool(max_workers=jobs, context=ctx, initializer=_init_worker) as pool:
         try:
             warm = {}
             for t in tasks:  # compile kernels and load data outside the timed, time-limited tasks
@@ -183,11 +136,6 @@ def collect(fut, task: Task) -> dict:
 Executor = Callable[[list[Task], int, float, Callable[[dict], None]], None]
 
 
-def _discard(out: Path) -> None:
-    (out / "estimates.csv").unlink(missing_ok=True)
-    (out / "run.json").unlink(missing_ok=True)
-
-
 def run(config: RunConfig, progress: bool | None = None, executor: Executor = execute_local,
         regenerate: bool = False, retry_errors: bool = False) -> Path:
     """Run (or resume) a benchmark; returns the run directory holding ``estimates.csv``.
@@ -202,46 +150,42 @@ def run(config: RunConfig, progress: bool | None = None, executor: Executor = ex
     removed (the file is rewritten atomically) and their tasks run again.
     """
     config = available(config, log=lambda line: print(line, file=sys.stderr))
-    out = Path(config.out)
+    rd = RunDir(Path(config.out))
     fp = fingerprint(config, build_matchers(config))
     tasks = make_tasks(config)
-    est = out / "estimates.csv"
     try:
-        done = done_keys(est) if out.is_dir() else set()
+        done = done_keys(rd.estimates) if rd.path.is_dir() else set()
     except ResultsError:  # damaged, or written by another version: only --regenerate goes on
         if not regenerate:
             raise
-        _discard(out)
+        rd.discard()
         done = set()
     if done:
-        diff = differences((read_run_json(out) or {}).get("fingerprint"), fp)
+        diff = differences(rd.recorded_fingerprint(), fp)
         if diff and not regenerate:
             more = f" (and {len(diff) - 3} more)" if len(diff) > 3 else ""
-            raise ConfigError(f"{out} holds a run of another configuration: {'; '.join(diff[:3])}{more}; "
+            raise ConfigError(f"{rd.path} holds a run of another configuration: {'; '.join(diff[:3])}{more}; "
                               "to start it over give --regenerate, to keep it choose another --out")
         if diff:
-            _discard(out)
+            rd.discard()
             done = set()
     todo = [t for t in tasks if t.key not in done]
     if regenerate and not todo and tasks:
-        _discard(out)
+        rd.discard()
         todo = tasks
     elif retry_errors and done:
-        keep = done_keys(est, redo=("error", "timeout"))
+        keep = done_keys(rd.estimates, redo=("error", "timeout"))
         retry = {t.key for t in tasks if t.key in done and t.key not in keep}
-        drop_rows(est, done - retry)
+        drop_rows(rd.estimates, done - retry)
         todo = [t for t in tasks if t.key not in done or t.key in retry]
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise ResultsError(f"{out}: cannot create the run directory ({exc.strerror or exc})") from None
-    write_run_json(config, out, len(tasks), len(tasks) - len(todo), fp)
+    rd.make()
+    rd.start_session(session_doc(config, fp), len(tasks), len(tasks) - len(todo), load_average())
     if not todo:
-        return out
+        return rd.path
     bar = tqdm(total=len(tasks), initial=len(tasks) - len(todo), unit="task", desc=config.name,
                disable=None if progress is None else not progress, smoothing=0.05, mininterval=1.0)
     failures = 0
-    with ResultWriter(out / "estimates.csv") as writer:
+    with ResultWriter(rd.estimates) as writer:
         def on_row(row: dict) -> None:
             nonlocal failures
             writer.write(row)
@@ -254,7 +198,5 @@ def run(config: RunConfig, progress: bool | None = None, executor: Executor = ex
             executor(todo, config.jobs, config.timeout_s, on_row)
         finally:
             bar.close()
-            close_session(out)
-    return out
-
-
+            rd.close_session(load_average())
+    return rd.path

@@ -1,33 +1,39 @@
-"""One (scan, matcher) task, executed in a worker process: localize, time, score, classify.
+"""One (scan, matcher) task, executed in a worker process: localize, time, and record what only
+the worker can know.
 
-Tasks carry only small data (dataset path, scan id, matcher spec, thresholds); each worker
-loads a dataset's scans and map once and keeps them (module-level caches).
+Tasks carry only small data (dataset path, scan id, matcher spec, thresholds); the worker's
+:mod:`~tfloc.harness.workspace` loads a dataset's scans and map and the matcher once per process.
+Before a process times its first task of a dataset and matcher it warms up, untimed
+(:func:`~tfloc.harness.workspace.warm`). A scan-to-scan dataset's map is the reference scan, new
+for every scan, so its build stays in every task's time.
 
-Timing: ``runtime_s`` is the wall time and ``cpu_s`` the CPU time of the worker process (all its
-threads; the workers run one thread each, :mod:`tfloc.harness.threads`) during ``localize``
-alone. Before a process times its first task of a dataset and matcher it warms up, untimed
-(:func:`warm`): the matcher's ``prepare`` builds what depends only on the map, and one ``score``
-loads numba kernels (the runner's :func:`warm_up` has compiled all of them into numba's
-cache). A scan-to-scan dataset's map is the reference scan, new for every scan, so its build
-stays in every task's time (the warm-up uses a map of its own).
+A row records the estimate, its errors against the truth, the CPU and wall time of ``localize``
+and, for a failure under the run's thresholds, the matcher's own objective at its answer and at
+the truth (``score_est``, ``score_true``: only the worker holds the matcher and the problem). Its
+``outcome`` is :func:`tfloc.evaluation.outcome.outcome`, the one rule (the report applies the same
+function to the same columns). A global problem given to a local matcher is an ``invalid:`` row
+(:func:`tfloc.core.matcher.check_solvable`); a global matcher's first five hypotheses go into
+``info["hypotheses"]``.
 """
 
 from __future__ import annotations
 
 import json
-import time
 from dataclasses import dataclass
-from functools import lru_cache
 from typing import Any
 
 import numpy as np
 
-from tfloc.core.matcher import get_matcher
+from tfloc.core.matcher import check_solvable
 from tfloc.core.pose import Pose, angdiff
-from tfloc.core.problem import Estimate, Problem
-from tfloc.errors import InvalidProblemError, MatcherError
+from tfloc.errors import InvalidProblemError
 from tfloc.evaluation.outcome import AMBIGUOUS, NO_ANSWER, Thresholds, outcome
-from tfloc.io.scenario import Scan, Scenario, map_for, read_scans, read_scenario
+from tfloc.io.scenario import Scan
+
+from .workspace import load_dataset, load_matcher, problem_of, status_of, timed_localize, warm
+
+#: how many of a global matcher's hypotheses a row keeps (top-5 success)
+HYPOTHESES = 5
 
 
 @dataclass(frozen=True)
@@ -47,31 +53,6 @@ class Task:
         return (self.dataset_name, self.scan_id, self.label)
 
 
-@lru_cache(maxsize=16)
-def load_dataset(path: str) -> tuple[Scenario, dict[str, Scan]]:
-    """A dataset's metadata and scans by id, loaded once per worker process."""
-    scenario = read_scenario(path)
-    return scenario, {s.scan_id: s for s in read_scans(scenario)}
-
-
-_MAPS: dict = {}
-
-
-@lru_cache(maxsize=32)
-def load_matcher(name: str, params_json: str):
-    """A matcher instance, built once per worker; ``module:Class`` names are imported directly
-    (the command line allows them only with ``--allow-import``)."""
-    params = json.loads(params_json)
-    if ":" in name:
-        module, _, attr = name.partition(":")
-        try:
-            factory = getattr(__import__(module, fromlist=[attr]), attr)
-        except (ImportError, AttributeError) as exc:
-            raise MatcherError(f"matcher {name!r}: cannot import it ({exc})") from None
-        return factory(**params)
-    return get_matcher(name, **params)
-
-
 def _pose_fields(prefix: str, p: Pose | None) -> dict[str, Any]:
     if p is None:
         return {f"{prefix}_x": "", f"{prefix}_y": "", f"{prefix}_theta": ""}
@@ -84,7 +65,7 @@ def base_row(task: Task, scan: Scan | None) -> dict[str, Any]:
                            "group": scan.group if scan else "", "matcher": task.label}
     row.update(_pose_fields("true", scan.true if scan else None))
     row.update(_pose_fields("init", scan.initial if scan else None))
-    if scan is not None and scan.true is not None:
+    if scan is not None and scan.true is not None and scan.initial is not None:
         row["init_dist_err_m"] = scan.initial.distance_to(scan.true)
         row["init_orient_err_rad"] = abs(angdiff(scan.initial.theta, scan.true.theta))
     return row
@@ -105,78 +86,68 @@ def failure_row(task: Task, status: str, scan: Scan | None = None) -> dict[str, 
 _WARM: set[tuple[str, str, str]] = set()
 
 
-def problem_of(scenario: Scenario, scan: Scan) -> Problem:
-    """The :class:`Problem` of one scan (the dataset's map, or the scan's reference scan)."""
-    return Problem(map_for(scenario, scan, _MAPS), scenario.laser, scan.ranges, scan.initial,
-                   where=f"{scenario.scans_path}:{scan.line}")
-
-
-def warm(matcher, problem: Problem) -> None:
-    """Untimed warm-up: ``matcher.prepare(problem)`` (map-only structures) if the matcher has one,
-    then one ``score`` at the initial pose (kernels compiled or loaded from numba's cache)."""
-    prepare = getattr(matcher, "prepare", None)
-    if prepare is not None:
-        prepare(problem)
-    matcher.score(problem, problem.initial)
-
-
-def _warm_once(task: Task, matcher, scenario: Scenario, scan: Scan) -> None:
+def _warm_once(task: Task, matcher, problem) -> None:
     key = (task.dataset, task.matcher, task.params_json)
     if key in _WARM:
         return
     _WARM.add(key)
     try:
-        warm(matcher, problem_of(scenario, scan))
+        warm(matcher, problem)
     except Exception:  # noqa: BLE001 - the timed call reports what is wrong
         pass
 
 
-def status_of(est: Estimate) -> str:
-    """``failed`` when the matcher declined to answer (``info["status"] == "no-answer"``) or gave a
-    non-finite pose, else ``ok``; whether it converged is reported separately."""
-    return "failed" if est.info.get("status") == "no-answer" or not est.pose.is_finite() else "ok"
+def _posed(task: Task):
+    """The task's scan, matcher and problem (raises what building them raises; a global problem
+    for a local matcher is an :class:`InvalidProblemError`)."""
+    scenario, scans = load_dataset(task.dataset)
+    scan = scans[task.scan_id]
+    matcher = load_matcher(task.matcher, task.params_json)
+    problem = problem_of(scenario, scan)
+    check_solvable(matcher, problem)
+    return scenario, scan, matcher, problem
 
 
 def run_task(task: Task) -> dict[str, Any]:
     """Run one task; exceptions from the matcher become an ``error:`` row (never raised), a
     problem the data cannot pose (:class:`InvalidProblemError`) an ``invalid:`` row."""
-    scenario, scans = load_dataset(task.dataset)
-    scan = scans[task.scan_id]
+    scan = load_dataset(task.dataset)[1][task.scan_id]
     try:
-        matcher = load_matcher(task.matcher, task.params_json)
-        problem = problem_of(scenario, scan)
+        scenario, scan, matcher, problem = _posed(task)
     except InvalidProblemError as exc:
         return failure_row(task, f"invalid:{exc}", scan)
     except Exception as exc:  # noqa: BLE001 - a failing matcher is a result, not a crash
         return failure_row(task, f"error:{type(exc).__name__}: {exc}", scan)
     try:
-        _warm_once(task, matcher, scenario, scan)
-        t0, c0 = time.perf_counter(), time.process_time()
-        est = matcher.localize(problem)
-        runtime, cpu = time.perf_counter() - t0, time.process_time() - c0
+        _warm_once(task, matcher, problem_of(scenario, scan))
+        timed = timed_localize(matcher, problem)
     except Exception as exc:  # noqa: BLE001 - a failing matcher is a result, not a crash
         return failure_row(task, f"error:{type(exc).__name__}: {exc}", scan)
+    est = timed.estimate
     row = base_row(task, scan)
     p = est.pose
     status = status_of(est)
-    declined = status == "failed"
-    row.update(est_x=p.x, est_y=p.y, est_theta=p.theta, runtime_s=runtime, cpu_s=cpu,
+    info = est.info if not est.hypotheses else {
+        **est.info, "hypotheses": [[h.x, h.y, h.theta] for h in est.hypotheses[:HYPOTHESES]]}
+    row.update(est_x=p.x, est_y=p.y, est_theta=p.theta, runtime_s=timed.wall_s, cpu_s=timed.cpu_s,
                converged=int(bool(est.converged)), iterations=est.iterations,
                evaluations=est.evaluations, status=status,
-               info=json.dumps(est.info, default=str, separators=(",", ":")))
+               info=json.dumps(info, default=str, separators=(",", ":")))
     if scan.true is None:
         return row
     d, o = p.distance_to(scan.true), abs(angdiff(p.theta, scan.true.theta))
     row.update(dist_err_m=d, orient_err_rad=o)
-    if declined or task.thresholds.success(d, o):
-        row["outcome"] = outcome(not declined, d, o, np.nan, np.nan, task.thresholds)
-        return row
-    try:  # why did it fail? compare the matcher's own objective at its answer and at the truth
-        s_est, s_true = float(matcher.score(problem, p)), float(matcher.score(problem, scan.true))
-        row.update(score_est=s_est, score_true=s_true,
-                   outcome=outcome(True, d, o, s_est, s_true, task.thresholds))
-    except Exception as exc:  # noqa: BLE001
-        row.update(outcome=AMBIGUOUS, info=row["info"][:-1] + f',"score_error":{json.dumps(str(exc))}}}')
+    s_est = s_true = np.nan
+    recorded = ""
+    if status == "ok" and not task.thresholds.success(d, o):
+        try:  # why did it fail? the matcher's own objective at its answer and at the truth
+            s_est, s_true = float(matcher.score(problem, p)), float(matcher.score(problem, scan.true))
+            row.update(score_est=s_est, score_true=s_true)
+        except Exception as exc:  # noqa: BLE001
+            s_est = s_true = np.nan
+            recorded = AMBIGUOUS
+            row["info"] = row["info"][:-1] + f',"score_error":{json.dumps(str(exc))}}}'
+    row["outcome"] = outcome(status == "ok", d, o, s_est, s_true, task.thresholds, recorded)
     return row
 
 
@@ -184,11 +155,9 @@ def warm_up(task: Task) -> None:
     """Before a run: load the dataset and matcher of ``task``, :func:`warm` them up and run one
     untimed ``localize``, which compiles every numba kernel the matcher uses into numba's on-disk
     cache (other workers then only load them). The caller gives it the task's time limit."""
-    scenario, scans = load_dataset(task.dataset)
-    scan = scans[task.scan_id]
     try:
-        matcher = load_matcher(task.matcher, task.params_json)
-        _warm_once(task, matcher, scenario, scan)
-        matcher.localize(problem_of(scenario, scan))
+        scenario, scan, matcher, problem = _posed(task)
+        _warm_once(task, matcher, problem_of(scenario, scan))
+        matcher.localize(problem)
     except Exception:  # noqa: BLE001 - the real run will report it
         pass

@@ -10,7 +10,7 @@ conditions:
   matcher timed out or raised in the run is left out: it would dominate the pass's time).
 * **One process pinned to the configured cores** (``os.sched_setaffinity``), every library on
   one thread (:func:`tfloc.harness.threads.limit_threads`).
-* **Warm-up**: for each dataset and matcher, :func:`tfloc.harness.task.warm` and ``warmup``
+* **Warm-up**: for each dataset and matcher, :func:`tfloc.harness.workspace.warm` and ``warmup``
   untimed ``localize`` calls on sampled scans (kernels, map-only structures, the allocator).
 * **Interleaved**: scan by scan, every matcher once, the order rotated by one per scan, so slow
   drifts of the machine (load, frequency) hit every matcher alike.
@@ -33,28 +33,21 @@ import numpy as np
 import pandas as pd
 
 from tfloc.errors import ConfigError
-from tfloc.io.estimates import read_estimates
+from tfloc.io.rundir import RunDir, RunInfo
 
 from .runner import load_average
-from .task import load_dataset, load_matcher, problem_of, warm
 from .threads import limit_threads
+from .workspace import load_dataset, load_matcher, problem_of, timed_localize, warm
 
 TIMING_COLUMNS = ["dataset", "scan_id", "group", "matcher", "position", "cpu_ms", "wall_ms"]
 SEED = 20261130
 
 
-def read_run(run_dir: Path) -> tuple[pd.DataFrame, dict]:
-    """The estimates and ``run.json`` of a run; a missing piece is a one-line ConfigError."""
-    run_json = run_dir / "run.json"
-    if not (run_dir / "estimates.csv").is_file() or not run_json.is_file():
-        raise ConfigError(f"{run_dir}: needs estimates.csv and run.json (run 'tfloc bench' first)")
-    try:
-        doc = json.loads(run_json.read_text())
-    except json.JSONDecodeError as exc:
-        raise ConfigError(f"{run_json}: not valid JSON ({exc})") from None
-    if not doc.get("config", {}).get("matchers") or not doc.get("datasets"):
-        raise ConfigError(f"{run_json}: no 'config.matchers' or 'datasets' (not written by tfloc bench?)")
-    return read_estimates(run_dir), doc
+def read_run(run_dir: Path) -> tuple[pd.DataFrame, RunInfo]:
+    """The rows and ``run.json`` of a run (:class:`~tfloc.io.rundir.RunDir`; both required)."""
+    rd = RunDir(run_dir)
+    info = rd.info(required=True)
+    return rd.results(), info
 
 
 def sample_scans(df: pd.DataFrame, per_stratum: int, seed: int = SEED) -> pd.DataFrame:
@@ -91,16 +84,16 @@ def pin(cores: Sequence[int]) -> list[int]:
 
 def run_timing(run_dir: Path, per_stratum: int = 4, seed: int = SEED, cores: Sequence[int] | None = None,
                warmup: int = 2, progress: Callable[[int, int], None] | None = None,
-               run: tuple[pd.DataFrame, dict] | None = None) -> tuple[pd.DataFrame, dict]:
+               run: tuple[pd.DataFrame, RunInfo] | None = None) -> tuple[pd.DataFrame, dict]:
     """Re-time a stratified sample of the run in ``run_dir`` (see the module docstring), pinned
     to ``cores`` (default: the last core this process may run on).
 
     Returns the rows (``TIMING_COLUMNS``; times in ms) and a provenance dict (cores, load
-    averages, sample size, seed). ``run``: the run's estimates and ``run.json`` if the caller
-    has already read them (:func:`read_run`)."""
-    df, doc = read_run(run_dir) if run is None else run
-    specs = [m for m in doc["config"]["matchers"] if m["label"] in set(df["matcher"])]
-    paths = doc["datasets"]
+    averages, sample size, seed). ``run``: the run's rows and ``run.json`` if the caller has
+    already read them (:func:`read_run`)."""
+    df, info_run = read_run(run_dir) if run is None else run
+    specs = [m for m in info_run.matchers if m["label"] in set(df["matcher"])]
+    paths = info_run.datasets
     sample = sample_scans(df, per_stratum, seed)
     if sample.empty:
         raise ConfigError(f"{run_dir}: no scan that every matcher answered")
@@ -120,7 +113,7 @@ def run_timing(run_dir: Path, per_stratum: int = 4, seed: int = SEED, cores: Seq
     return rows, info
 
 
-def _time_sample(sample: pd.DataFrame, specs: list[dict], paths: dict, warmup: int,
+def _time_sample(sample: pd.DataFrame, specs: list[dict], paths: dict[str, Path], warmup: int,
                  progress: Callable[[int, int], None] | None) -> pd.DataFrame:
     """Warm up, then time every matcher on every sampled scan, interleaved (module docstring)."""
     matchers = [(m["label"], load_matcher(m["name"], json.dumps(m.get("params", {}), sort_keys=True)))
@@ -143,12 +136,9 @@ def _time_sample(sample: pd.DataFrame, specs: list[dict], paths: dict, warmup: i
         scan = scans[r.scan_id]
         for pos in range(k):
             label, m = matchers[(i + pos) % k]
-            problem = problem_of(scenario, scan)
-            w0, c0 = time.perf_counter(), time.process_time()
-            m.localize(problem)
-            cpu, wall = time.process_time() - c0, time.perf_counter() - w0
+            t = timed_localize(m, problem_of(scenario, scan))
             rows.append({"dataset": r.dataset, "scan_id": r.scan_id, "group": r.group, "matcher": label,
-                         "position": pos, "cpu_ms": 1000.0 * cpu, "wall_ms": 1000.0 * wall})
+                         "position": pos, "cpu_ms": 1000.0 * t.cpu_s, "wall_ms": 1000.0 * t.wall_s})
         if progress:
             progress(i + 1, len(sample))
     return pd.DataFrame(rows, columns=TIMING_COLUMNS)

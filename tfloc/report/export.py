@@ -9,15 +9,16 @@ appearance in ``estimates.csv``. Rows without a finite pose are left out and cou
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from tfloc.errors import DatasetError
+from tfloc.errors import DatasetError, TflocError
 from tfloc.io.estimates import read_rows
+from tfloc.io.rundir import RunDir
+from tfloc.io.scenario import read_scenario
 from tfloc.io.text import csv_rows
 from tfloc.io.tum import write_tum
 
@@ -46,40 +47,30 @@ def _read_rows(path: Path) -> list[dict]:
     return [row for _, row in rows]
 
 
-def _dataset_dirs(run_dir: Path) -> list[Path]:
-    """Dataset directories named anywhere in ``run.json`` (any string that is one)."""
-    path = run_dir / "run.json"
+def _dataset_dirs(run_dir: Path) -> dict[str, Path]:
+    """The run's datasets (name → directory) as ``run.json`` records them (none without one)."""
     try:
-        doc = json.loads(path.read_text())
-    except (FileNotFoundError, json.JSONDecodeError):
-        return []
-    found, stack = [], [doc]
-    while stack:
-        v = stack.pop()
-        if isinstance(v, dict):
-            stack.extend(v.values())
-        elif isinstance(v, list):
-            stack.extend(v)
-        elif isinstance(v, str) and len(v) < 4096:
-            for cand in (Path(v), run_dir / v):
-                if (cand / "scenario.json").is_file():
-                    found.append(cand)
-    return found
+        return RunDir(run_dir).info().datasets
+    except TflocError:
+        return {}
 
 
 def find_dataset(name: str, run_dir: Path, root: Path | None) -> Path | None:
-    """The directory of dataset ``name`` (a path, a directory named in run.json, or ``root/name``)."""
-    cands = [Path(name), run_dir / name, *(d for d in _dataset_dirs(run_dir) if d.name == name)]
+    """The directory of dataset ``name``: the run's record of it, a path, a directory of that name
+    in the run directory or under ``root``, or any recorded directory whose scenario is named so."""
+    recorded = _dataset_dirs(run_dir)
+    cands = [*([recorded[name]] if name in recorded else []), Path(name), run_dir / name,
+             *(d for d in recorded.values() if d.name == name)]
     if root is not None:
         cands.append(root / name)
     for c in cands:
         if (c / "scenario.json").is_file() and (c / "scans.csv").is_file():
             return c
-    for d in _dataset_dirs(run_dir):  # a scenario.json whose "name" is the dataset's name
+    for d in recorded.values():  # a scenario.json whose "name" is the dataset's name
         try:
-            if json.loads((d / "scenario.json").read_text()).get("name") == name:
+            if read_scenario(d).name == name:
                 return d
-        except json.JSONDecodeError:
+        except TflocError:
             continue
     return None
 

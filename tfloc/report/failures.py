@@ -22,7 +22,7 @@ from matplotlib.figure import Figure
 from tfloc.core.pose import Pose
 from tfloc.errors import TflocError
 from tfloc.evaluation.outcome import OUTCOMES
-from tfloc.harness.task import load_dataset
+from tfloc.harness.workspace import load_dataset
 from tfloc.io.scenario import Scan, Scenario, map_for
 
 FAILURES = tuple(OUTCOMES[1:])  # local-optimum, ambiguous, no-answer
@@ -98,7 +98,7 @@ def _draw(path: Path, scenario: Scenario, scan: Scan, r: pd.Series, cache: dict)
     return path
 
 
-def draw_failures(run_dir: Path, p: pd.DataFrame, datasets: dict[str, str]) -> list[FailurePicture]:
+def draw_failures(run_dir: Path, p: pd.DataFrame, datasets: dict[str, Path]) -> list[FailurePicture]:
     """Draw the representative failures of every matcher of prepared rows ``p``; ``datasets``
     maps dataset names to their directories (``run.json``). Returns what was drawn."""
     fails = p[p["truth"] & p["outcome_eval"].isin(FAILURES)]

@@ -22,7 +22,7 @@ from scipy.stats import spearmanr
 
 from tfloc.core.pose import Pose
 from tfloc.errors import TflocError
-from tfloc.harness.task import load_dataset, problem_of
+from tfloc.harness.workspace import load_dataset, problem_of
 from tfloc.paper.landscape import err_landscape, local_minima
 
 HALF_WIDTH_M = 3.0
@@ -51,7 +51,7 @@ def _pick(p: pd.DataFrame) -> pd.DataFrame:
     return chosen.head(3)
 
 
-def draw_landscapes(run_dir: Path, p: pd.DataFrame, datasets: dict[str, str]) -> tuple[Path | None, list[LandscapeStats]]:
+def draw_landscapes(run_dir: Path, p: pd.DataFrame, datasets: dict[str, Path]) -> tuple[Path | None, list[LandscapeStats]]:
     """Compute and draw the landscapes of :func:`_pick`'s scans; ``datasets`` maps dataset names to
     directories (``run.json``). Returns the figure (relative to ``run_dir``) and the statistics."""
     chosen = _pick(p)

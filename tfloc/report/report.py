@@ -1,6 +1,6 @@
 """``tfloc report RUN``: RUN/report.md, RUN/summary.csv and RUN/figures/*.png from a run's results.
 
-Reads ``estimates.csv`` and ``run.json`` (:mod:`tfloc.harness.runner`), computes the metrics
+Reads ``estimates.csv`` and ``run.json`` (:class:`tfloc.io.rundir.RunDir`), computes the metrics
 (:mod:`tfloc.evaluation.metrics`, :mod:`tfloc.evaluation.summary`) and the paired tests
 (:mod:`tfloc.evaluation.paired`, also written to ``paired.csv``), draws the figures
 (:mod:`tfloc.report.figures`, :mod:`tfloc.report.failures`) and writes the markdown
@@ -16,7 +16,6 @@ from pathlib import Path
 
 import pandas as pd
 
-from tfloc.errors import ResultsError
 from tfloc.evaluation.metrics import prepare, summarize
 from tfloc.evaluation.outcome import Thresholds
 from tfloc.evaluation.paired import ALPHA, paired_table
@@ -28,8 +27,9 @@ from tfloc.evaluation.summary import (
     summary_table,
     write_summary,
 )
-from tfloc.io.estimates import read_estimates, status_kind
-from tfloc.io.text import parse_text
+from tfloc.io.estimates import status_kind
+from tfloc.io.rundir import RunDir, RunInfo
+from tfloc.io.scenario import SCAN_TO_SCAN
 
 from . import figures as F
 from . import sections as S
@@ -51,68 +51,12 @@ class ReportFiles:
 
 
 
-def load_run(run_dir: Path) -> tuple[pd.DataFrame, dict]:
-    """The estimates and the ``run.json`` document (``{}`` when missing) of a run directory."""
-    if not (run_dir / "estimates.csv").is_file():
-        raise ResultsError(f"{run_dir}: no estimates.csv (not a run directory? run 'tfloc bench' first)")
-    df = read_estimates(run_dir)
-    if df.empty:
-        raise ResultsError(f"{run_dir / 'estimates.csv'}: no results yet (no task of the run has finished)")
-    run_json = run_dir / "run.json"
-    run = parse_text(run_json, ResultsError, "run.json file", json.loads, ValueError, "JSON") if run_json.is_file() else {}
-    _check_run(run, run_json)
-    return df, run
-
-
-#: the run.json fields the report reads, and what each must be
-_RUN_FIELDS = {"config": dict, "git": dict, "machine": dict, "versions": dict, "datasets": dict, "sessions": list,
-               "config.success": dict, "config.matchers": list, "git.commit": (str, type(None)),
-               "git.dirty": (bool, type(None)), "config.name": str}
-
-
-def _finite_list(v: list) -> bool:
-    return bool(v) and all(isinstance(x, int | float) and not isinstance(x, bool) and abs(x) < 1e300 for x in v)
-
-
-def _check_run(run: object, path: Path) -> None:
-    """A ResultsError naming ``path`` and the field if ``run.json`` is not what the report reads."""
-    if not isinstance(run, dict):
-        raise ResultsError(f"{path}: expected a JSON object")
-    for name, kind in _RUN_FIELDS.items():
-        *parents, leaf = name.split(".")
-        doc = run
-        for p in parents:
-            doc = doc.get(p, {})
-        if leaf in doc and not isinstance(doc[leaf], kind):
-            raise ResultsError(f"{path}: field {name} is {type(doc[leaf]).__name__}, not the expected "
-                               f"{getattr(kind, '__name__', 'string or null')}")
-    ok = all(isinstance(v, str) for v in run.get("datasets", {}).values())
-    ok &= all(isinstance(v, dict) and isinstance(v.get("started", ""), str)
-              and all(isinstance(v.get(k) or [0], list) and _finite_list(v.get(k) or [0])
-                      for k in ("loadavg_start", "loadavg_end")) for v in run.get("sessions", []))
-    ok &= all(isinstance(m, dict) and isinstance(m.get("label"), str) and isinstance(m.get("name"), str)
-              and isinstance(m.get("params", {}), dict) for m in run.get("config", {}).get("matchers", []))
-    try:
-        thr = Thresholds.from_run(run)
-        ok &= thr.dist_m >= 0 and thr.orient_deg >= 0  # (NaN is not)
-    except (TypeError, ValueError, OverflowError):
-        ok = False
-    if not ok:
-        raise ResultsError(f"{path}: malformed datasets, sessions, config.matchers or config.success")
-
-
-def scan_to_scan_datasets(run: dict, names: list[str]) -> set[str]:
-    """Datasets whose ``scenario.json`` says ``"scan_to_scan": true`` (or named ``*relations*``)."""
-    out = set()
-    for name in names:
-        path = Path(run.get("datasets", {}).get(name, "")) / "scenario.json"
-        try:
-            flag = bool(json.loads(path.read_text()).get("scan_to_scan", False)) if path.is_file() else None
-        except (OSError, json.JSONDecodeError):
-            flag = None
-        if flag or (flag is None and "relations" in name):
-            out.add(name)
-    return out
+def load_run(run_dir: Path) -> tuple[pd.DataFrame, RunInfo]:
+    """The rows and the ``run.json`` of a run directory (:class:`~tfloc.io.rundir.RunDir`;
+    ``run.json`` may be missing: provenance unknown, default thresholds)."""
+    rd = RunDir(run_dir)
+    rd.require_results()
+    return rd.results(), rd.info()
 
 
 def header(run_dir: Path, run: dict, df: pd.DataFrame, thr: Thresholds, s2s: set[str]) -> str:
@@ -131,8 +75,8 @@ def header(run_dir: Path, run: dict, df: pd.DataFrame, thr: Thresholds, s2s: set
              + (f" ({len(sessions)} sessions, resumed)" if len(sessions) > 1 else ""),
              f"- Commit: `{commit}`",
              f"- Machine: {mach.get('platform', '?')}, {mach.get('cpu_count', '?')} CPUs, Python "
-             f"{mach.get('python', '?')}; {cfg.get('jobs', '?')} worker(s) × {run.get('threads_per_job', '?')} "
-             f"thread(s); time limit {cfg.get('timeout_s', '?')} s per scan",
+             f"{mach.get('python', '?')}; {cfg.get('jobs', '?')} worker(s) of one thread each; "
+             f"time limit {cfg.get('timeout_s', '?')} s per scan",
              "- Versions: " + (", ".join(f"{k} {v}" for k, v in run.get("versions", {}).items() if v) or "unknown")]
     if not run:
         lines.append("- **run.json is missing**: provenance unknown, default thresholds used.")
@@ -338,10 +282,11 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
                  with_figures: bool = True) -> ReportFiles:
     """Write report.md, summary.csv and figures/*.png into ``run_dir``; returns their paths."""
     run_dir = Path(run_dir)
-    df, run = load_run(run_dir)
-    thr = thresholds or Thresholds.from_run(run)
+    df, info = load_run(run_dir)
+    run = info.doc
+    thr = thresholds or info.thresholds
     p = prepare(df, thr)
-    s2s = scan_to_scan_datasets(run, list(p["dataset"].unique()))
+    s2s = info.datasets_in(list(p["dataset"].unique()), SCAN_TO_SCAN)
     summary = write_summary(summary_table(p, s2s), run_dir / "summary.csv")
     order = label_order(run, p)
     sweep = len(order) > MANY_MATCHERS  # a parameter sweep: compare each label with the first only
@@ -359,8 +304,8 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
                 F.fig_runtime(p, fd / "runtime.png"), F.fig_outcomes(p, fd / "outcomes.png", s2s)]
         figs = [f for f in made if f is not None]
         drawn = p[p["matcher"] == order[0]] if sweep else p
-        failures = failures_section(draw_failures(run_dir, drawn, run.get("datasets", {})))
-        landscape = landscape_section(*draw_landscapes(run_dir, p, run.get("datasets", {})))
+        failures = failures_section(draw_failures(run_dir, drawn, info.datasets))
+        landscape = landscape_section(*draw_landscapes(run_dir, p, info.datasets))
     report = run_dir / "report.md"
     report.write_text(render(run_dir, run, p, thr, s2s, figs, pt, failures, landscape, line_labels, sweep))
     return ReportFiles(report, summary, tuple(figs))

@@ -19,7 +19,7 @@ The cost is the mean over all beams. Without the beam check two poses that see t
 the beam model's free-space evidence, which point-to-line matching ignores.
 
 Why the far side on grids: measured at the true poses of the development logs
-(``benchmarks/tfplus_real_diagnostics.py``), the rule "more than 5 cm beyond the first occupied
+(``scripts/tfplus_real_diagnostics.py``), the rule "more than 5 cm beyond the first occupied
 cell" counted 23 % (Intel) and 24 % (CSAIL) of all beams as seen through a wall, and 75–98 % with
 the walls thickened by one or two cells, so it penalised the truth about as much as any wrong
 pose. Beyond the far side + 10 cm: 8 % and 11 % (14–24 % thickened), of which 4 % and 3 % are

@@ -37,7 +37,7 @@ needs ~1800 cost evaluations per scan). Stages:
 Each stage can be switched off or put back as it was before the real logs (``tf_seed``,
 ``heading_sweep``, ``grid``, ``coarse_bound``, ``refine``, ``refine_to="virtual"``,
 ``select="virtual"``, ``beam_check``, ``tie_tolerance=0``) for the ablations in
-``benchmarks/tfplus-ablation.toml`` (simulated) and ``benchmarks/tfplus_ablation_real.py`` (real
+``benchmarks/tfplus-ablation.toml`` (simulated) and ``scripts/tfplus_ablation_real.py`` (real
 logs); ``docs/tf-plus.md`` has the measurements. It uses the :class:`~tfloc.core.map.Map`
 protocol, on a :class:`~tfloc.maps.grid.GridMap` also its occupied cells (walls have thickness
 there), and never the true pose.

@@ -16,7 +16,7 @@ Writes ``OUT.csv`` (one row per scan × variant) and ``OUT.md`` (per dataset and
 success, median/mean errors, failure outcomes by the matcher's own ``score``, median and p95 CPU
 ms).
 
-Run: ``OMP_NUM_THREADS=1 PYTHONPATH=$PWD python benchmarks/tfplus_ablation_real.py
+Run: ``OMP_NUM_THREADS=1 PYTHONPATH=$PWD python scripts/tfplus_ablation_real.py
 [--datasets real-intel-scan-to-map real-csail-scan-to-map] [--limit-per-group N]
 [--out results/tf-plus-ablation-real]``
 """
@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import time
 from pathlib import Path
 
 import numpy as np
@@ -34,6 +33,7 @@ import pandas as pd
 import tfloc
 from tfloc import GridMap, Problem
 from tfloc.evaluation.outcome import Thresholds, failure_kind
+from tfloc.harness.workspace import timed_localize
 from tfloc.io.scenario import map_for, read_scans, read_scenario
 from tfloc.tfplus.refine import RefineConfig
 
@@ -111,9 +111,8 @@ def run(datasets: list[str], variants: dict[str, dict], limit_per_group: int = 0
             m = tfloc.get_matcher(matcher, **kw)
             m.localize(probs[0][2])                     # warm-up: JIT, the map's caches
             for sid, group, p, true in probs:
-                c0 = time.process_time()
-                e = m.localize(p)
-                cpu = time.process_time() - c0
+                t = timed_localize(m, p)
+                e, cpu = t.estimate, t.cpu_s
                 d_err = e.pose.distance_to(true)
                 o_err = abs(tfloc.angdiff(e.pose.theta, true.theta))
                 outcome = ("success" if SUCCESS.success(d_err, o_err)
@@ -192,7 +191,7 @@ def main() -> None:
     df.to_csv(args.out.with_suffix(".csv"), index=False)
     args.out.with_suffix(".md").write_text(
         "# tf-plus ablation on real scan-to-map logs\n\n"
-        f"Command: `OMP_NUM_THREADS=1 PYTHONPATH=$PWD python benchmarks/tfplus_ablation_real.py --datasets "
+        f"Command: `OMP_NUM_THREADS=1 PYTHONPATH=$PWD python scripts/tfplus_ablation_real.py --datasets "
         f"{' '.join(args.datasets)}{f' --limit-per-group {args.limit_per_group}' if args.limit_per_group else ''}"
         f"{' --thicken ' + ' '.join(map(str, args.thicken)) if args.thicken != [0] else ''}"
         f"{' --matcher ' + args.matcher if args.matcher != 'tf-plus' else ''} --out {_shown(args.out)}`. "

@@ -1,7 +1,7 @@
 """Why ``tf-plus`` lost on real grid maps, measured at the *true* poses of the real scan-to-map logs.
 
 For each dataset (and its map with walls thickened by ``--thicken`` cells, see
-``benchmarks/tfplus_ablation_real.py``), at every scan's corrected pose:
+``scripts/tfplus_ablation_real.py``), at every scan's corrected pose:
 
 * **virtual-scan bias**: the grid's ray-cast range minus the real range, over all beams where
   both have a return (a ray stops at the first occupied cell; a real return lies inside the wall);
@@ -19,7 +19,7 @@ For each dataset (and its map with walls thickened by ``--thicken`` cells, see
 
 Writes a markdown report to ``--out`` (default ``results/tf-plus-real-diagnostics.md``).
 
-Run: ``OMP_NUM_THREADS=1 PYTHONPATH=$PWD python benchmarks/tfplus_real_diagnostics.py
+Run: ``OMP_NUM_THREADS=1 PYTHONPATH=$PWD python scripts/tfplus_real_diagnostics.py
 [--datasets ...] [--thicken 0 1 2] [--limit-per-group 20]``
 """
 
@@ -109,7 +109,7 @@ def main() -> None:
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(
         "# tf-plus on real grid maps: measurements at the true poses\n\n"
-        f"Command: `OMP_NUM_THREADS=1 PYTHONPATH=$PWD python benchmarks/tfplus_real_diagnostics.py --datasets "
+        f"Command: `OMP_NUM_THREADS=1 PYTHONPATH=$PWD python scripts/tfplus_real_diagnostics.py --datasets "
         f"{' '.join(args.datasets)} --thicken {' '.join(map(str, args.thicken))} --limit-per-group "
         f"{args.limit_per_group}`. `+k`: the map's occupied cells dilated by k cells. See the script's "
         "docstring for what each row measures.\n\n" + markdown(df) + "\n")

@@ -1,0 +1,49 @@
+"""The matchers of the registry, as the generic tests see them: every installed entry point of
+``tfloc.matchers`` (the project's own and any third party's), so that a new matcher is covered by
+the generic tests without editing a test file. A matcher whose optional library is missing is
+skipped with the registry's one-line reason."""
+
+from __future__ import annotations
+
+from importlib.metadata import entry_points
+
+import pytest
+
+from tfloc.core.matcher import GROUP, available_matchers, get_matcher, solves_global
+from tfloc.core.tracker import is_tracker
+from tfloc.errors import LibraryMissingError
+
+NAMES = available_matchers()
+
+
+def target(name: str) -> str:
+    """The entry point's ``module:attr`` of a registered matcher."""
+    return next(ep.value for ep in entry_points(group=GROUP) if ep.name == name)
+
+
+#: the baselines: registered matchers whose module is one of ``baselines/``
+BASELINES = [n for n in NAMES if target(n).startswith("tfloc.baselines.")]
+
+
+def build(name: str, **params):
+    """``get_matcher(name, **params)``, or skip the test when its library is not installed."""
+    try:
+        return get_matcher(name, **params)
+    except LibraryMissingError as exc:
+        pytest.skip(str(exc))
+
+
+def kind(matcher) -> str:
+    """``tracker`` (start/step, no single-scan mode), ``global`` (answers problems without an
+    initial guess) or ``local``."""
+    if is_tracker(matcher) and not callable(getattr(matcher, "localize", None)):
+        return "tracker"
+    return "global" if solves_global(matcher) else "local"
+
+
+def single_scan(name: str):
+    """The matcher ``name`` for a single-scan test, or skip it if it is a tracker."""
+    matcher = build(name)
+    if kind(matcher) == "tracker":
+        pytest.skip("a tracker has no single-scan mode")
+    return matcher

@@ -1,0 +1,88 @@
+"""The per-process workspace: what a worker (or any command that runs matchers) loads once and
+how it runs one matcher on one problem.
+
+* :func:`load_dataset` — a dataset's metadata and scans by id, read once per process;
+* :func:`load_matcher` — a matcher built once per process and configuration
+  (:func:`tfloc.core.matcher.get_matcher`, registered names and ``module:Class`` alike);
+* :func:`problem_of` — the :class:`~tfloc.core.problem.Problem` of a scan (the dataset's map,
+  loaded once, or the scan's reference scan);
+* :func:`warm` — the untimed warm-up before a matcher's first timed call on a map;
+* :func:`timed_localize` — one ``localize`` call timed by CPU time (``time.process_time``: this
+  process, all its threads; workers run every library on one thread) and wall time.
+
+The runner's tasks, the timing pass, the report's pictures, ``tfloc localize`` and the scripts
+all use these, so a scan is posed, warmed and timed the same way everywhere.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass
+from functools import lru_cache
+
+from tfloc.core.matcher import Matcher, get_matcher
+from tfloc.core.problem import Estimate, Problem
+from tfloc.io.scenario import Scan, Scenario, map_for, read_scans, read_scenario
+
+_MAPS: dict = {}
+
+
+@lru_cache(maxsize=16)
+def load_dataset(path: str) -> tuple[Scenario, dict[str, Scan]]:
+    """A dataset's metadata and scans by id, loaded once per process."""
+    scenario = read_scenario(path)
+    return scenario, {s.scan_id: s for s in read_scans(scenario)}
+
+
+@lru_cache(maxsize=32)
+def load_matcher(name: str, params_json: str = "{}") -> Matcher:
+    """A matcher built once per process (``params_json``: its parameters as sorted JSON)."""
+    return get_matcher(name, **json.loads(params_json))
+
+
+def use_map(scenario: Scenario, map_) -> None:
+    """Localize ``scenario``'s scans in ``map_`` instead of the map its ``scenario.json`` names
+    (``tfloc localize --map``)."""
+    _MAPS[scenario.map_path] = map_
+
+
+def problem_of(scenario: Scenario, scan: Scan, initial=...) -> Problem:
+    """The :class:`Problem` of one scan: the dataset's map (loaded once per process) or the
+    scan's reference scan; ``initial`` overrides the scan's guess (a tracker's prediction)."""
+    guess = scan.initial if initial is ... else initial
+    return Problem(map_for(scenario, scan, _MAPS), scenario.laser, scan.ranges, guess,
+                   where=f"{scenario.scans_path}:{scan.line}")
+
+
+def warm(matcher: Matcher, problem: Problem) -> None:
+    """Untimed warm-up: ``matcher.prepare(problem)`` (map-only structures) if the matcher has one,
+    then one ``score`` at the initial pose, if there is one (kernels compiled or loaded from
+    numba's cache)."""
+    prepare = getattr(matcher, "prepare", None)
+    if prepare is not None:
+        prepare(problem)
+    if problem.initial is not None:
+        matcher.score(problem, problem.initial)
+
+
+@dataclass(frozen=True)
+class Timed:
+    """One timed call: the estimate, its wall time and its CPU time (seconds)."""
+
+    estimate: Estimate
+    wall_s: float
+    cpu_s: float
+
+
+def timed_localize(matcher: Matcher, problem: Problem) -> Timed:
+    """``matcher.localize(problem)`` timed by wall and CPU time (exceptions propagate)."""
+    t0, c0 = time.perf_counter(), time.process_time()
+    est = matcher.localize(problem)
+    return Timed(est, time.perf_counter() - t0, time.process_time() - c0)
+
+
+def status_of(est: Estimate) -> str:
+    """``failed`` when the matcher declined to answer (``info["status"] == "no-answer"``) or gave a
+    non-finite pose, else ``ok``; whether it converged is reported separately."""
+    return "failed" if est.info.get("status") == "no-answer" or not est.pose.is_finite() else "ok"
