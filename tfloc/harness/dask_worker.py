@@ -4,7 +4,7 @@ Dask cannot kill one running task, so each Dask worker keeps a small :class:`peb
 (one spawned process per worker thread) and runs :func:`~tfloc.harness.task.run_task` there with
 the task's time limit, exactly as the local runner does: a task past its limit is killed with its
 process, which pebble replaces, and becomes a ``timeout`` row. The pool's processes keep the
-per-process caches of :mod:`tfloc.harness.task`, so a dataset's scans and map are loaded once per
+per-process caches of :mod:`tfloc.harness.workspace`, so a dataset's scans and map are loaded once per
 process, never shipped with a task. The pool lives in a :class:`distributed.WorkerPlugin`, created
 when the plugin is registered and shut down with the worker.
 """
