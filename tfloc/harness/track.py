@@ -12,7 +12,7 @@ One row per scan, in order, in the columns of :data:`tfloc.io.estimates.COLUMNS`
   map: ``failed``, ``info.reason``) or when it raised (``status`` = ``error:<message>``; the run
   goes on from the prediction);
 * ``cpu_s``/``runtime_s``: process CPU time and wall time of the step alone (the matcher's
-  ``prepare`` and one ``score`` run untimed before the first scan, as in single-scan runs);
+  ``prepare``, one ``score`` and one ``localize`` of the first scan run untimed before it);
 * ``dist_err_m``, ``orient_err_rad``, ``init_*_err``, ``outcome``, ``score_*``: left empty.
 """
 
@@ -59,12 +59,14 @@ def _pose_fields(prefix: str, p: Pose | None) -> dict[str, Any]:
 
 
 def _warm(matcher, problem: Problem) -> None:
-    """Untimed: ``prepare`` (map-only structures) and one ``score`` (numba kernels loaded)."""
+    """Untimed: ``prepare`` (map-only structures), one ``score`` and one ``localize`` (numba
+    kernels compiled or loaded), as the runner's warm-up does before a run."""
     try:
         prepare = getattr(matcher, "prepare", None)
         if prepare is not None:
             prepare(problem)
         matcher.score(problem, problem.initial)
+        matcher.localize(problem)
     except Exception:  # noqa: BLE001 - the timed steps report what is wrong
         pass
 
