@@ -89,17 +89,24 @@ def recompose(rot1: np.ndarray | float, trans: np.ndarray | float,
                             np.atleast_1d(wrap_angle(rot1 + rot2))])
 
 
-def sample_increments(delta: Pose, noise: OdometryNoise, rng: np.random.Generator,
-                      n: int = 1) -> np.ndarray:
-    """``n`` draws of ``sample_motion_model_odometry`` (Table 5.6) for the motion ``delta``:
-    ``(n, 3)`` noisy relative motions. Draws 3·n normals in a fixed order (reproducible)."""
+def sample_parts(delta: Pose, noise: OdometryNoise, rng: np.random.Generator, n: int = 1) -> np.ndarray:
+    """``n`` draws of the noisy parts ``(δ̂rot1, δ̂trans, δ̂rot2)`` of Table 5.6 for the motion
+    ``delta``, ``(n, 3)``. Draws 3·n normals in a fixed order (reproducible)."""
     a1, a2, a3, a4 = noise.alphas
     rot1, trans, rot2 = decompose(delta)
     z = rng.standard_normal((n, 3))
-    r1 = rot1 - z[:, 0] * math.sqrt(a1 * rot1 ** 2 + a2 * trans ** 2)
-    tr = trans - z[:, 1] * math.sqrt(a3 * trans ** 2 + a4 * (rot1 ** 2 + rot2 ** 2))
-    r2 = rot2 - z[:, 2] * math.sqrt(a1 * rot2 ** 2 + a2 * trans ** 2)
-    return recompose(r1, tr, r2)
+    return np.column_stack([
+        rot1 - z[:, 0] * math.sqrt(a1 * rot1 ** 2 + a2 * trans ** 2),
+        trans - z[:, 1] * math.sqrt(a3 * trans ** 2 + a4 * (rot1 ** 2 + rot2 ** 2)),
+        rot2 - z[:, 2] * math.sqrt(a1 * rot2 ** 2 + a2 * trans ** 2)])
+
+
+def sample_increments(delta: Pose, noise: OdometryNoise, rng: np.random.Generator,
+                      n: int = 1) -> np.ndarray:
+    """``n`` draws of ``sample_motion_model_odometry`` (Table 5.6) for the motion ``delta``:
+    ``(n, 3)`` noisy relative motions (x, y, θ in the start's frame)."""
+    p = sample_parts(delta, noise, rng, n)
+    return recompose(p[:, 0], p[:, 1], p[:, 2])
 
 
 def draw_odometry(true_poses: np.ndarray, noise: OdometryNoise, rng: np.random.Generator,
