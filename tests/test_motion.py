@@ -8,8 +8,15 @@ import numpy as np
 import pytest
 
 from tfloc.core.pose import Pose
-from tfloc.datasets.motion import (OdometryNoise, Slip, decompose, draw_odometry, recompose, sample_increments,
-                                   sample_parts)
+from tfloc.datasets.motion import (
+    OdometryNoise,
+    Slip,
+    decompose,
+    draw_odometry,
+    recompose,
+    sample_increments,
+    sample_parts,
+)
 from tfloc.errors import ConfigError
 
 

@@ -13,7 +13,7 @@ import pytest
 
 from tfloc.core.laser import LaserSpec
 from tfloc.core.pose import Pose
-from tfloc.datasets.sequences import BUNDLE, CONDITIONS, SimSpec, SequenceSpec, generate_sequences
+from tfloc.datasets.sequences import BUNDLE, CONDITIONS, SequenceSpec, SimSpec, generate_sequences
 from tfloc.errors import DatasetError
 from tfloc.io.scenario import SEQUENCE, Scan, read_scans, read_scenario, write_scenario
 

@@ -32,6 +32,7 @@ from tfloc.errors import ConfigError
 
 #: a motion shorter than this (metres) is a turn in place: δrot1 = 0
 MIN_TRANS_M = 0.01
+ORIGIN = Pose()
 
 
 @dataclass(frozen=True)
@@ -110,7 +111,7 @@ def sample_increments(delta: Pose, noise: OdometryNoise, rng: np.random.Generato
 
 
 def draw_odometry(true_poses: np.ndarray, noise: OdometryNoise, rng: np.random.Generator,
-                  slip: Slip | None = None, start: Pose = Pose()) -> tuple[np.ndarray, np.ndarray]:
+                  slip: Slip | None = None, start: Pose = ORIGIN) -> tuple[np.ndarray, np.ndarray]:
     """Raw odometry ``(N, 3)`` for a trajectory of ``(N, 3)`` true poses (world frame): each true
     increment goes through :func:`sample_increments`, then (with ``slip``) a slip event removes a
     jump of ``slip.min_m``–``max_m`` metres from what the odometry saw. The odometry frame starts

@@ -27,7 +27,15 @@ from tfloc.io.carmen import read_carmen
 from tfloc.io.scenario import SEQUENCE, Scan, write_scenario
 
 from .motion import OdometryNoise, draw_odometry
-from .real import ACES_LASER, ACES_NO_RETURN_M, CSAIL_LASER, INTEL_LASER, NO_RETURN_M, clean_ranges, front_scans
+from .real import (
+    ACES_LASER,
+    ACES_NO_RETURN_M,
+    CSAIL_LASER,
+    INTEL_LASER,
+    NO_RETURN_M,
+    clean_ranges,
+    front_scans,
+)
 
 #: the α's of the drawn odometry (all four)
 ALPHA = 0.05

@@ -25,7 +25,6 @@ order, so the bundle is reproducible bit for bit and adding a dataset at the end
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 

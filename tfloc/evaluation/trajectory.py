@@ -34,6 +34,7 @@ from tfloc.core.pose import angdiff
 from .outcome import Thresholds
 
 LOST_DIST_M, LOST_ORIENT_DEG = 0.5, 10.0
+DEFAULT = Thresholds()
 
 
 @dataclass(frozen=True)
@@ -128,7 +129,7 @@ def errors(est: np.ndarray, true: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def episodes(dist_err: np.ndarray, orient_err: np.ndarray,
-             thresholds: Thresholds = Thresholds()) -> list[tuple[int, int | None]]:
+             thresholds: Thresholds = DEFAULT) -> list[tuple[int, int | None]]:
     """Lost stretches as ``(first lost scan, recovery scan or None)`` (module notes)."""
     lost = (dist_err > LOST_DIST_M) | (np.degrees(orient_err) > LOST_ORIENT_DEG)
     ok = thresholds.success(dist_err, orient_err)
@@ -149,7 +150,7 @@ def episodes(dist_err: np.ndarray, orient_err: np.ndarray,
 
 
 def score_track(est: np.ndarray, true: np.ndarray, cpu_s: np.ndarray | None = None,
-                thresholds: Thresholds = Thresholds()) -> TrackScore:
+                thresholds: Thresholds = DEFAULT) -> TrackScore:
     """Every score of one sequence (module notes). ``true`` rows with NaN are left out."""
     est, true = np.asarray(est, dtype=float).reshape(-1, 3), np.asarray(true, dtype=float).reshape(-1, 3)
     n_scans = len(est)
@@ -178,7 +179,7 @@ def score_track(est: np.ndarray, true: np.ndarray, cpu_s: np.ndarray | None = No
         cpu_ms_median=cpu)
 
 
-def score_rows(rows, thresholds: Thresholds = Thresholds()) -> TrackScore:
+def score_rows(rows, thresholds: Thresholds = DEFAULT) -> TrackScore:
     """:func:`score_track` of one (sequence, matcher)'s result rows (dicts or a DataFrame, in
     scan order, columns ``est_*``, ``true_*``, ``cpu_s``; empty truth = NaN)."""
     import pandas as pd
