@@ -55,7 +55,7 @@ def sequence_scans(log_path: Path, laser, no_return: float, rng: np.random.Gener
     own = bool(np.all(np.diff(t) > 0))
     stamps = t if own else np.arange(len(recs), dtype=float)
     odom, _ = draw_odometry(P, noise, rng)
-    rows = [Scan(f"s{k:04d}", "sequence", clean_ranges(r.ranges, no_return),
+    rows = [Scan(f"s{k:04d}", "real", clean_ranges(r.ranges, no_return),
                  Pose.from_array(P[0]) if k == 0 else None, Pose.from_array(P[k]),
                  stamp=float(stamps[k]), odom=Pose.from_array(odom[k]))
             for k, r in enumerate(recs)]

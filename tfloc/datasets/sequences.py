@@ -18,7 +18,8 @@ and names what makes a robot lose track:
 Design (all under ``data/scenarios/seq-*``, about 16 MB): ``easy`` and the rate conditions on all
 three routes (route a on office-1, b on office-2, c on office-3); the other hard conditions on
 route b (office-2) only, so that each compares with ``seq-easy-b`` on the same route and map;
-``seq-quick``: the first 100 scans of ``seq-easy-b`` (``make quick``, the regression guard).
+``seq-quick``: the first 100 scans of ``seq-easy-b`` (``make quick``, the regression guard;
+reported as its own set, ``"set": "quick"``, not with the easy sequences it repeats).
 Every dataset draws from its own child of one master seed (``SeedSequence.spawn``), in a fixed
 order, so the bundle is reproducible bit for bit and adding a dataset at the end changes no other.
 """
@@ -84,19 +85,21 @@ ROUTE_LEVEL = {"a": 1, "b": 2, "c": 3}
 
 @dataclass(frozen=True)
 class SequenceSpec:
-    """One dataset of the bundle: its name, route, condition and (optionally) a scan limit."""
+    """One dataset of the bundle: its name, route, condition, (optionally) a scan limit and the
+    sequence set it is reported in (default: its condition's)."""
 
     name: str
     route: str
     condition: str
     limit: int | None = None
+    set: str | None = None
 
 
 BUNDLE: tuple[SequenceSpec, ...] = (
     *(SequenceSpec(f"seq-easy-{r}", r, "easy") for r in "abc"),
     *(SequenceSpec(f"seq-{c}-{r}", r, c) for c in ("rate-2hz", "rate-1hz") for r in "abc"),
     *(SequenceSpec(f"seq-{c}-b", "b", c) for c in ("odom-high", "slip", "people")),
-    SequenceSpec("seq-quick", "b", "easy", QUICK_SCANS),
+    SequenceSpec("seq-quick", "b", "easy", QUICK_SCANS, set="quick"),
 )
 
 
@@ -209,8 +212,9 @@ def generate_sequences(out: str | Path, spec: SimSpec = SimSpec(), log=None) -> 
                    f"{spec.slip.min_m:g}-{spec.slip.max_m:g} m" if cond.slip else "")
                 + (f"; {spec.people.n} unmapped people (0.3 m discs) walking along the route"
                    if cond.people else "") + ".")
+        extra = {} if item.set is None else {"set": item.set}
         write_scenario(root, item.name, path, spec.laser, scans, description=desc, mode=SEQUENCE,
-                       condition=cond.to_dict(), route=item.route,
+                       condition=cond.to_dict(), route=item.route, **extra,
                        generator={"command": "tfloc generate", "seed": spec.seed,
                                   "child": int(ss.spawn_key[-1]), **summary,
                                   "noise": {"sigma_m": spec.noise.sigma_m,

@@ -189,3 +189,17 @@ def score_rows(rows, thresholds: Thresholds = DEFAULT) -> TrackScore:
     cpu = pd.to_numeric(df["cpu_s"], errors="coerce").dropna().to_numpy(float)
     return score_track(num(["est_x", "est_y", "est_theta"]), num(["true_x", "true_y", "true_theta"]),
                        cpu, thresholds)
+
+
+def pooled_share(k, n, n_boot: int = 2000, seed: int = 20261122) -> tuple[float, float, float]:
+    """The share Σk/Σn pooled over sequences (``k`` tracked of ``n`` scans each) and its 95 %
+    percentile-bootstrap interval over sequences (resampled with replacement, seeded); the
+    interval is NaN with fewer than two sequences (scans of one sequence are not independent)."""
+    k, n = np.asarray(k, dtype=float), np.asarray(n, dtype=float)
+    share = float(k.sum() / n.sum()) if n.sum() > 0 else math.nan
+    if len(k) < 2:
+        return share, math.nan, math.nan
+    idx = np.random.default_rng(seed).integers(0, len(k), size=(n_boot, len(k)))
+    boot = k[idx].sum(axis=1) / n[idx].sum(axis=1)
+    lo, hi = np.percentile(boot, [2.5, 97.5])
+    return share, float(lo), float(hi)
