@@ -111,3 +111,13 @@ def test_cli_track_one_line_errors(tmp_path, capsys):
     root = _copy(tmp_path / "a", 5)
     assert main(["track", "--dataset", str(root), "--param", "nope=1", "--out", str(tmp_path / "e.csv")]) == 2
     assert "nope" in capsys.readouterr().err
+
+
+def test_run_sequence_is_one_task(tmp_path):
+    from tfloc.harness.track import run_sequence
+
+    root = _copy(tmp_path / "a", 8)
+    rows = run_sequence(str(root), "tfp", "tf-plus", '{"grid_step": 0.1}')
+    assert [r["matcher"] for r in rows] == ["tfp"] * 8 and {r["status"] for r in rows} == {"ok"}
+    odo = run_sequence(str(root), "odometry", "odometry")
+    assert odo == dead_reckoning(read_scenario(root), read_scans(read_scenario(root)))

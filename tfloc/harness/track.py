@@ -32,6 +32,8 @@ from tfloc.io.scenario import SEQUENCE, Scan, Scenario, map_for
 
 #: status of a row whose estimate is the matcher's own answer / the prediction kept
 OK, FAILED = "ok", "failed"
+#: the matcher name of dead reckoning (the prediction alone), the floor of every tracking table
+DEAD_RECKONING = "odometry"
 
 
 def check_sequence(scenario: Scenario, scans: Sequence[Scan]) -> None:
@@ -135,7 +137,7 @@ def track(scenario: Scenario, scans: Sequence[Scan], matcher, *, label: str | No
     return rows
 
 
-def dead_reckoning(scenario: Scenario, scans: Sequence[Scan], *, label: str = "odometry",
+def dead_reckoning(scenario: Scenario, scans: Sequence[Scan], *, label: str = DEAD_RECKONING,
                    dataset: str | None = None) -> list[dict[str, Any]]:
     """The floor every table shows: the prediction alone (the odometry composed from the start
     pose), as rows of a matcher named ``odometry`` (status ``ok``, CPU time 0)."""
@@ -147,3 +149,19 @@ def dead_reckoning(scenario: Scenario, scans: Sequence[Scan], *, label: str = "o
         rows.append(row(dataset, label, scan, pred, pred, OK, 0.0, 0.0))
         last = pred
     return rows
+
+
+def run_sequence(dataset: str, label: str, matcher: str, params_json: str = "{}") -> list[dict[str, Any]]:
+    """One sequence task of a run, as a worker executes it: load the dataset ``dataset`` (a
+    directory), build the registered ``matcher`` with ``params_json`` (``odometry``: dead
+    reckoning) and track the whole sequence; the rows carry ``label`` as their matcher. Dataset
+    errors raise :class:`DatasetError`; a matcher that raises on a scan is that scan's
+    ``error:`` row, the run goes on."""
+    from tfloc.core.matcher import get_matcher
+    from tfloc.io.scenario import read_scans, read_scenario
+
+    scenario = read_scenario(dataset)
+    scans = read_scans(scenario)
+    if matcher == DEAD_RECKONING:
+        return dead_reckoning(scenario, scans, label=label)
+    return track(scenario, scans, get_matcher(matcher, **json.loads(params_json)), label=label)
