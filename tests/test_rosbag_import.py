@@ -244,3 +244,41 @@ def test_bench_runs_on_an_imported_dataset(tmp_path, sim, map_yaml) -> None:
     np.testing.assert_allclose(ref.positions_xyz[:, :2], [[s.true.x, s.true.y] for s in scans], atol=1e-6)
     est = file_interface.read_tum_trajectory_file(str(tmp_path / "tum" / "mybag" / "tf.tum"))
     assert 1 <= est.num_poses <= len(scans)
+
+
+@pytest.mark.parametrize("how", ["odometry", "tf"])
+def test_odometry_topic_makes_a_sequence(tmp_path, sim, map_yaml, how) -> None:
+    """--odom-topic: a sequence dataset; the odometry (in its own frame) is read at the scan
+    stamps, its increments are the true ones, and `tfloc track` runs on it."""
+    t, P, R = sim
+    odom_frame = Pose(-3.0, 2.0, 0.7)  # where the odom frame's origin is in the map
+    in_odom = [odom_frame.inverse().compose(Pose(*p)) for p in path_pose(POSE_T)]
+    if how == "odometry":
+        items = [type(a)("/odom", "Odometry", a.t, tuple(o.as_array()), "odom")
+                 for a, o in zip(pose_items("/odom", "Odometry", POSE_T), in_odom, strict=True)]
+        args = ["--odom-topic", "/odom"]
+    else:
+        items = [TfItem("/tf", float(ti), (("odom", "base_link", tuple(o.as_array())),))
+                 for ti, o in zip(POSE_T, in_odom, strict=True)]
+        args = ["--odom-topic", "/tf", "--odom-frames", "odom", "base_link"]
+    bag = write_bag(bag_path(tmp_path, "mcap"), "mcap",
+                    scan_items("/scan", t, R) + pose_items("/gt", "PoseStamped", POSE_T) + items)
+    out = tmp_path / "seq"
+    assert main(["import-bag", str(bag), "--scan-topic", "/scan", "--pose-topic", "/gt",
+                 "--map", str(map_yaml), "--out", str(out), *args]) == 0
+    sc = read_scenario(out)
+    assert sc.mode == "sequence"
+    scans = _check_dataset(out, sim)
+    assert scans[0].initial is not None and all(s.initial is None for s in scans[1:])
+    for a, b in zip(scans[:-1], scans[1:], strict=True):
+        d_odom, d_true = a.odom.between(b.odom), a.true.between(b.true)
+        assert d_odom.distance_to(d_true) < 3e-4 and abs(angdiff(d_odom.theta, d_true.theta)) < 1e-5
+    assert main(["track", "--dataset", str(out), "--matcher", "odometry", "--out", str(tmp_path / "e.csv")]) == 0
+
+
+def test_odometry_topic_excludes_initial_poses(tmp_path, map_yaml) -> None:
+    from tfloc.errors import ConfigError
+
+    with pytest.raises(ConfigError, match="--odom-topic writes a sequence"):
+        BagImport(tmp_path / "x.bag", "/scan", "/gt", tmp_path / "o", map_file=map_yaml,
+                  initial_topic="/amcl_pose", odom_topic="/odom")

@@ -1,7 +1,9 @@
 """Generate the bundled office maps and the scenario datasets of the paper's protocol.
 
-Writes OUT/maps/office-{1,2,3}.geojson (rooms only, furnished, crowded) and
-OUT/scenarios/{office-pool,detail-1,detail-2,detail-3}. The same seed gives the same bytes.
+Writes OUT/maps/office-{1,2,3}.geojson (rooms only, furnished, crowded),
+OUT/scenarios/{office-pool,detail-1,detail-2,detail-3} and the simulated sequences
+OUT/scenarios/seq-* (a robot driving routes through the three floors with odometry, under
+labelled conditions: tfloc.datasets.sequences). The same seeds give the same bytes.
 """
 
 from __future__ import annotations
@@ -25,6 +27,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--spurious", type=float, default=0.0, help="probability of a spurious short return (0)")
     p.add_argument("--clearance", type=float, default=0.3,
                    help="min distance of true and initial poses from geometry, metres (0.3)")
+    p.add_argument("--no-sequences", action="store_true",
+                   help="skip the sequence datasets seq-* (tracking)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -36,4 +40,8 @@ def run(args: argparse.Namespace) -> int:
                       noise=NoiseModel(args.sigma, args.dropout, args.spurious),
                       clearance_m=args.clearance)
     generate_bundle(args.out, spec, log=print)
+    if not args.no_sequences:
+        from tfloc.datasets.sequences import SimSpec, generate_sequences
+
+        generate_sequences(args.out, SimSpec(noise=spec.noise), log=print)
     return 0

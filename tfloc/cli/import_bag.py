@@ -6,10 +6,15 @@ and scans outside the pose stream are skipped and counted. The map is a map_serv
 (--map) or an OccupancyGrid topic in the bag (--map-topic); it is stored in the dataset.
 Initial poses are the reference perturbed in the paper's 3 x 3 offset bins (--seed), or come
 from a second pose topic (--initial-topic, e.g. AMCL's estimate or odometry with --align-initial).
+With --odom-topic (nav_msgs/Odometry, or a tf topic with --odom-frames odom base_link) the
+dataset is a sequence for `tfloc track`: the scans in time order with the odometry at each, the
+robot starting at the reference pose of the first scan.
 
 Example:
   tfloc import-bag run1.bag --scan-topic /scan --pose-topic /ground_truth \\
       --map map.yaml --out data/scenarios/run1
+  tfloc import-bag run1.bag --scan-topic /scan --pose-topic /ground_truth --odom-topic /odom \
+      --map map.yaml --out data/scenarios/run1-sequence
 """
 
 from __future__ import annotations
@@ -50,6 +55,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--laser-offset", nargs=3, type=float, default=(0.0, 0.0, 0.0),
                    metavar=("X", "Y", "YAW"),
                    help="laser pose in the frame of the reference poses (m, m, rad; default 0 0 0)")
+    p.add_argument("--odom-topic",
+                   help="write a sequence (tracking): the robot's odometry, nav_msgs/Odometry or a tf topic")
+    p.add_argument("--odom-frames", nargs=2, metavar=("PARENT", "CHILD"),
+                   help="frame pair when --odom-topic is a tf topic (e.g. odom base_link)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -59,12 +68,14 @@ def run(args: argparse.Namespace) -> int:
                     args.name, tuple(args.pose_frames) if args.pose_frames else None,
                     args.initial_topic, tuple(args.initial_frames) if args.initial_frames else None,
                     args.align_initial, args.seed, args.clearance, args.every, args.limit,
-                    args.max_pose_gap, Pose(*args.laser_offset))
+                    args.max_pose_gap, Pose(*args.laser_offset), args.odom_topic,
+                    tuple(args.odom_frames) if args.odom_frames else None)
     s = import_bag(cfg)
-    skipped = s.outside_poses + s.outside_initial + s.no_return
+    skipped = s.outside_poses + s.outside_initial + s.no_return + s.outside_odom
     print(f"{s.path}: {s.kept} scans from {s.messages} messages on {args.scan_topic}"
           + (f"; skipped {s.outside_poses} outside {args.pose_topic}" if s.outside_poses else "")
           + (f", {s.outside_initial} outside {args.initial_topic}" if s.outside_initial else "")
+          + (f", {s.outside_odom} outside {args.odom_topic} or out of time order" if s.outside_odom else "")
           + (f", {s.no_return} without a return" if s.no_return else "")
           + ("" if skipped else "; none skipped"))
     return 0

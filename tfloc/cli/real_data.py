@@ -2,8 +2,9 @@
 
 Writes OUT/scenarios/real-csail-relations/ and real-csail-relations-perturbed/ (scan-to-scan, the
 1172 MIT CSAIL relations from the odometry guess and from perturbed guesses),
-OUT/scenarios/real-{intel,csail,aces}-scan-to-map/ (scan-to-map), and their grid maps
-OUT/maps/real-{intel,csail,aces}.yaml|.pgm.
+OUT/scenarios/real-{intel,csail,aces}-scan-to-map/ (scan-to-map), their grid maps
+OUT/maps/real-{intel,csail,aces}.yaml|.pgm, and OUT/scenarios/real-{intel,csail,aces}-sequence/
+(tracking: every scan in time order, odometry drawn from the corrected increments).
 """
 
 from __future__ import annotations
@@ -29,9 +30,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from tfloc.datasets.real import build_all
+    from tfloc.datasets.real_sequences import build_sequences
     from tfloc.datasets.relations import build_relations
 
     for root in [*build_relations(args.real, args.out, args.seed),
-                 *build_all(args.real, args.out, args.seed, args.resolution)]:
+                 *build_all(args.real, args.out, args.seed, args.resolution),
+                 *build_sequences(args.real, args.out)]:
         print(root)
     return 0

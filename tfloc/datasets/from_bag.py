@@ -1,5 +1,7 @@
 """A scenario dataset from a ROS bag: scans, reference poses at the scan stamps, a map, and
-initial poses (perturbed in the paper's bins from a seed, or from a second pose topic)."""
+initial poses (perturbed in the paper's bins from a seed, or from a second pose topic); or, given
+an odometry topic, a *sequence* (tracking): the scans in time order with the robot's odometry
+pose at each, the start = the reference at the first scan."""
 
 from __future__ import annotations
 
@@ -38,6 +40,9 @@ class BagImport:
         every: keep every n-th scan message; limit: at most this many scans (0 = all).
         max_pose_gap_s: a scan between two poses further apart than this is not covered.
         laser_offset: the laser's pose in the frame of the reference poses (m, m, rad).
+        odom_topic: write a sequence dataset: the robot's odometry (nav_msgs/Odometry, a pose
+            topic, or tf with ``odom_frames``, e.g. ``odom base_link``) interpolated to the scan
+            stamps; excludes ``initial_topic`` and the perturbation.
     """
 
     bag: Path
@@ -57,6 +62,8 @@ class BagImport:
     limit: int = 0
     max_pose_gap_s: float = 1.0
     laser_offset: Pose = field(default_factory=Pose)
+    odom_topic: str | None = None
+    odom_frames: tuple[str, str] | None = None
 
     def __post_init__(self) -> None:
         """Argument errors (one type, :class:`ConfigError`, whoever builds the import)."""
@@ -68,6 +75,11 @@ class BagImport:
             raise ConfigError("--initial-frames needs --initial-topic")
         if self.align_initial and not self.initial_topic:
             raise ConfigError("--align-initial needs --initial-topic")
+        if self.odom_frames and not self.odom_topic:
+            raise ConfigError("--odom-frames needs --odom-topic")
+        if self.odom_topic and (self.initial_topic or self.seed is not None):
+            raise ConfigError("--odom-topic writes a sequence (the start is the reference at the first scan): "
+                              "it takes no --initial-topic or --seed")
         if not (self.clearance_m >= 0 and self.max_pose_gap_s > 0 and self.laser_offset.is_finite()):
             raise ConfigError(f"--clearance must be ≥ 0 m, --max-pose-gap > 0 s and --laser-offset finite, got "
                               f"{self.clearance_m}, {self.max_pose_gap_s} and {self.laser_offset}")
@@ -83,6 +95,7 @@ class ImportSummary:
     outside_poses: int
     outside_initial: int
     no_return: int
+    outside_odom: int = 0
 
 
 def import_bag(cfg: BagImport) -> ImportSummary:
@@ -98,6 +111,7 @@ def import_bag(cfg: BagImport) -> ImportSummary:
         scans = bag.scans(cfg.scan_topic)
         ref = bag.poses(cfg.pose_topic, cfg.pose_frames)
         init = bag.poses(cfg.initial_topic, cfg.initial_frames) if cfg.initial_topic else None
+        odom = bag.poses(cfg.odom_topic, cfg.odom_frames) if cfg.odom_topic else None
         grid = bag.grid(cfg.map_topic) if cfg.map_topic else None
 
     pick = np.flatnonzero(scans.index % cfg.every == 0)
@@ -116,6 +130,18 @@ def import_bag(cfg: BagImport) -> ImportSummary:
         if not keep.any():
             raise BagError(f"{cfg.bag}: {cfg.initial_topic} covers none of the scans on {cfg.scan_topic} "
                            f"that {cfg.pose_topic} covers (poses span {_span(init.stamps)})")
+    outside_odom = 0
+    if odom is not None:
+        odom_p, odom_cov = interpolate_poses(odom.stamps, odom.poses, t, cfg.max_pose_gap_s)
+        outside_odom = int(np.count_nonzero(keep & ~odom_cov))
+        keep &= odom_cov
+        if not keep.any():
+            raise BagError(f"{cfg.bag}: {cfg.odom_topic} covers none of the scans on {cfg.scan_topic} "
+                           f"that {cfg.pose_topic} covers (poses span {_span(odom.stamps)})")
+        # a sequence's stamps increase strictly: a scan not later than every earlier one is dropped
+        late = t > np.maximum.accumulate(np.concatenate([[-np.inf], t[:-1]]))
+        outside_odom += int(np.count_nonzero(keep & ~late))
+        keep &= late
     no_return = scans.laser.valid(scans.ranges[pick]).sum(axis=1) == 0
     n_empty = int(np.count_nonzero(keep & no_return))
     keep &= ~no_return
@@ -133,6 +159,9 @@ def import_bag(cfg: BagImport) -> ImportSummary:
     if not the_map.in_bounds(true_p[:, :2]).any():
         raise BagError(f"{cfg.bag}: none of the {cfg.pose_topic} poses at the scans lies inside the map "
                        f"(bounds {tuple(round(b, 2) for b in the_map.bounds)} m); are they in the map frame?")
+    if odom is not None:
+        return _write_sequence(cfg, scans, pick, rows, t, true_p, odom_p, grid, ref, out,
+                               int(np.count_nonzero(~covered)), outside_odom, n_empty)
     if init is not None:
         ip = start[rows]
         if cfg.align_initial:  # express the initial stream in the reference frame at the first scan
@@ -174,6 +203,39 @@ def import_bag(cfg: BagImport) -> ImportSummary:
                    source=source)
     return ImportSummary(out, int(scans.index.size), int(rows.size), int(np.count_nonzero(~covered)),
                          outside_init, n_empty)
+
+
+def _write_sequence(cfg: BagImport, scans, pick, rows, t, true_p, odom_p, grid, ref, out: Path,
+                    outside_poses: int, outside_odom: int, n_empty: int) -> ImportSummary:
+    """Write the sequence dataset: scans in time order, odometry of the laser (the robot's
+    odometry composed with the laser offset), the start = the reference at the first scan."""
+    from tfloc.io.scenario import SEQUENCE
+
+    off = cfg.laser_offset
+    odom_l = [Pose.from_array(odom_p[k]).compose(off) for k in rows]
+    rows_out = [Scan(f"s{scans.index[pick[k]]:05d}", "sequence", scans.ranges[pick[k]],
+                     Pose.from_array(tp) if i == 0 else None, Pose.from_array(tp), stamp=float(t[k]), odom=o)
+                for i, (k, tp, o) in enumerate(zip(rows, true_p, odom_l, strict=True))]
+    las = scans.laser
+    out.mkdir(parents=True, exist_ok=True)
+    map_path = _save_map(cfg, grid, out)
+    source = {"bag": str(cfg.bag), "scan_topic": cfg.scan_topic, "pose_topic": cfg.pose_topic,
+              "pose_frames": list(cfg.pose_frames) if cfg.pose_frames else None,
+              "odom_topic": cfg.odom_topic, "odom_frames": list(cfg.odom_frames) if cfg.odom_frames else None,
+              "map_topic": cfg.map_topic, "laser_frame": scans.frame_id, "pose_frame": ref.frame_id,
+              "laser_offset": [off.x, off.y, off.theta],
+              "angle_min": las.angle_min, "angle_increment": las.resolution, "range_min": scans.range_min,
+              "range_max": las.max_range, "n_beams": las.n_beams, "every": cfg.every,
+              "max_pose_gap_s": cfg.max_pose_gap_s,
+              "scan_messages": int(scans.index.size), "imported": int(rows.size),
+              "skipped": {"outside_poses": outside_poses, "outside_odom": outside_odom, "no_return": n_empty}}
+    write_scenario(out, cfg.name or out.name, map_path, las, rows_out,
+                   description=(f"Imported from ROS bag {Path(cfg.bag).name} as a sequence: {cfg.scan_topic} "
+                                f"scans in time order, odometry from {cfg.odom_topic} and reference poses "
+                                f"from {cfg.pose_topic}, both interpolated to the scan stamps; the robot "
+                                "starts at the reference pose of the first scan."),
+                   mode=SEQUENCE, condition={"name": "bag"}, source=source)
+    return ImportSummary(out, int(scans.index.size), int(rows.size), outside_poses, 0, n_empty, outside_odom)
 
 
 def _span(stamps: np.ndarray) -> str:

@@ -1,0 +1,43 @@
+"""The tracking section of a report: one table per sequence set with intervals over sequences,
+dead reckoning as the floor, and the figures."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+
+from tfloc.harness.track import dead_reckoning, row
+from tfloc.io.maps import load_map
+from tfloc.io.scenario import read_scans, read_scenario
+from tfloc.report.tracking import sequence_scores, tracking_section
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _rows(name: str, n: int, lost_from: int | None = None) -> list[dict]:
+    sc = read_scenario(ROOT / "data" / "scenarios" / name)
+    scans = read_scans(sc)[:n]
+    out = dead_reckoning(sc, scans, dataset=name)
+    for k, s in enumerate(scans):  # a "perfect" matcher, lost (1 m off) from lost_from on
+        est = s.true if lost_from is None or k < lost_from else s.true.compose(type(s.true)(1.0, 0.0, 0.0))
+        out.append(row(name, "perfect", s, s.true, est, "ok", 0.002, 0.002))
+    return out
+
+
+def test_tables_and_figures(tmp_path):
+    df = pd.DataFrame(_rows("seq-rate-1hz-a", 40) + _rows("seq-rate-1hz-b", 40, lost_from=30)
+                      + _rows("seq-quick", 30)).astype(str)
+    names = df["dataset"].unique()
+    ds = {n: read_scenario(ROOT / "data" / "scenarios" / n) for n in names}
+    s = sequence_scores(df, ds)
+    assert set(s["condition"]) == {"rate-1hz", "quick"}
+    text = tracking_section(df, ds, {n: load_map(ds[n].map_path) for n in names}, tmp_path)
+    assert "**rate-1hz** (2 sequences" in text and "**quick** (1 sequence" in text
+    line = next(x for x in text.splitlines() if x.startswith("| perfect") and "[" in x)
+    # pooled over the two sequences: 70 of 80 scans tracked, with a bootstrap interval
+    assert line.split("|")[2].strip().startswith("87.5 [")
+    assert "| 1 | 0 | 1 |" in line  # one loss, no recovery, unrecovered
+    assert any(x.startswith("| odometry") for x in text.splitlines())
+    figs = sorted(p.name for p in (tmp_path / "figures" / "tracking").iterdir())
+    assert "seq-rate-1hz-b-trajectories.png" in figs and "seq-quick-error.png" in figs

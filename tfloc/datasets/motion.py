@@ -1,0 +1,131 @@
+"""The odometry motion model (Thrun, Burgard, Fox, *Probabilistic Robotics*, 2005, Sec. 5.4) and
+wheel slip: how simulated (and re-drawn real) odometry departs from the true motion.
+
+A motion between two poses is decomposed as a rotation ``δrot1`` towards the new position, a
+translation ``δtrans`` and a second rotation ``δrot2`` (Eq. 5.33–5.35). The sampler of Table 5.6
+(``sample_motion_model_odometry``) perturbs each part with zero-mean Gaussian noise of variance
+
+* ``δrot1``: α1·δrot1² + α2·δtrans²
+* ``δtrans``: α3·δtrans² + α4·(δrot1² + δrot2²)
+* ``δrot2``: α1·δrot2² + α2·δtrans²
+
+(α1: rotation from rotation, α2: rotation from translation, α3: translation from translation,
+α4: translation from rotation; the model AMCL's ``diff`` odometry uses). Here it draws the
+*odometry* a robot would have measured from its *true* increments: the raw odometry pose is the
+noisy increments composed from the start. A motion shorter than :data:`MIN_TRANS_M` is a turn in
+place: ``δrot1`` = 0 (its heading would be undefined), as AMCL does.
+
+Wheel slip (:class:`Slip`) is a separate, labelled perturbation: at a few scans the robot moved
+by 0.3–1 m more than the wheels say (it slid or was pushed), a jump the odometry does not see.
+Units: metres, radians.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from tfloc.core.pose import Pose, wrap_angle
+from tfloc.errors import ConfigError
+
+#: a motion shorter than this (metres) is a turn in place: δrot1 = 0
+MIN_TRANS_M = 0.01
+ORIGIN = Pose()
+
+
+@dataclass(frozen=True)
+class OdometryNoise:
+    """The four α of Table 5.6 (dimensionless variance ratios: rad²/rad², rad²/m², m²/m², m²/rad²)."""
+
+    alpha1: float = 0.05
+    alpha2: float = 0.05
+    alpha3: float = 0.05
+    alpha4: float = 0.05
+
+    def __post_init__(self) -> None:
+        if not all(math.isfinite(a) and a >= 0 for a in self.alphas):
+            raise ConfigError(f"odometry noise α's must be finite and ≥ 0, got {self.alphas}")
+
+    @property
+    def alphas(self) -> tuple[float, float, float, float]:
+        return (self.alpha1, self.alpha2, self.alpha3, self.alpha4)
+
+    def to_dict(self) -> dict[str, float]:
+        return {"alpha1": self.alpha1, "alpha2": self.alpha2, "alpha3": self.alpha3, "alpha4": self.alpha4}
+
+
+@dataclass(frozen=True)
+class Slip:
+    """Wheel slip: with probability ``prob`` per scan the true motion exceeds the odometry by a
+    translation of ``min_m``–``max_m`` metres in a uniformly random direction."""
+
+    prob: float = 0.01
+    min_m: float = 0.3
+    max_m: float = 1.0
+
+    def __post_init__(self) -> None:
+        if not (0 <= self.prob <= 1 and 0 <= self.min_m <= self.max_m):
+            raise ConfigError(f"slip needs 0 ≤ prob ≤ 1 and 0 ≤ min_m ≤ max_m, got {self}")
+
+    def to_dict(self) -> dict[str, float]:
+        return {"prob": self.prob, "min_m": self.min_m, "max_m": self.max_m}
+
+
+def decompose(delta: Pose) -> tuple[float, float, float]:
+    """``(δrot1, δtrans, δrot2)`` of a relative motion ``delta`` (robot frame of the start;
+    Eq. 5.33–5.35); a turn in place (δtrans < :data:`MIN_TRANS_M`) has δrot1 = 0."""
+    trans = math.hypot(delta.x, delta.y)
+    rot1 = math.atan2(delta.y, delta.x) if trans >= MIN_TRANS_M else 0.0
+    rot2 = float(wrap_angle(delta.theta - rot1))
+    return rot1, trans, rot2
+
+
+def recompose(rot1: np.ndarray | float, trans: np.ndarray | float,
+              rot2: np.ndarray | float) -> np.ndarray:
+    """Relative motions ``(N, 3)`` (x, y, θ in the start's frame) from their three parts."""
+    rot1, trans, rot2 = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (rot1, trans, rot2)))
+    return np.column_stack([np.atleast_1d(trans * np.cos(rot1)), np.atleast_1d(trans * np.sin(rot1)),
+                            np.atleast_1d(wrap_angle(rot1 + rot2))])
+
+
+def sample_parts(delta: Pose, noise: OdometryNoise, rng: np.random.Generator, n: int = 1) -> np.ndarray:
+    """``n`` draws of the noisy parts ``(δ̂rot1, δ̂trans, δ̂rot2)`` of Table 5.6 for the motion
+    ``delta``, ``(n, 3)``. Draws 3·n normals in a fixed order (reproducible)."""
+    a1, a2, a3, a4 = noise.alphas
+    rot1, trans, rot2 = decompose(delta)
+    z = rng.standard_normal((n, 3))
+    return np.column_stack([
+        rot1 - z[:, 0] * math.sqrt(a1 * rot1 ** 2 + a2 * trans ** 2),
+        trans - z[:, 1] * math.sqrt(a3 * trans ** 2 + a4 * (rot1 ** 2 + rot2 ** 2)),
+        rot2 - z[:, 2] * math.sqrt(a1 * rot2 ** 2 + a2 * trans ** 2)])
+
+
+def sample_increments(delta: Pose, noise: OdometryNoise, rng: np.random.Generator,
+                      n: int = 1) -> np.ndarray:
+    """``n`` draws of ``sample_motion_model_odometry`` (Table 5.6) for the motion ``delta``:
+    ``(n, 3)`` noisy relative motions (x, y, θ in the start's frame)."""
+    p = sample_parts(delta, noise, rng, n)
+    return recompose(p[:, 0], p[:, 1], p[:, 2])
+
+
+def draw_odometry(true_poses: np.ndarray, noise: OdometryNoise, rng: np.random.Generator,
+                  slip: Slip | None = None, start: Pose = ORIGIN) -> tuple[np.ndarray, np.ndarray]:
+    """Raw odometry ``(N, 3)`` for a trajectory of ``(N, 3)`` true poses (world frame): each true
+    increment goes through :func:`sample_increments`, then (with ``slip``) a slip event removes a
+    jump of ``slip.min_m``–``max_m`` metres from what the odometry saw. The odometry frame starts
+    at ``start``. Returns the odometry poses and a boolean array marking slip scans."""
+    P = np.asarray(true_poses, dtype=float)
+    odom = [start]
+    slipped = np.zeros(len(P), dtype=bool)
+    for k in range(1, len(P)):
+        delta = Pose.from_array(P[k - 1]).between(Pose.from_array(P[k]))
+        inc = Pose.from_array(sample_increments(delta, noise, rng)[0])
+        if slip is not None:
+            u, dist, ang = rng.random(), rng.uniform(slip.min_m, slip.max_m), rng.uniform(-math.pi, math.pi)
+            if u < slip.prob:
+                slipped[k] = True
+                inc = Pose(inc.x - dist * math.cos(ang), inc.y - dist * math.sin(ang), inc.theta)
+        odom.append(odom[-1].compose(inc))
+    return np.array([p.as_array() for p in odom]), slipped

@@ -1,0 +1,182 @@
+"""The tracking section of a report: one table per sequence set and figures, from a run's rows.
+
+Input: the estimate rows of sequence datasets (a DataFrame as
+:func:`tfloc.io.estimates.read_estimates` gives, one row per scan and matcher, each (dataset,
+matcher)'s rows in scan order as the tracking loop writes them) and the datasets' scenarios.
+A **sequence set** is the datasets of one condition (``scenario.json`` ``set``, else
+``condition.name``: easy, rate-1hz, …, real); its table has one row per matcher (dead reckoning, ``odometry``, included as
+the floor): the tracked share pooled over the set's scans with a 95 % bootstrap interval over
+sequences (where the set has several), losses, recoveries and unrecovered losses summed over
+sequences, the longest lost stretch, APE translation RMSE pooled over scans (cm), RPE per metre
+(mean over sequences, cm/m) and the median CPU ms per scan. Definitions:
+:mod:`tfloc.evaluation.trajectory`. Figures: each sequence's trajectories drawn on the map per
+matcher, and the distance error over distance travelled.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from matplotlib.figure import Figure
+
+from tfloc.evaluation.outcome import Thresholds
+from tfloc.evaluation.trajectory import LOST_DIST_M, errors, path_length, pooled_share, score_rows
+from tfloc.io.scenario import Scenario
+
+from .mdtable import num, table
+
+DEAD_RECKONING = "odometry"
+MAP_SPACING_M = 0.05
+DEFAULT = Thresholds()
+
+
+def condition_of(scenario: Scenario | None, rows: pd.DataFrame) -> str:
+    """The sequence set of a dataset: its scenario's ``set``, else its ``condition.name``, else
+    its rows' group."""
+    extra = scenario.extra if scenario is not None else {}
+    return str(extra.get("set") or (extra.get("condition") or {}).get("name") or rows["group"].iloc[0])
+
+
+def sequence_scores(df: pd.DataFrame, datasets: dict[str, Scenario],
+                    thresholds: Thresholds = DEFAULT) -> pd.DataFrame:
+    """One row per (dataset, matcher): its condition and every score of
+    :class:`~tfloc.evaluation.trajectory.TrackScore`."""
+    out = []
+    for (ds, m), g in df.groupby(["dataset", "matcher"], sort=False):
+        s = score_rows(g, thresholds).to_dict()
+        out.append({"dataset": ds, "matcher": m, "condition": condition_of(datasets.get(ds), g),
+                    "cpu_ms_all": pd.to_numeric(g["cpu_s"], errors="coerce").to_numpy(float) * 1e3, **s})
+    return pd.DataFrame(out)
+
+
+def _order(matchers) -> list[str]:
+    ms = sorted(set(matchers) - {DEAD_RECKONING})
+    return ms + ([DEAD_RECKONING] if DEAD_RECKONING in set(matchers) else [])
+
+
+def condition_table(s: pd.DataFrame) -> str:
+    """The markdown table of one sequence set (rows of :func:`sequence_scores`)."""
+    rows = []
+    for m in _order(s["matcher"]):
+        g = s[s["matcher"] == m]
+        share, lo, hi = pooled_share(g["n_tracked"], g["n_truth"])
+        ci = "" if math.isnan(lo) else f" [{100 * lo:.1f}, {100 * hi:.1f}]"
+        n = g["n_truth"].to_numpy(float)
+        ape = math.sqrt(float((n * g["ape_rmse_m"].to_numpy(float) ** 2).sum() / n.sum())) if n.sum() else math.nan
+        cpu = np.concatenate(list(g["cpu_ms_all"])) if len(g) else np.array([])
+        cpu = cpu[np.isfinite(cpu)]
+        rows.append([m, f"{100 * share:.1f}{ci}", int(g["losses"].sum()), int(g["recoveries"].sum()),
+                     int(g["unrecovered"].sum()), num(g["longest_lost_m"].max(), 1), num(100 * ape, 1),
+                     num(100 * g["rpe_trans_m_per_m"].mean(), 2),
+                     "—" if m == DEAD_RECKONING or not cpu.size else num(float(np.median(cpu)), 2)])
+    return table(["matcher", "tracked % [95 % CI over sequences]", "losses", "recoveries",
+                  "unrecovered", "longest lost (m)", "APE RMSE (cm)", "RPE (cm/m)", "CPU ms/scan (median)"],
+                 rows)
+
+
+def tracking_tables(s: pd.DataFrame) -> str:
+    """One table per sequence set, each headed with its sequences, scans and metres."""
+    parts = []
+    for cond, g in s.groupby("condition", sort=True):
+        seqs = g.drop_duplicates("dataset")
+        parts.append(f"**{cond}** ({len(seqs)} sequence{'s' * (len(seqs) != 1)}: "
+                     f"{', '.join(seqs['dataset'])}; {int(seqs['n_truth'].sum())} scans, "
+                     f"{seqs['distance_m'].sum():.0f} m)\n\n" + condition_table(g))
+    return "\n".join(parts)
+
+
+def _safe(name: str) -> str:
+    return re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("_") or "x"
+
+
+def _poses(g: pd.DataFrame, prefix: str) -> np.ndarray:
+    return g[[f"{prefix}_x", f"{prefix}_y", f"{prefix}_theta"]].apply(pd.to_numeric, errors="coerce").to_numpy(float)
+
+
+def fig_trajectories(scenario: Scenario, the_map, rows: pd.DataFrame, path: Path) -> Path:
+    """One panel per matcher: the map, the true trajectory and the matcher's estimates (scans
+    lost, > 0.5 m off, in red)."""
+    ms = _order(rows["matcher"].unique())
+    mp, _ = the_map.sample_points(MAP_SPACING_M)
+    ncol = min(3, len(ms))
+    nrow = math.ceil(len(ms) / ncol)
+    fig = Figure(figsize=(5.2 * ncol, 4.2 * nrow), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(nrow, ncol)).ravel()
+    for ax, m in zip(axes, ms, strict=False):
+        g = rows[rows["matcher"] == m]
+        t, e = _poses(g, "true"), _poses(g, "est")
+        ax.scatter(mp[:, 0], mp[:, 1], s=0.2, c="black", rasterized=True)
+        ax.plot(t[:, 0], t[:, 1], "-", color="#2ca02c", lw=1.2, label="truth")
+        ax.plot(e[:, 0], e[:, 1], "-", color="#1f77b4", lw=0.8, label="estimate")
+        ok = np.isfinite(t).all(axis=1)
+        d = np.full(len(t), np.nan)
+        d[ok] = errors(e[ok], t[ok])[0]
+        lost = d > LOST_DIST_M
+        ax.plot(e[lost, 0], e[lost, 1], ".", color="#d62728", ms=2, label="lost (> 0.5 m)")
+        ax.set_title(m, fontsize=10)
+        ax.set_aspect("equal")
+        ax.tick_params(labelsize=7)
+    for ax in axes[len(ms):]:
+        ax.set_visible(False)
+    axes[0].legend(fontsize=7, loc="best")
+    fig.suptitle(f"{scenario.name}: trajectories on the map", fontsize=11)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=90)
+    return path
+
+
+def fig_error_distance(scenario: Scenario, rows: pd.DataFrame, path: Path) -> Path:
+    """Distance error (log scale) over the true distance travelled, one line per matcher."""
+    from .figures import colours
+
+    ms = _order(rows["matcher"].unique())
+    col = colours(ms)
+    fig = Figure(figsize=(8, 3.6), layout="constrained")
+    ax = fig.subplots()
+    for m in ms:
+        g = rows[rows["matcher"] == m]
+        t, e = _poses(g, "true"), _poses(g, "est")
+        ok = np.isfinite(t).all(axis=1)
+        if ok.sum() < 2:
+            continue
+        ax.plot(path_length(t[ok]), np.maximum(errors(e[ok], t[ok])[0], 1e-3), lw=0.8,
+                color=col[m], label=m)
+    ax.axhline(LOST_DIST_M, color="grey", ls="--", lw=0.8)
+    ax.set_yscale("log")
+    ax.set_xlabel("distance travelled (m)")
+    ax.set_ylabel("distance error (m)")
+    ax.set_title(f"{scenario.name}: error over distance travelled (dashed: lost)", fontsize=10)
+    ax.legend(fontsize=7, ncol=3)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=90)
+    return path
+
+
+def tracking_section(df: pd.DataFrame, datasets: dict[str, Scenario], maps: dict[str, object],
+                     out_dir: Path, thresholds: Thresholds = DEFAULT,
+                     figures: bool = True) -> str:
+    """The markdown of the tracking section (tables, then figures written under
+    ``out_dir/figures/tracking/``); ``maps``: dataset name → its map, for the figures."""
+    s = sequence_scores(df, datasets, thresholds)
+    text = ["## Tracking\n",
+            "Each sequence tracked scan by scan from the last estimate composed with the odometry "
+            "(no reset); truth only for scoring. tracked = within "
+            f"{100 * thresholds.dist_m:.0f} cm and {thresholds.orient_deg:g}°; a loss = the error "
+            "goes above 0.5 m or 10°; a recovery = back within the thresholds by itself; APE/RPE by "
+            "evo with no alignment (map frame); `odometry` = dead reckoning, the floor.\n",
+            tracking_tables(s)]
+    if figures:
+        fig_dir = Path(out_dir) / "figures" / "tracking"
+        for ds, g in df.groupby("dataset", sort=False):
+            sc = datasets.get(ds)
+            if sc is None or ds not in maps:
+                continue
+            a = fig_trajectories(sc, maps[ds], g, fig_dir / f"{_safe(ds)}-trajectories.png")
+            b = fig_error_distance(sc, g, fig_dir / f"{_safe(ds)}-error.png")
+            rel = lambda p: p.relative_to(out_dir).as_posix()  # noqa: E731
+            text.append(f"\n![{ds} trajectories]({rel(a)})\n\n![{ds} error over distance]({rel(b)})\n")
+    return "\n".join(text)
