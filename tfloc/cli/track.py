@@ -27,14 +27,13 @@ from tfloc.errors import ConfigError, ResultsError
 
 HELP = "track a sequence dataset with one matcher (guess = last estimate ⊕ odometry)"
 COLUMNS = ["scan_id", "est_x", "est_y", "est_theta", "status", "cpu_s"]
-DEAD_RECKONING = "odometry"
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--dataset", required=True, type=Path,
                    help="sequence dataset directory (scenario.json with \"mode\": \"sequence\" + scans.csv)")
     p.add_argument("--matcher", default="tf-plus",
-                   help=f"registered matcher name, or '{DEAD_RECKONING}' (default: tf-plus)")
+                   help="registered matcher name; 'odometry' is dead reckoning (default: tf-plus)")
     p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
                    help="a matcher parameter, VALUE in TOML syntax (repeatable)")
     p.add_argument("--out", type=Path, default=Path("est.csv"), help="output CSV (default: est.csv)")
@@ -44,9 +43,9 @@ def run(args: argparse.Namespace) -> int:
     from tfloc.cli.localize import parse_params
     from tfloc.harness.config import MatcherSpec
     from tfloc.harness.fingerprint import build_matcher
-    from tfloc.harness.task import load_matcher
     from tfloc.harness.threads import limit_threads
-    from tfloc.harness.track import check_sequence, dead_reckoning, track
+    from tfloc.harness.track import check_sequence, track
+    from tfloc.harness.workspace import load_matcher
     from tfloc.io.scenario import read_scans, read_scenario
 
     limit_threads(1)
@@ -56,18 +55,12 @@ def run(args: argparse.Namespace) -> int:
     params = parse_params(args.param)
     scans = read_scans(scenario)
     check_sequence(scenario, scans)
-    if args.matcher == DEAD_RECKONING:
-        if params:
-            raise ConfigError(f"--matcher {DEAD_RECKONING} takes no --param")
-        rows = dead_reckoning(scenario, scans)
-    else:
-        spec = MatcherSpec.make(args.matcher, params, where=f"--matcher {args.matcher}",
-                                keys={k: f"--param {k}" for k in params})
-        build_matcher(spec)
-        matcher = load_matcher(spec.name, spec.params_json)
-        with tqdm(total=len(scans), desc=args.matcher, unit="scan",
-                  disable=not sys.stderr.isatty()) as bar:
-            rows = track(scenario, scans, matcher, progress=lambda _k: bar.update(1))
+    spec = MatcherSpec.make(args.matcher, params, where=f"--matcher {args.matcher}",
+                            keys={k: f"--param {k}" for k in params})
+    build_matcher(spec)
+    matcher = load_matcher(spec.name, spec.params_json)
+    with tqdm(total=len(scans), desc=args.matcher, unit="scan", disable=not sys.stderr.isatty()) as bar:
+        rows = track(scenario, scans, matcher, progress=lambda _k: bar.update(1))
     write_track(args.out, rows)
     counts: dict[str, int] = {}
     for r in rows:

@@ -85,3 +85,22 @@ class LocalTracker:
 def as_tracker(obj: object) -> Tracker:
     """``obj`` itself if it is a tracker, else a :class:`LocalTracker` around the matcher."""
     return obj if is_tracker(obj) else LocalTracker(obj)
+
+
+class DeadReckoning:
+    """``odometry``: the prediction alone, the floor of every tracking table. Run along a
+    sequence (:class:`LocalTracker`) it composes the odometry from the start pose (dead
+    reckoning); on a single scan it answers its initial guess unchanged. It has no objective
+    (no ``score``) and takes no parameter."""
+
+    name = "odometry"
+
+    def __init__(self, **params) -> None:
+        if params:
+            from tfloc.errors import ParameterError
+
+            raise ParameterError(f"unknown parameter(s) {', '.join(sorted(params))}; known: (none)",
+                                 tuple(sorted(params)))
+
+    def localize(self, problem: Problem) -> Estimate:
+        return Estimate(problem.initial, True)

@@ -10,6 +10,7 @@ A run configuration file looks like::
     matchers = ["tf", "csm-corr", { label = "tf-S0.5", name = "tf", params = { spacing = 0.5 } }]
     jobs = 2                 # worker processes
     timeout_s = 60           # per (scan, matcher) task
+    sequence_timeout_s = 3600  # per (sequence, matcher) task of a sequence dataset
     limit_per_group = 0      # 0 = all scans; N = the first N scans of each group (smoke runs)
     [success]
     dist_m = 0.10
@@ -83,6 +84,7 @@ class RunConfig:
     jobs: int = 2
     timeout_s: float = 60.0
     limit_per_group: int = 0
+    sequence_timeout_s: float = 3600.0
     success: Thresholds = Thresholds()
     skip_per_group: tuple[tuple[str, int], ...] = ()
     extra: dict = field(default_factory=dict, compare=False)
@@ -100,7 +102,7 @@ class RunConfig:
         labels = [m.label for m in self.matchers]
         if len(set(labels)) != len(labels):
             raise ConfigError(f"run {self.name!r}: duplicate matcher labels {labels}")
-        if self.jobs < 1 or self.timeout_s <= 0 or self.limit_per_group < 0 or any(
+        if self.jobs < 1 or self.timeout_s <= 0 or self.sequence_timeout_s <= 0 or self.limit_per_group < 0 or any(
                 n < 0 for _, n in self.skip_per_group):
             raise ConfigError(f"run {self.name!r}: jobs ≥ 1, timeout_s > 0 and limit_per_group ≥ 0 required")
 
@@ -111,6 +113,7 @@ class RunConfig:
         return {"name": self.name, "out": str(self.out), "datasets": [str(d) for d in self.datasets],
                 "matchers": [{"label": m.label, "name": m.name, "params": m.params} for m in self.matchers],
                 "jobs": self.jobs, "timeout_s": self.timeout_s, "limit_per_group": self.limit_per_group,
+                **({"sequence_timeout_s": self.sequence_timeout_s} if self.sequence_timeout_s != 3600.0 else {}),
                 **({"skip_per_group": dict(self.skip_per_group)} if self.skip_per_group else {}),
                 "success": self.success.to_dict(), **self.extra}
 
@@ -218,7 +221,7 @@ def load_config(path: str | Path) -> RunConfig:
     path = Path(path)
     doc = parse_text(path, ConfigError, "run configuration", tomllib.loads, tomllib.TOMLDecodeError, "TOML")
     known = {"name", "out", "datasets", "matchers", "jobs", "timeout_s", "limit_per_group",
-             "success", "params", "description", "sweep"}
+             "success", "params", "description", "sweep", "sequence_timeout_s"}
     unknown = sorted(set(doc) - known)
     if unknown:
         raise ConfigError(f"{path}: unknown key(s) {', '.join(unknown)}")
@@ -237,6 +240,7 @@ def load_config(path: str | Path) -> RunConfig:
             matchers=parse_matchers(doc["matchers"], doc.get("params", {}), str(path))
             + expand_sweeps(doc.get("sweep", []), doc.get("params", {}), str(path)),
             jobs=int(doc.get("jobs", 2)), timeout_s=float(doc.get("timeout_s", 60.0)),
+            sequence_timeout_s=float(doc.get("sequence_timeout_s", 3600.0)),
             limit_per_group=int(doc.get("limit_per_group", 0)),
             success=Thresholds.from_dict(success),
             extra={k: doc[k] for k in ("description",) if k in doc})

@@ -49,8 +49,10 @@ class TaskPool(WorkerPlugin):
             self.pool.join(timeout=10)
             self.pool = None
 
-    def run(self, task: Task, timeout_s: float) -> dict[str, Any]:
-        """Warm up (untimed, once per dataset and matcher), then run ``task`` within ``timeout_s``."""
+    def run(self, task: Task, timeout_s: float) -> dict[str, Any] | list[dict[str, Any]]:
+        """Warm up (untimed, once per dataset and matcher), then run ``task`` within its own time
+        limit, else ``timeout_s``."""
+        timeout_s = task.timeout_s or timeout_s
         if self.pool is None:
             raise RuntimeError("this Dask worker is a daemonic process and cannot start tfloc's "
                                "task processes; start it with DASK_DISTRIBUTED__WORKER__DAEMON=False")
@@ -58,20 +60,22 @@ class TaskPool(WorkerPlugin):
         with self.lock:
             cold = key not in self.warm
             self.warm.add(key)
-        if cold:  # load data and compile kernels outside the timed, time-limited task
+        if cold and not task.sequence:  # load data, compile kernels outside the timed, time-limited task
             try:
                 self.pool.schedule(warm_up, args=(task,), timeout=max(60.0, timeout_s)).result()
             except Exception:  # noqa: BLE001 - the task itself will report the failure
                 pass
         row = collect(self.pool.schedule(run_task, args=(task,), timeout=timeout_s), task)
-        if row.get("status") == "timeout" or str(row.get("status")).startswith("error:worker died"):
+        last = row[-1] if isinstance(row, list) else row
+        if last.get("status") == "timeout" or str(last.get("status")).startswith("error:worker died"):
             with self.lock:  # its process was replaced: the next tasks warm up again
                 self.warm.clear()
         return row
 
 
-def run_on_worker(task: Task, timeout_s: float) -> dict[str, Any]:
-    """The Dask task: one (scan, matcher) pair, run in this worker's :class:`TaskPool`."""
+def run_on_worker(task: Task, timeout_s: float) -> dict[str, Any] | list[dict[str, Any]]:
+    """The Dask task: one (scan, matcher) pair or one (sequence, matcher), run in this worker's
+    :class:`TaskPool`."""
     return get_worker().plugins[PLUGIN_NAME].run(task, timeout_s)
 
 

@@ -28,35 +28,59 @@ from pathlib import Path
 from pebble import ProcessExpired, ProcessPool
 from tqdm import tqdm
 
+from tfloc.core.tracker import is_tracker
 from tfloc.errors import ConfigError, ResultsError
 from tfloc.io.estimates import ResultWriter, done_keys, drop_rows
 from tfloc.io.rundir import RunDir
-from tfloc.io.scenario import iter_scans, read_scenario
+from tfloc.io.scenario import SEQUENCE, iter_scans, read_scans, read_scenario
 
 from .config import RunConfig
 from .fingerprint import available, build_matchers, differences, fingerprint
 from .task import Task, failure_row, run_task, warm_up
 from .threads import limit_threads
+from .workspace import load_matcher
 
 PACKAGES = ("tfloc", "numpy", "scipy", "shapely", "numba", "pandas", "open3d", "kiss-icp",
             "opencv-python-headless", "small-gicp", "karto-scanmatcher", "pebble", "matplotlib")
 
 
-def make_tasks(config: RunConfig) -> list[Task]:
-    """Every (dataset, scan, matcher) task of a run, in dataset/scan order (validates datasets)."""
+def make_tasks(config: RunConfig, log: Callable[[str], None] | None = None) -> list[Task]:
+    """Every task of a run, in dataset/scan order (validates datasets): one per (scan, matcher),
+    and one per (sequence, matcher) on a sequence dataset. A tracker (no single-scan mode, e.g.
+    ``amcl``) is left out of the other datasets with one line to ``log``."""
     tasks = []
     for d in config.datasets:
         scenario = read_scenario(d)
+        if scenario.mode == SEQUENCE:
+            scans = read_scans(scenario)
+            tasks += [Task(str(d), scenario.name, scans[-1].scan_id, m.label, m.name, m.params_json,
+                           config.success, sequence=True, timeout_s=config.sequence_timeout_s)
+                      for m in config.matchers]
+            continue
+        single = [m for m in config.matchers if not tracker_only(m)]
+        if log is not None and len(single) < len(config.matchers):
+            log(f"dataset {scenario.name}: " + ", ".join(m.label for m in config.matchers if m not in single)
+                + " left out: a tracker has no single-scan mode (it runs on sequence datasets only)")
         per_group: dict[str, int] = {}
         skip = config.skip(d)
         for scan in iter_scans(scenario):
             n = per_group[scan.group] = per_group.get(scan.group, 0) + 1
             if n <= skip or (config.limit_per_group and n - skip > config.limit_per_group):
                 continue
-            for m in config.matchers:
+            for m in single:
                 tasks.append(Task(str(d), scenario.name, scan.scan_id, m.label, m.name, m.params_json,
                                   config.success))
     return tasks
+
+
+def tracker_only(spec) -> bool:
+    """Whether the matcher of ``spec`` is a tracker with no single-scan mode (``start``/``step``,
+    no ``localize``)."""
+    try:
+        m = load_matcher(spec.name, spec.params_json)
+    except Exception:  # noqa: BLE001 - build_matchers reports it
+        return False
+    return is_tracker(m) and not callable(getattr(m, "localize", None))
 
 
 def _init_worker() -> None:
@@ -100,20 +124,22 @@ def session_doc(config: RunConfig, fp: dict | None) -> dict:
 
 
 def execute_local(tasks: list[Task], jobs: int, timeout_s: float,
-                  on_row: Callable[[dict], None]) -> None:
-    """Run ``tasks`` on a local process pool; every task ends in exactly one ``on_row`` call."""
+                  on_row: Callable[[dict | list[dict]], None]) -> None:
+    """Run ``tasks`` on a local process pool; every task ends in exactly one ``on_row`` call (a
+    sequence task's with its list of rows)."""
     ctx = multiprocessing.get_context("spawn")
     with ProcessPool(max_workers=jobs, context=ctx, initializer=_init_worker) as pool:
         try:
             warm = {}
             for t in tasks:  # compile kernels and load data outside the timed, time-limited tasks
-                warm.setdefault((t.dataset, t.matcher, t.params_json), t)
+                if not t.sequence:  # (a sequence task warms itself up, untimed)
+                    warm.setdefault((t.dataset, t.matcher, t.params_json), t)
             for f in [pool.schedule(warm_up, args=(t,), timeout=timeout_s) for t in warm.values()]:
                 try:
                     f.result()
                 except Exception:  # noqa: BLE001 - the task itself will report the failure
                     pass
-            futures = {pool.schedule(run_task, args=(t,), timeout=timeout_s): t for t in tasks}
+            futures = {pool.schedule(run_task, args=(t,), timeout=t.timeout_s or timeout_s): t for t in tasks}
             for fut in as_completed(futures):
                 on_row(collect(fut, futures[fut]))
         except BaseException:  # a failed write, Ctrl-C: stop the workers, do not run the rest
@@ -121,8 +147,8 @@ def execute_local(tasks: list[Task], jobs: int, timeout_s: float,
             raise
 
 
-def collect(fut, task: Task) -> dict:
-    """The row of a pebble future of ``run_task(task)``: its result, or a timeout/error row."""
+def collect(fut, task: Task) -> dict | list[dict]:
+    """The row(s) of a pebble future of ``run_task(task)``: its result, or a timeout/error row."""
     try:
         return fut.result()
     except (TimeoutError, FutureTimeout):
@@ -133,7 +159,22 @@ def collect(fut, task: Task) -> dict:
         return failure_row(task, f"error:{type(exc).__name__}: {exc}")
 
 
-Executor = Callable[[list[Task], int, float, Callable[[dict], None]], None]
+Executor = Callable[[list[Task], int, float, Callable[[dict | list[dict]], None]], None]
+
+
+def _sequence_pairs(tasks: list[Task]) -> set[tuple[str, str]]:
+    return {(t.dataset_name, t.label) for t in tasks if t.sequence}
+
+
+def _drop_cut_sequences(rd: RunDir, tasks: list[Task], done: set) -> set:
+    """A sequence task writes its rows one by one and its last row last: rows of a sequence
+    whose last row is missing were cut off by a kill. They are dropped (the file is rewritten
+    atomically) and the sequence runs again; returns the keys that remain."""
+    finished = {(t.dataset_name, t.label) for t in tasks if t.sequence and t.key in done}
+    cut = {k for k in done if (k[0], k[2]) in _sequence_pairs(tasks) - finished}
+    if cut:
+        drop_rows(rd.estimates, done - cut)
+    return done - cut
 
 
 def run(config: RunConfig, progress: bool | None = None, executor: Executor = execute_local,
@@ -149,10 +190,11 @@ def run(config: RunConfig, progress: bool | None = None, executor: Executor = ex
     interruptions. With ``retry_errors``, rows whose status is ``error:…`` or ``timeout`` are
     removed (the file is rewritten atomically) and their tasks run again.
     """
-    config = available(config, log=lambda line: print(line, file=sys.stderr))
+    log = lambda line: print(line, file=sys.stderr)  # noqa: E731
+    config = available(config, log=log)
     rd = RunDir(Path(config.out))
     fp = fingerprint(config, build_matchers(config))
-    tasks = make_tasks(config)
+    tasks = make_tasks(config, log)
     try:
         done = done_keys(rd.estimates) if rd.path.is_dir() else set()
     except ResultsError:  # damaged, or written by another version: only --regenerate goes on
@@ -169,14 +211,17 @@ def run(config: RunConfig, progress: bool | None = None, executor: Executor = ex
         if diff:
             rd.discard()
             done = set()
+    done = _drop_cut_sequences(rd, tasks, done)
     todo = [t for t in tasks if t.key not in done]
     if regenerate and not todo and tasks:
         rd.discard()
         todo = tasks
     elif retry_errors and done:
-        keep = done_keys(rd.estimates, redo=("error", "timeout"))
-        retry = {t.key for t in tasks if t.key in done and t.key not in keep}
-        drop_rows(rd.estimates, done - retry)
+        bad = done - done_keys(rd.estimates, redo=("error", "timeout"))
+        pairs = {(k[0], k[2]) for k in bad}
+        retry = {t.key for t in tasks if t.key in done and (t.key in bad or t.sequence and t.key[::2] in pairs)}
+        drop = {k for k in done if k in retry or (k[0], k[2]) in pairs & _sequence_pairs(tasks)}
+        drop_rows(rd.estimates, done - drop)
         todo = [t for t in tasks if t.key not in done or t.key in retry]
     rd.make()
     rd.start_session(session_doc(config, fp), len(tasks), len(tasks) - len(todo), load_average())
@@ -186,10 +231,11 @@ def run(config: RunConfig, progress: bool | None = None, executor: Executor = ex
                disable=None if progress is None else not progress, smoothing=0.05, mininterval=1.0)
     failures = 0
     with ResultWriter(rd.estimates) as writer:
-        def on_row(row: dict) -> None:
+        def on_row(rows: dict | list[dict]) -> None:
             nonlocal failures
-            writer.write(row)
-            failures += str(row.get("status", "ok")).startswith(("error", "timeout"))
+            for row in rows if isinstance(rows, list) else [rows]:  # a sequence's last row last
+                writer.write(row)
+                failures += str(row.get("status", "ok")).startswith(("error", "timeout"))
             bar.update(1)
             if failures:
                 bar.set_postfix(errors=failures, refresh=False)

@@ -47,9 +47,12 @@ class Task:
     matcher: str          # registered matcher name (or "module:Class")
     params_json: str = "{}"
     thresholds: Thresholds = Thresholds()
+    sequence: bool = False  # a whole sequence (scan_id: its last scan), tracked: harness/track.py
+    timeout_s: float = 0.0  # this task's time limit (0: the run's per-task limit)
 
     @property
     def key(self) -> tuple[str, str, str]:
+        """The key of the task's (last) row: a sequence task is done when its last row is written."""
         return (self.dataset_name, self.scan_id, self.label)
 
 
@@ -108,9 +111,12 @@ def _posed(task: Task):
     return scenario, scan, matcher, problem
 
 
-def run_task(task: Task) -> dict[str, Any]:
+def run_task(task: Task) -> dict[str, Any] | list[dict[str, Any]]:
     """Run one task; exceptions from the matcher become an ``error:`` row (never raised), a
-    problem the data cannot pose (:class:`InvalidProblemError`) an ``invalid:`` row."""
+    problem the data cannot pose (:class:`InvalidProblemError`) an ``invalid:`` row. A sequence
+    task gives one row per scan (:func:`run_sequence_task`)."""
+    if task.sequence:
+        return run_sequence_task(task)
     scan = load_dataset(task.dataset)[1][task.scan_id]
     try:
         scenario, scan, matcher, problem = _posed(task)
@@ -161,3 +167,25 @@ def warm_up(task: Task) -> None:
         matcher.localize(problem)
     except Exception:  # noqa: BLE001 - the real run will report it
         pass
+
+
+def run_sequence_task(task: Task) -> list[dict[str, Any]]:
+    """A whole sequence tracked (:func:`tfloc.harness.track.run_sequence`): one row per scan in
+    order; each row with truth gets its errors and outcome by the one rule (a tracking loop has
+    no objective to score a failure with: such a failure is ``unscored``). A matcher that cannot
+    be built is one ``error:`` row for the task."""
+    from .track import run_sequence
+
+    try:
+        rows = run_sequence(task.dataset, task.label, task.matcher, task.params_json)
+    except Exception as exc:  # noqa: BLE001 - a failing matcher is a result, not a crash
+        return [failure_row(task, f"error:{type(exc).__name__}: {exc}")]
+    for r in rows:
+        if r["true_x"] == "" or r["init_x"] == "":
+            continue
+        true, pred, est = (Pose(r[f"{k}_x"], r[f"{k}_y"], r[f"{k}_theta"]) for k in ("true", "init", "est"))
+        d, o = est.distance_to(true), abs(angdiff(est.theta, true.theta))
+        r.update(dist_err_m=d, orient_err_rad=o, init_dist_err_m=pred.distance_to(true),
+                 init_orient_err_rad=abs(angdiff(pred.theta, true.theta)),
+                 outcome=outcome(r["status"] == "ok", d, o, np.nan, np.nan, task.thresholds))
+    return rows

@@ -25,15 +25,13 @@ from typing import Any
 
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
-from tfloc.core.tracker import PREDICTED, LocalTracker, as_tracker, is_tracker
+from tfloc.core.tracker import PREDICTED, DeadReckoning, LocalTracker, as_tracker, is_tracker
 from tfloc.errors import DatasetError, InvalidProblemError
 from tfloc.io.estimates import COLUMNS
 from tfloc.io.scenario import SEQUENCE, Scan, Scenario, map_for
 
 #: status of a row whose estimate is the matcher's own answer / the prediction kept
 OK, FAILED = "ok", "failed"
-#: the matcher name of dead reckoning (the prediction alone), the floor of every tracking table
-DEAD_RECKONING = "odometry"
 
 
 def check_sequence(scenario: Scenario, scans: Sequence[Scan]) -> None:
@@ -81,7 +79,7 @@ def row(dataset: str, label: str, scan: Scan, pred: Pose, est: Pose, status: str
                **_pose_fields("true", scan.true), **_pose_fields("init", pred),
                **_pose_fields("est", est), runtime_s=wall_s, cpu_s=cpu_s, status=status)
     if estimate is not None:
-        out.update(converged=estimate.converged, iterations=estimate.iterations,
+        out.update(converged=int(bool(estimate.converged)), iterations=estimate.iterations,
                    evaluations=estimate.evaluations)
     out["info"] = json.dumps(info or {}, default=str, sort_keys=True)
     return out
@@ -137,31 +135,21 @@ def track(scenario: Scenario, scans: Sequence[Scan], matcher, *, label: str | No
     return rows
 
 
-def dead_reckoning(scenario: Scenario, scans: Sequence[Scan], *, label: str = DEAD_RECKONING,
+def dead_reckoning(scenario: Scenario, scans: Sequence[Scan], *, label: str = DeadReckoning.name,
                    dataset: str | None = None) -> list[dict[str, Any]]:
     """The floor every table shows: the prediction alone (the odometry composed from the start
-    pose), as rows of a matcher named ``odometry`` (status ``ok``, CPU time 0)."""
-    check_sequence(scenario, scans)
-    dataset = dataset or scenario.name
-    rows, last = [], scans[0].initial
-    for scan, delta in zip(scans, odom_deltas(scans), strict=True):
-        pred = last.compose(delta)
-        rows.append(row(dataset, label, scan, pred, pred, OK, 0.0, 0.0))
-        last = pred
-    return rows
+    pose): :func:`track` with the registered matcher ``odometry``
+    (:class:`~tfloc.core.tracker.DeadReckoning`)."""
+    return track(scenario, scans, DeadReckoning(), label=label, dataset=dataset)
 
 
 def run_sequence(dataset: str, label: str, matcher: str, params_json: str = "{}") -> list[dict[str, Any]]:
-    """One sequence task of a run, as a worker executes it: load the dataset ``dataset`` (a
-    directory), build the registered ``matcher`` with ``params_json`` (``odometry``: dead
-    reckoning) and track the whole sequence; the rows carry ``label`` as their matcher. Dataset
-    errors raise :class:`DatasetError`; a matcher that raises on a scan is that scan's
-    ``error:`` row, the run goes on."""
-    from tfloc.core.matcher import get_matcher
-    from tfloc.io.scenario import read_scans, read_scenario
+    """One sequence task of a run, as a worker executes it: the dataset ``dataset`` (a directory)
+    and the matcher ``matcher`` with ``params_json`` from the worker's workspace, the whole
+    sequence tracked; the rows carry ``label`` as their matcher. Dataset errors raise
+    :class:`DatasetError`; a matcher that raises on a scan is that scan's ``error:`` row, the
+    run goes on."""
+    from .workspace import load_dataset, load_matcher
 
-    scenario = read_scenario(dataset)
-    scans = read_scans(scenario)
-    if matcher == DEAD_RECKONING:
-        return dead_reckoning(scenario, scans, label=label)
-    return track(scenario, scans, get_matcher(matcher, **json.loads(params_json)), label=label)
+    scenario, by_id = load_dataset(dataset)
+    return track(scenario, list(by_id.values()), load_matcher(matcher, params_json), label=label)

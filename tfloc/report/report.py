@@ -27,9 +27,10 @@ from tfloc.evaluation.summary import (
     summary_table,
     write_summary,
 )
+from tfloc.harness.workspace import load_dataset
 from tfloc.io.estimates import status_kind
 from tfloc.io.rundir import RunDir, RunInfo
-from tfloc.io.scenario import SCAN_TO_SCAN
+from tfloc.io.scenario import SCAN_TO_SCAN, SEQUENCE
 
 from . import figures as F
 from . import sections as S
@@ -278,14 +279,36 @@ def line_figure_matchers(p: pd.DataFrame, order: list[str], most: int = 8) -> li
     return [order[0], *best]
 
 
+def _tracking(run_dir: Path, df: pd.DataFrame, info: RunInfo, thr: Thresholds, with_figures: bool) -> str:
+    """The tracking section of a run's sequence datasets (:mod:`tfloc.report.tracking`); their
+    scores per (sequence, matcher) go to ``tracking.csv``."""
+    from tfloc.io.maps import load_map
+
+    from .tracking import sequence_scores, tracking_section
+
+    scenarios = {n: load_dataset(str(d))[0] for n, d in info.datasets.items() if n in set(df["dataset"])}
+    maps = {n: load_map(sc.map_path) for n, sc in scenarios.items()} if with_figures else {}
+    sequence_scores(df, scenarios, thr).drop(columns="cpu_ms_all").to_csv(
+        run_dir / "tracking.csv", index=False, float_format="%.6g")
+    return tracking_section(df, scenarios, maps, run_dir, thr, figures=with_figures)
+
+
 def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
                  with_figures: bool = True) -> ReportFiles:
-    """Write report.md, summary.csv and figures/*.png into ``run_dir``; returns their paths."""
+    """Write report.md, summary.csv and figures/*.png into ``run_dir``; returns their paths.
+    Sequence datasets get the tracking section; the other sections cover the other datasets."""
     run_dir = Path(run_dir)
     df, info = load_run(run_dir)
     run = info.doc
     thr = thresholds or info.thresholds
-    p = prepare(df, thr)
+    seq = info.datasets_in(list(df["dataset"].unique()), SEQUENCE)
+    tracking = _tracking(run_dir, df[df["dataset"].isin(seq)], info, thr, with_figures) if seq else ""
+    if seq and df["dataset"].isin(seq).all():
+        p = prepare(df, thr)
+        report = run_dir / "report.md"
+        report.write_text("\n".join([header(run_dir, run, p, thr, set()), tracking]))
+        return ReportFiles(report, run_dir / "tracking.csv", ())
+    p = prepare(df[~df["dataset"].isin(seq)], thr)
     s2s = info.datasets_in(list(p["dataset"].unique()), SCAN_TO_SCAN)
     summary = write_summary(summary_table(p, s2s), run_dir / "summary.csv")
     order = label_order(run, p)
@@ -307,6 +330,6 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
         failures = failures_section(draw_failures(run_dir, drawn, info.datasets))
         landscape = landscape_section(*draw_landscapes(run_dir, p, info.datasets))
     report = run_dir / "report.md"
-    report.write_text(render(run_dir, run, p, thr, s2s, figs, pt, failures, landscape, line_labels, sweep))
+    text = render(run_dir, run, p, thr, s2s, figs, pt, failures, landscape, line_labels, sweep)
+    report.write_text(text + ("\n" + tracking if tracking else ""))
     return ReportFiles(report, summary, tuple(figs))
-

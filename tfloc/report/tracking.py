@@ -23,13 +23,14 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
+from tfloc.core.tracker import DeadReckoning
 from tfloc.evaluation.outcome import Thresholds
 from tfloc.evaluation.trajectory import LOST_DIST_M, errors, path_length, pooled_share, score_rows
 from tfloc.io.scenario import Scenario
 
 from .mdtable import num, table
 
-DEAD_RECKONING = "odometry"
+DEAD_RECKONING = DeadReckoning.name  # the floor, shown last
 MAP_SPACING_M = 0.05
 DEFAULT = Thresholds()
 
