@@ -42,3 +42,18 @@ def test_no_accuracy_regression(config, reference):
     diff = guard.compare(current, reference)
     assert len(diff) == len(reference) * len(guard.RULES)
     assert not diff.worse.any(), "accuracy regression:\n" + guard.format_table(diff)
+
+
+def test_no_tracking_regression(tmp_path_factory):
+    """The tracking guard: seq-quick's tracked share, APE RMSE and unrecovered losses per matcher."""
+    os.chdir(ROOT)
+    cfg = load_config(ROOT / guard.TRACKING_CONFIG)
+    cfg = cfg.with_overrides(out=tmp_path_factory.mktemp("guard-tracking") / "run")
+    reference = guard.read_reference(ROOT / guard.TRACKING_REFERENCE)
+    assert {m.label for m in cfg.matchers} <= set(reference.matcher)
+    current = run_subset(cfg, progress=False, summarise=guard.tracking_summary)
+    diff = guard.compare(current, reference, guard.TRACK_RULES)
+    assert len(diff) == len(reference) * len(guard.TRACK_RULES)
+    assert not diff.worse.any(), "tracking regression:\n" + guard.format_table(diff)
+    worse = reference.assign(tracked_pct=reference.tracked_pct + 2.0)  # a reference 2 scans better
+    assert guard.compare(current, worse, guard.TRACK_RULES).worse.any()  # the guard bites

@@ -29,10 +29,15 @@ HELP = "accuracy regression guard: rerun a fixed subset and compare with the ref
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    from tfloc.evaluation.guard import CONFIG, REFERENCE
+    from tfloc.evaluation.guard import CONFIG, REFERENCE, TRACKING_CONFIG, TRACKING_REFERENCE
 
     p.add_argument("--config", type=Path, default=CONFIG, help=f"subset run configuration ({CONFIG})")
     p.add_argument("--reference", type=Path, default=REFERENCE, help=f"reference metrics ({REFERENCE})")
+    p.add_argument("--tracking-config", type=Path, default=TRACKING_CONFIG,
+                   help=f"the tracking guard's sequence run ({TRACKING_CONFIG})")
+    p.add_argument("--tracking-reference", type=Path, default=TRACKING_REFERENCE,
+                   help=f"the tracking guard's reference ({TRACKING_REFERENCE})")
+    p.add_argument("--no-tracking", action="store_true", help="only the single-scan guard")
     p.add_argument("--update", action="store_true", help="rewrite the reference with this run's metrics")
     p.add_argument("--matchers", help="only these matchers (comma-separated)")
     p.add_argument("--jobs", type=int, help="worker processes (default from the config)")
@@ -41,43 +46,62 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from tfloc.evaluation import guard
+
+    parts = [(args.config, args.reference, guard.guard_summary, guard.RULES)]
+    if not args.no_tracking and args.tracking_config.exists():
+        parts.append((args.tracking_config, args.tracking_reference, guard.tracking_summary, guard.TRACK_RULES))
+    worse = 0
+    for config, reference, summarise, rules in parts:
+        status = _one(args, config, reference, summarise, rules)
+        if status is None:
+            continue
+        worse += status
+    return 1 if worse else 0
+
+
+def _one(args: argparse.Namespace, config: Path, reference: Path, summarise, rules) -> int | None:
+    """One guard (a subset and its reference): None after ``--update``, else the number of
+    metrics worse than the reference allows."""
     import pandas as pd
 
     from tfloc.evaluation import guard
     from tfloc.harness.config import load_config, parse_matchers
 
-    cfg = load_config(args.config)
+    cfg = load_config(config)
     if args.matchers:
         cfg = cfg.with_overrides(matchers=parse_matchers(args.matchers.split(","), {}, "--matchers"))
     cfg = cfg.with_overrides(jobs=args.jobs)
-    current = run_subset(cfg, fresh=not args.resume)
+    current = run_subset(cfg, fresh=not args.resume, summarise=summarise)
     if args.update:
-        old = guard.read_reference(args.reference) if args.reference.exists() else current.iloc[:0]
-        if args.matchers and args.reference.exists():  # keep the other matchers' reference rows
+        old = guard.read_reference(reference) if reference.exists() else current.iloc[:0]
+        if args.matchers and reference.exists():  # keep the other matchers' reference rows
             keep = old[~old.matcher.isin(current.matcher.unique())]
             current = pd.concat([keep, current]).sort_values(list(guard.KEY), ignore_index=True)
-        guard.write_reference(current, args.reference)
-        print(f"updated {args.reference}:\n{guard.format_changes(old, current)}")
-        return 0
-    if not args.reference.exists():
-        raise ConfigError(f"{args.reference}: no reference yet; create it with 'tfloc guard --update'")
-    diff = guard.compare(current, guard.read_reference(args.reference))
+        guard.write_reference(current, reference)
+        print(f"updated {reference}:\n{guard.format_changes(old, current)}")
+        return None
+    if not reference.exists():
+        raise ConfigError(f"{reference}: no reference yet; create it with 'tfloc guard --update'")
+    diff = guard.compare(current, guard.read_reference(reference), rules)
     print(guard.format_table(diff, only_worse=not args.all))
     n = int(diff.worse.sum())
     if n:
-        print(f"\n{n} metric(s) worse than the reference allows", file=sys.stderr)
-        return 1
-    print(f"\nall {len(diff)} guarded metrics within tolerance", file=sys.stderr)
-    return 0
+        print(f"\n{config}: {n} metric(s) worse than the reference allows", file=sys.stderr)
+    else:
+        print(f"\n{config}: all {len(diff)} guarded metrics within tolerance", file=sys.stderr)
+    return n
 
 
-def run_subset(config: RunConfig, fresh: bool = True, progress: bool | None = None) -> pd.DataFrame:
-    """Run the guard's subset (from scratch unless ``fresh`` is False) and summarise it."""
+def run_subset(config: RunConfig, fresh: bool = True, progress: bool | None = None,
+               summarise=None) -> pd.DataFrame:
+    """Run the guard's subset (from scratch unless ``fresh`` is False) and summarise it
+    (``summarise``: :func:`tfloc.evaluation.guard.guard_summary` by default)."""
     from tfloc.evaluation.guard import guard_summary
     from tfloc.harness.runner import run as run_benchmark
-    from tfloc.io.estimates import read_estimates
+    from tfloc.io.rundir import RunDir
 
     if fresh and Path(config.out).exists():
         shutil.rmtree(config.out)
     out = run_benchmark(config, progress=progress)
-    return guard_summary(read_estimates(out), config.success)
+    return (summarise or guard_summary)(RunDir(out).results(), config.success)

@@ -7,6 +7,11 @@ Compared per matcher and per group (the nine distance × angle cells, and ``all`
   most 2 % of the reference plus 0.05 cm / 0.005°;
 * local-optimum, ambiguous and no-answer counts, lower is better: may grow by at most 1.
 
+The tracking guard (``benchmarks/regression-tracking.toml``, reference
+``results/reference/tracking.csv``) compares, per matcher and sequence, the share of scans
+tracked (may drop by one scan), the APE translation RMSE (may grow by 2 % + 0.05 cm) and the
+unrecovered losses (may not grow), scored by :mod:`tfloc.evaluation.trajectory`.
+
 Why these tolerances: every bundled matcher is deterministic (fixed seeds, no threads in the
 numerics that affect results), and two runs on this machine gave identical summaries, so the
 run-to-run spread is 0. The margins only absorb floating-point differences on another CPU (a
@@ -27,6 +32,8 @@ from .outcome import Thresholds
 
 CONFIG = Path("benchmarks/regression.toml")
 REFERENCE = Path("results/reference/summary.csv")
+TRACKING_CONFIG = Path("benchmarks/regression-tracking.toml")
+TRACKING_REFERENCE = Path("results/reference/tracking.csv")
 KEY = ("matcher", "group")
 
 
@@ -53,6 +60,9 @@ RULES = (
     Rule("n_local_optimum", -1, abs=1), Rule("n_ambiguous", -1, abs=1), Rule("n_no_answer", -1, abs=1),
 )
 GUARDED = ["n", *(r.metric for r in RULES)]
+TRACK_RULES = (Rule("tracked_pct", +1, per_scan=True), Rule("ape_rmse_cm", -1, rel=0.02, abs=0.05),
+               Rule("unrecovered", -1))
+TRACK_GUARDED = ["n", *(r.metric for r in TRACK_RULES)]
 
 
 def guard_summary(estimates: pd.DataFrame, thresholds: Thresholds) -> pd.DataFrame:
@@ -64,7 +74,19 @@ def guard_summary(estimates: pd.DataFrame, thresholds: Thresholds) -> pd.DataFra
     return out.sort_values(list(KEY), ignore_index=True)
 
 
-def compare(current: pd.DataFrame, reference: pd.DataFrame) -> pd.DataFrame:
+def tracking_summary(estimates: pd.DataFrame, thresholds: Thresholds) -> pd.DataFrame:
+    """The guarded tracking metrics per matcher and sequence (``group`` = the dataset)."""
+    from .trajectory import score_rows
+
+    rows = []
+    for (ds, m), g in estimates.groupby(["dataset", "matcher"], sort=True):
+        sc = score_rows(g, thresholds)
+        rows.append({"matcher": m, "group": ds, "n": sc.n_truth, "tracked_pct": 100.0 * sc.tracked,
+                     "ape_rmse_cm": 100.0 * sc.ape_rmse_m, "unrecovered": sc.unrecovered})
+    return pd.DataFrame(rows, columns=[*KEY, *TRACK_GUARDED]).sort_values(list(KEY), ignore_index=True)
+
+
+def compare(current: pd.DataFrame, reference: pd.DataFrame, rules: tuple[Rule, ...] = RULES) -> pd.DataFrame:
     """One row per (matcher, group, metric) with reference, current, allowed and ``worse``.
 
     A (matcher, group) in the reference but missing from the current run counts as worse.
@@ -77,7 +99,7 @@ def compare(current: pd.DataFrame, reference: pd.DataFrame) -> pd.DataFrame:
         if key[0] not in set(cur.index.get_level_values(0)):
             continue
         c = cur.loc[key] if key in cur.index else None
-        for rule in RULES:
+        for rule in rules:
             rv = float(r[rule.metric])
             cv = np.nan if c is None else float(c[rule.metric])
             allowed = rule.allowed(rv, int(r["n"]))
@@ -110,7 +132,7 @@ def format_changes(old: pd.DataFrame, new: pd.DataFrame) -> str:
         if r["_merge"] != "both":
             lines.append(f"{r.matcher:12s} {r.group:6s} {'added' if r['_merge'] == 'right_only' else 'removed'}")
             continue
-        for k in GUARDED:
+        for k in (c for c in GUARDED + TRACK_GUARDED if f"{c}_old" in m):
             a, b = r[f"{k}_old"], r[f"{k}_new"]
             if not (np.isclose(a, b, equal_nan=True)):
                 lines.append(f"{r.matcher:12s} {r.group:6s} {k:18s} {a:10.3f} -> {b:10.3f}")
