@@ -23,6 +23,8 @@ quick: $(STAMP)
 	$(BIN)/tfloc bench benchmarks/paper-protocol.toml --quick --jobs $(JOBS) --regenerate
 	$(BIN)/tfloc timing results/paper-protocol-quick --per-stratum 1
 	$(BIN)/tfloc report results/paper-protocol-quick
+	$(BIN)/tfloc bench benchmarks/sequences-quick.toml --jobs $(JOBS) --regenerate
+	$(BIN)/tfloc report results/sequences-quick
 
 ## The main job: every registered matcher on the bundled scenarios, a side-by-side timing pass
 ## of each run (timing.md), and the reports; then the reading study of the paper's method and the
@@ -44,6 +46,8 @@ bench: $(STAMP)
 	$(BIN)/tfloc report results/tf-readings-heldout
 	$(BIN)/tfloc bench benchmarks/tfplus-ablation.toml --jobs $(JOBS) --regenerate
 	$(BIN)/tfloc report results/tf-plus-ablation
+	$(BIN)/tfloc bench benchmarks/sequences.toml --jobs $(JOBS) --regenerate
+	$(BIN)/tfloc report results/sequences
 
 ## tf-plus's per-stage ablation on the real logs, maps as built and thickened (results/tf-plus-ablation-real/; ~5 min quiet).
 ablation-real: $(STAMP)
