@@ -1,7 +1,10 @@
 """Generate the bundled office maps and the scenario datasets of the paper's protocol.
 
 Writes OUT/maps/office-{1,2,3}.geojson (rooms only, furnished, crowded) and
-OUT/scenarios/{office-pool,detail-1,detail-2,detail-3}. The same seed gives the same bytes.
+OUT/scenarios/{office-pool,detail-1,detail-2,detail-3}, and the changed-world datasets
+OUT/scenarios/changed-{clutter-0,clutter-10,clutter-25,furniture-gone} (the furnished office's
+map, scans with unmapped people and boxes or without the furniture; tfloc.datasets.changed_world).
+The same seed gives the same bytes.
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from tfloc.datasets.changed_world import generate_changed_world
     from tfloc.datasets.noise import NoiseModel
     from tfloc.datasets.synthetic import BundleSpec, generate_bundle
 
@@ -36,4 +40,5 @@ def run(args: argparse.Namespace) -> int:
                       noise=NoiseModel(args.sigma, args.dropout, args.spurious),
                       clearance_m=args.clearance)
     generate_bundle(args.out, spec, log=print)
+    generate_changed_world(args.out, spec, log=print)
     return 0

@@ -112,14 +112,15 @@ def read_ros_map(yaml_path: str | Path) -> GridMap:
         raise MapFormatError(f"{path}: {str(exc).removeprefix(path.stem + ': ')}") from None
 
 
-def write_ros_map(grid: GridMap, yaml_path: str | Path) -> Path:
-    """Write ``grid`` as ``<stem>.pgm`` + ``<stem>.yaml`` (mode ``scale``, negate 0).
+def write_ros_map(grid: GridMap, yaml_path: str | Path, image_suffix: str = ".pgm") -> Path:
+    """Write ``grid`` as ``<stem>.pgm`` (or ``image_suffix``, e.g. ``.png``) + ``<stem>.yaml``
+    (mode ``scale``, negate 0).
 
     Known cells keep their probability (to 1/255); unknown cells get a value between the
-    thresholds, so reading the files back gives the same occupied, free and unknown cells."""
+    thresholds, so reading the files back gives the same occupied and free cells."""
     path = Path(yaml_path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    img = path.with_suffix(".pgm")
+    img = path.with_suffix(image_suffix)
     p = np.array(grid.occupancy, dtype=float)
     unknown = 0.5 * (grid.occupied_thresh + grid.free_thresh)
     v = np.round(255.0 * (1.0 - np.where(np.isnan(p), unknown, p))).astype(np.uint8)
@@ -137,4 +138,37 @@ def write_ros_map(grid: GridMap, yaml_path: str | Path) -> Path:
            "occupied_thresh": grid.occupied_thresh, "free_thresh": grid.free_thresh}
     path.write_text(f"# tfloc GridMap {grid.name!r}: {grid.shape[1]} x {grid.shape[0]} cells\n"
                     + yaml.safe_dump(doc, sort_keys=False))
+    return path
+
+
+#: map_saver's pixel values: occupied, free, unknown.
+SAVER_PIXELS = (0, 254, 205)
+#: cartographer_ros's pixel for a never-observed cell (its canvas's 0.5 grey).
+CARTO_UNKNOWN_PIXEL = 128
+
+
+def write_exported_map(grid: GridMap, yaml_path: str | Path, exporter: str, image_suffix: str = ".png") -> Path:
+    """Write ``grid`` the way a ROS mapping tool exports a map: image + YAML without ``mode``
+    (map_server reads it as ``trinary``), the grid's thresholds, negate 0.
+
+    ``exporter`` = ``"map_saver"`` (ROS map_saver, e.g. of a gmapping map): occupied cells 0,
+    free 254, the rest 205; ``"cartographer"`` (cartographer_ros's pbstream_to_ros_map): every
+    observed cell its grey level ``round(255 · (1 − p))``, unobserved cells 128."""
+    path = Path(yaml_path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    img = path.with_suffix(image_suffix)
+    if exporter == "map_saver":
+        occ_v, free_v, unk_v = SAVER_PIXELS
+        v = np.where(grid.occupied, occ_v, np.where(grid.free, free_v, unk_v))
+    elif exporter == "cartographer":
+        p = np.array(grid.occupancy, dtype=float)
+        v = np.where(np.isnan(p), CARTO_UNKNOWN_PIXEL, np.round(255.0 * (1.0 - np.nan_to_num(p))))
+    else:
+        raise ValueError(f"unknown exporter {exporter!r} (map_saver or cartographer)")
+    Image.fromarray(np.flipud(v.astype(np.uint8)), mode="L").save(img)
+    doc = {"image": img.name, "resolution": grid.resolution,
+           "origin": [grid.origin[0], grid.origin[1], 0.0], "negate": 0,
+           "occupied_thresh": grid.occupied_thresh, "free_thresh": grid.free_thresh}
+    path.write_text(f"# tfloc GridMap {grid.name!r} as {exporter} exports it: "
+                    f"{grid.shape[1]} x {grid.shape[0]} cells\n" + yaml.safe_dump(doc, sort_keys=False))
     return path
