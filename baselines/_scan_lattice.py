@@ -69,7 +69,7 @@ class ScanLattice:
 
 
 def run_centre_ranges(grid: Any, poses: np.ndarray, laser: LaserSpec, near: np.ndarray,
-                      max_depth: float = 0.5, chunk: int = 64) -> np.ndarray:
+                      max_depth: float = 0.5, chunk: int = 16) -> np.ndarray:
     """Ranges (metres) to the middle of the run of occupied cells each beam enters at its
     ray-cast range ``near`` ``(P, B)``: the beam is sampled every quarter cell from one cell
     before ``near`` to ``max_depth`` beyond it; the run is the contiguous occupied samples from
