@@ -185,4 +185,4 @@ def robustness_markdown(cells: pd.DataFrame, changes: pd.DataFrame, figure: str 
                   changes_table(changes, log), ""]
     if figure:
         parts += [f"![success by style]({figure})", ""]
-    return "\n".join(parts)
+    return "\n".join(parts) + "\n"
