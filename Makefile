@@ -6,7 +6,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.tfloc-installed
 JOBS   ?= 2
 
-.PHONY: install quick bench ablation-real test test-unit timing lint clean-venv real-data fuzz chaos
+.PHONY: install quick bench robustness robustness-full ablation-real test test-unit timing lint clean-venv real-data fuzz chaos
 
 $(STAMP): pyproject.toml
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -48,6 +48,25 @@ bench: $(STAMP)
 	$(BIN)/tfloc report results/tf-plus-ablation
 	$(BIN)/tfloc bench benchmarks/sequences.toml --jobs $(JOBS) --regenerate
 	$(BIN)/tfloc report results/sequences
+	$(BIN)/tfloc bench benchmarks/robustness.toml --jobs $(JOBS) --regenerate
+	$(BIN)/tfloc timing results/robustness
+	$(BIN)/tfloc report results/robustness
+	$(BIN)/tfloc robustness results/robustness
+
+## Issue 25: every matcher on every map style of the real logs and every changed world of the
+## simulated office (10 scans per offset group of each dataset; ~12 min on 2 quiet cores)
+## → results/robustness/robustness.md. robustness-full: every scan (~30 min).
+robustness: $(STAMP)
+	$(BIN)/tfloc bench benchmarks/robustness.toml --jobs $(JOBS) --regenerate
+	$(BIN)/tfloc timing results/robustness
+	$(BIN)/tfloc report results/robustness
+	$(BIN)/tfloc robustness results/robustness
+
+robustness-full: $(STAMP)
+	$(BIN)/tfloc bench benchmarks/robustness-full.toml --jobs $(JOBS) --regenerate
+	$(BIN)/tfloc timing results/robustness-full
+	$(BIN)/tfloc report results/robustness-full
+	$(BIN)/tfloc robustness results/robustness-full
 
 ## tf-plus's per-stage ablation on the real logs, maps as built and thickened (results/tf-plus-ablation-real/; ~5 min quiet).
 ablation-real: $(STAMP)

@@ -3,9 +3,15 @@
 Scan matchers built for SLAM (OpenKarto's) correlate a scan with *other scans*, not with a map. A
 tfloc map has no recorded scans, so the lattice stands in for them: positions every ``spacing``
 metres (cell centres of a square grid over the map's bounds) that lie in free space at least
-``clearance`` metres from any obstacle, each with the virtual sensor's 360° scan from there. The
-positions are computed when the lattice is built; a position's scan is ray-cast the first time it
+``clearance`` metres from any obstacle, each with a 360° scan of the map from there. The
+positions are computed when the lattice is built; a position's scan is made the first time it
 is asked for (a scan-to-scan map is used for one scan only, so most are never needed).
+
+A scan's beam ends on the map's surface: ``surface = "near-face"`` is the virtual sensor's range
+(the first occupied cell); ``"run-centre"`` is, on a grid, the middle of the run of occupied
+cells the beam enters there (the map's own points: an occupied run in a grid built from scans is
+the scatter of the returns around one surface, whose middle is where the recorded scans that a
+SLAM system would hand Karto put it). On a vector map both are the ray-cast range.
 """
 
 from __future__ import annotations
@@ -34,10 +40,11 @@ class ScanLattice:
         laser: the virtual 360° laser.
     """
 
-    def __init__(self, map_: Any, positions: np.ndarray, laser: LaserSpec) -> None:
+    def __init__(self, map_: Any, positions: np.ndarray, laser: LaserSpec, surface: str = "near-face") -> None:
         self._map = map_
         self.positions = positions
         self.laser = laser
+        self.surface = surface
         self._ranges: dict[int, np.ndarray] = {}
 
     def near(self, xy: np.ndarray, radius: float) -> np.ndarray:
@@ -54,14 +61,45 @@ class ScanLattice:
         if todo:
             poses = np.column_stack((self.positions[todo], np.zeros(len(todo))))
             cast = np.atleast_2d(self._map.raycast(poses, self.laser))
+            if self.surface == "run-centre" and hasattr(self._map, "occupied"):
+                cast = run_centre_ranges(self._map, poses, self.laser, cast)
             for i, r in zip(todo, cast, strict=True):
                 self._ranges[i] = r
         return np.array([self._ranges[int(i)] for i in idx]).reshape(len(idx), self.laser.n_beams)
 
 
+def run_centre_ranges(grid: Any, poses: np.ndarray, laser: LaserSpec, near: np.ndarray,
+                      max_depth: float = 0.5, chunk: int = 16) -> np.ndarray:
+    """Ranges (metres) to the middle of the run of occupied cells each beam enters at its
+    ray-cast range ``near`` ``(P, B)``: the beam is sampled every quarter cell from one cell
+    before ``near`` to ``max_depth`` beyond it; the run is the contiguous occupied samples from
+    the first one. Beams without a return keep ``inf``."""
+    res = grid.resolution
+    offs = np.arange(-res, max_depth + 0.125 * res, 0.25 * res)
+    idx = np.arange(offs.size)
+    out = np.array(near, dtype=float, copy=True)
+    H, W = grid.shape
+    ox, oy = grid.origin
+    for a in range(0, len(poses), chunk):
+        p, r = poses[a: a + chunk], out[a: a + chunk]
+        ang = p[:, 2:3] + laser.angles[None, :]
+        t = np.where(np.isfinite(r), r, 0.0)[..., None] + offs
+        i = np.floor((p[:, 0, None, None] + t * np.cos(ang)[..., None] - ox) / res).astype(np.int64)
+        j = np.floor((p[:, 1, None, None] + t * np.sin(ang)[..., None] - oy) / res).astype(np.int64)
+        inside = (i >= 0) & (i < W) & (j >= 0) & (j < H)
+        occ = np.zeros(t.shape, dtype=bool)
+        occ[inside] = grid.occupied[j[inside], i[inside]]
+        first = np.argmax(occ, axis=-1)
+        after = ~occ & (idx >= first[..., None])
+        end = np.where(after.any(axis=-1), np.argmax(after, axis=-1), offs.size)
+        centre = r + 0.5 * (offs[first] + offs[end - 1])
+        out[a: a + chunk] = np.where(np.isfinite(r) & occ.any(axis=-1), centre, r)
+    return out
+
+
 def scan_lattice(map_: Any, spacing: float, clearance: float, max_range: float,
-                 resolution_deg: float) -> ScanLattice:
-    """The cached :class:`ScanLattice` of ``map_`` (metres, degrees)."""
+                 resolution_deg: float, surface: str = "near-face") -> ScanLattice:
+    """The cached :class:`ScanLattice` of ``map_`` (metres, degrees; ``surface``: see the module)."""
 
     def build() -> ScanLattice:
         x0, y0, x1, y1 = map_.bounds
@@ -70,7 +108,8 @@ def scan_lattice(map_: Any, spacing: float, clearance: float, max_range: float,
         gx, gy = np.meshgrid(xs, ys)
         xy = np.column_stack((gx.ravel(), gy.ravel()))
         free = np.asarray(map_.is_free(xy, clearance), dtype=bool) if len(xy) else np.zeros(0, dtype=bool)
-        return ScanLattice(map_, np.ascontiguousarray(xy[free]), ring_laser(max_range, resolution_deg))
+        return ScanLattice(map_, np.ascontiguousarray(xy[free]), ring_laser(max_range, resolution_deg), surface)
 
-    key = ("scan-lattice", round(spacing, 9), round(clearance, 9), round(max_range, 9), round(resolution_deg, 9))
+    key = ("scan-lattice", round(spacing, 9), round(clearance, 9), round(max_range, 9), round(resolution_deg, 9),
+           surface)
     return cached(map_, key, build)

@@ -10,51 +10,21 @@ size, resolution, smear, range threshold, angular search and penalties), ``Wrapp
 response in [0, 1]). ``create_occupancy_grid`` builds a grid *from* scans for display; nothing
 matches against a grid.
 
-Configuration choices and why, measured on the development split (office-pool scans 100–139 of
-each of the nine offset cells, 360 scans, disjoint from the benchmark's scans 0–19; success
-≤ 10 cm and ≤ 2°, by offset bin 0–1 / 1–2 / 2–3 m; CPU ms = ``time.process_time`` per ``localize``;
-the variants' table: ``python benchmarks/peers_dev.py karto``). This configuration: 94.4 %
-(95.8 / 96.7 / 90.8), median 0.58 cm / 0.064° when successful, 10.5 ms median CPU.
+What it is fed and why, in short (the tuning record, with the measurements behind every choice,
+is docs/baselines/karto.md):
 
-* **The map is handed over as scans**, Karto's documented use: ``MatchScan`` correlates a scan
-  with a set of *base scans* (in OpenKarto's Mapper the running scans and the near chains of the
-  pose graph; slam_toolbox's localization mode matches against the scans of a saved pose graph).
-  A tfloc map has no recorded scans, so :mod:`tfloc.baselines._scan_lattice` ray-casts virtual 360°
-  scans (``virtual_beam_deg`` = 0.25°; 0.5°: same 94.4 %) from a lattice of free positions every
-  ``lattice_spacing`` = 1 m (≥ ``lattice_clearance`` = 0.2 m from obstacles; 0.5 m: 94.7 % at
-  1.5× the CPU), once per position and map; the base scans are those within ``base_radius`` = 4 m
-  of the initial pose (the protocol's reach of 3.5 m plus margin; 2 m: 91.1 %, 6 m: 94.4 % at
-  17 % more CPU). One virtual scan from the initial pose instead: 77.5 % (50.0 % at 2–3 m), it
-  misses what the real scan sees from the true pose; only lattice positions in sight of the
-  initial pose: 87.5 %, the true pose is often in a room the initial pose cannot see.
-* ``range_threshold`` = **the laser's range** (Karto's 40 m default builds a grid of
-  (search + 2 × 40 m) / resolution cells a side). Returns beyond it are dropped by Karto; no-return
-  beams are passed beyond it. For the real logs' 50 m lasers the fine stage's grid is then
-  ~10 000² cells (≈ 100 MB), which Karto clears for every match.
-* **Two stages, Karto's loop-closure pattern** (OpenKarto's ``TryCloseLoop``: the loop matcher
-  over a wide window without penalties, then the sequential matcher from its result): coarse
-  ``coarse_search_size`` = 7 m (the full width: ±3.5 m, the protocol's window like ``csm-corr``'s)
-  at ``coarse_resolution`` = 0.1 m with ``coarse_smear_deviation`` = 0.1 m, no penalty; fine
-  ``fine_search_size`` = 0.3 m at ``fine_resolution`` = 0.01 m with ``fine_smear_deviation`` =
-  0.03 m (OpenKarto's sequential defaults; smear 0.05 m: same) and its penalties. The coarse stage
-  alone: 79.4 %, only 32.8 % within 5 cm / 1° (its 0.1 m grid leaves 5.0 cm median error); one
-  stage over 7 m at 0.02 m: 95.8 % at 144 ms; a coarse stage at 0.05 m / 0.03 m smear: 94.7 % at
-  26.5 ms; coarse smear 0.15 m: 95.0 % (two scans more: noise, not kept). Windows of 1 m and 3 m
-  in one stage at 0.02 m reached 17.8 % and 62.2 % (45-scan subset, one virtual scan from the
-  initial pose as base; 7 m: 84.4 %): the window must cover the offsets.
-* **Angular search: Karto's defaults**, ±``coarse_angle_offset_deg`` = 20° (covers the protocol's
-  15°) in ``coarse_angle_resolution_deg`` = 2° steps, refined in ``fine_angle_resolution_deg`` =
-  0.2° steps; ``use_response_expansion`` (Karto's +20° retries when nothing responds). 1° coarse
-  steps: 94.7 % at 17.1 ms.
-* **Penalties: Karto's defaults** (``distance_variance_penalty`` = 0.5, ``minimum_distance_penalty``
-  = 1.0, i.e. no distance penalty; ``angle_variance_penalty`` = 0.349, ``minimum_angle_penalty`` =
-  0.9), applied in the fine stage only. Without the angle penalty, or with a minimum distance
-  penalty of 0.5: the same 94.4 %; within ±0.15 m they do not change the winner.
-* ``converged`` = Karto's final response ≥ ``min_response`` = 0.45 (slam_toolbox's
-  ``loop_match_minimum_response_fine``); a self-check, not a claim of correctness.
+* **The map is handed over as scans** (Karto's documented use: ``MatchScan`` correlates a scan
+  with *base scans*): 360° scans of the map from a lattice of free positions every 1 m
+  (:mod:`tfloc.baselines._scan_lattice`), those within 4 m of the initial pose. On a grid each
+  beam ends in the middle of the run of occupied cells it meets (``base_surface`` =
+  ``run-centre``), where the recorded scans a SLAM system would hand Karto put the surface;
+  ``near-face`` (the ray-cast range) is the earlier choice, biased short on thick walls.
+* **Two stages, Karto's loop-closure pattern**: a ±3.5 m / ±20° coarse search at 0.1 m without
+  penalties, then Karto's sequential defaults (0.3 m at 0.01 m, with penalties).
+* ``range_threshold`` = the laser's range; ``converged`` = final response ≥ 0.45
+  (slam_toolbox's ``loop_match_minimum_response_fine``), a self-check.
 
-**Amortised per map** (``prepare``): the lattice and every position's virtual scan as a Karto
-scan (without ``prepare`` they are ray-cast the first time a scan near them is matched).
+**Amortised per map** (``prepare``): the lattice and every position's base scan as a Karto scan.
 **Per scan**: the query scans and Karto's two correlations (Karto builds its grid from the base
 scans for every match; its API keeps no grid between matches).
 
@@ -100,7 +70,8 @@ class Config:
                 "virtual_beam_deg", "base_radius", "range_threshold"),
         ">= 0": ("coarse_angle_offset_deg", "lattice_clearance", "distance_variance_penalty",
                  "minimum_distance_penalty", "angle_variance_penalty", "minimum_angle_penalty",
-                 "min_response")}
+                 "min_response"),
+        ("run-centre", "near-face"): ("base_surface",)}
 
     coarse_search_size: float = 7.0
     coarse_resolution: float = 0.1
@@ -120,6 +91,7 @@ class Config:
     lattice_spacing: float = 1.0
     lattice_clearance: float = 0.2
     virtual_beam_deg: float = 0.25
+    base_surface: str = "run-centre"
     base_radius: float = 4.0
     min_response: float = 0.45
     score_window: float = 0.04
@@ -196,7 +168,7 @@ class KartoMatcher:
     def _lattice(self, problem: Problem) -> ScanLattice:
         c = self.config
         return scan_lattice(problem.map, c.lattice_spacing, c.lattice_clearance, self._threshold(problem.laser),
-                            c.virtual_beam_deg)
+                            c.virtual_beam_deg, c.base_surface)
 
     def _base_scans(self, problem: Problem) -> list:
         """Karto scans of the lattice positions within ``base_radius`` of the initial pose (cached per map)."""

@@ -1,9 +1,12 @@
 """Generate the bundled office maps and the scenario datasets of the paper's protocol.
 
 Writes OUT/maps/office-{1,2,3}.geojson (rooms only, furnished, crowded),
-OUT/scenarios/{office-pool,detail-1,detail-2,detail-3} and the simulated sequences
+OUT/scenarios/{office-pool,detail-1,detail-2,detail-3}, the simulated sequences
 OUT/scenarios/seq-* (a robot driving routes through the three floors with odometry, under
-labelled conditions: tfloc.datasets.sequences). The same seeds give the same bytes.
+labelled conditions: tfloc.datasets.sequences) and the changed-world datasets
+OUT/scenarios/changed-{clutter-0,clutter-10,clutter-25,furniture-gone} (the furnished office's
+map, scans with unmapped people and boxes or without the furniture; tfloc.datasets.changed_world).
+The same seeds give the same bytes.
 """
 
 from __future__ import annotations
@@ -32,6 +35,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from tfloc.datasets.changed_world import generate_changed_world
     from tfloc.datasets.noise import NoiseModel
     from tfloc.datasets.synthetic import BundleSpec, generate_bundle
 
@@ -44,4 +48,5 @@ def run(args: argparse.Namespace) -> int:
         from tfloc.datasets.sequences import SimSpec, generate_sequences
 
         generate_sequences(args.out, SimSpec(noise=spec.noise), log=print)
+    generate_changed_world(args.out, spec, log=print)
     return 0

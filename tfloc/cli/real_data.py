@@ -3,8 +3,12 @@
 Writes OUT/scenarios/real-csail-relations/ and real-csail-relations-perturbed/ (scan-to-scan, the
 1172 MIT CSAIL relations from the odometry guess and from perturbed guesses),
 OUT/scenarios/real-{intel,csail,aces}-scan-to-map/ (scan-to-map), their grid maps
-OUT/maps/real-{intel,csail,aces}.yaml|.pgm, and OUT/scenarios/real-{intel,csail,aces}-sequence/
-(tracking: every scan in time order, odometry drawn from the corrected increments).
+OUT/maps/real-{intel,csail,aces}.yaml|.pgm, OUT/scenarios/real-{intel,csail,aces}-sequence/
+(tracking: every scan in time order, odometry drawn from the corrected increments), and the
+map-style datasets
+OUT/scenarios/real-{intel,csail,aces}-<style>/ with their maps OUT/maps/styles/ (every 4th scan of
+each log on the same corrected scans drawn as other mapping tools draw them: as-built, hits-only,
+thick-1, thick-2, cartographer, gmapping, incomplete; tfloc.datasets.styles).
 """
 
 from __future__ import annotations
@@ -12,7 +16,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-HELP = "build the real-log scenario datasets (MIT CSAIL relations, Intel/CSAIL/ACES scan-to-map)"
+HELP = ("build the real-log scenario datasets (MIT CSAIL relations, Intel/CSAIL/ACES scan-to-map, "
+        "and their map styles)")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -32,9 +37,11 @@ def run(args: argparse.Namespace) -> int:
     from tfloc.datasets.real import build_all
     from tfloc.datasets.real_sequences import build_sequences
     from tfloc.datasets.relations import build_relations
+    from tfloc.datasets.styles import build_styles
 
     for root in [*build_relations(args.real, args.out, args.seed),
                  *build_all(args.real, args.out, args.seed, args.resolution),
-                 *build_sequences(args.real, args.out)]:
+                 *build_sequences(args.real, args.out),
+                 *build_styles(args.real, args.out, args.seed, args.resolution)]:
         print(root)
     return 0

@@ -4,6 +4,7 @@ or by rasterising a :class:`VectorMap`."""
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -27,15 +28,30 @@ def _frame(points: np.ndarray, resolution: float, margin: float) -> tuple[tuple[
     return (float(lo[0]), float(lo[1])), W, H
 
 
-def grid_from_scans(ranges: np.ndarray, poses: np.ndarray, laser: LaserSpec, resolution: float = 0.05,
-                    margin: float = 1.0, carve: bool = True, name: str = "scans") -> GridMap:
-    """Occupancy grid from scans ``(N, n_beams)`` taken at world laser poses ``(N, 3)`` (m, rad).
+@dataclass(frozen=True, eq=False)
+class ScanCounts:
+    """Per-cell beam counts of scans at known poses, on one grid frame.
+
+    Attributes:
+        hits: ``(H, W)`` returns that ended in each cell (float, whole numbers).
+        passes: ``(H, W)`` beams that crossed each cell before their return (0 without carving).
+        origin: ``(ox, oy)`` metres, outer corner of cell ``[0, 0]`` (row 0 = lowest y).
+        resolution: metres per cell.
+    """
+
+    hits: np.ndarray
+    passes: np.ndarray
+    origin: tuple[float, float]
+    resolution: float
+
+
+def scan_counts(ranges: np.ndarray, poses: np.ndarray, laser: LaserSpec, resolution: float = 0.05,
+                margin: float = 1.0, carve: bool = True) -> ScanCounts:
+    """Hit and pass counts of scans ``(N, n_beams)`` taken at world laser poses ``(N, 3)`` (m, rad).
 
     Every return adds a hit to its cell; with ``carve``, every cell a beam crosses before its
-    return adds a pass (beams without a return carve nothing). Occupancy = hits / (hits + passes),
-    NaN where no beam reached; thresholds are those of the counting model
-    (:data:`COUNT_OCCUPIED_THRESH`, :data:`COUNT_FREE_THRESH`). The extent covers every
-    return and pose plus ``margin`` metres."""
+    return adds a pass (beams without a return carve nothing). The extent covers every return
+    and pose plus ``margin`` metres."""
     R = np.asarray(ranges, dtype=float).reshape(len(poses), -1)
     P = np.asarray(poses, dtype=float).reshape(-1, 3)
     ok = laser.valid(R)
@@ -51,10 +67,24 @@ def grid_from_scans(ranges: np.ndarray, poses: np.ndarray, laser: LaserSpec, res
     if carve:
         starts = np.repeat((P[:, :2] - np.array(origin)) / resolution, ok.sum(axis=1), axis=0)
         carve_grid(passes, np.ascontiguousarray(starts), np.ascontiguousarray(ends_c))
-    total = hits + passes
+    return ScanCounts(hits, passes, origin, resolution)
+
+
+def grid_from_counts(counts: ScanCounts, name: str = "scans") -> GridMap:
+    """The counting model's grid: occupancy = hits / (hits + passes), NaN where no beam reached;
+    thresholds :data:`COUNT_OCCUPIED_THRESH`, :data:`COUNT_FREE_THRESH`."""
+    total = counts.hits + counts.passes
     with np.errstate(invalid="ignore", divide="ignore"):
-        occ = np.where(total > 0, hits / total, np.nan)
-    return GridMap(occ, resolution, origin, COUNT_OCCUPIED_THRESH, COUNT_FREE_THRESH, name)
+        occ = np.where(total > 0, counts.hits / total, np.nan)
+    return GridMap(occ, counts.resolution, counts.origin, COUNT_OCCUPIED_THRESH, COUNT_FREE_THRESH, name)
+
+
+def grid_from_scans(ranges: np.ndarray, poses: np.ndarray, laser: LaserSpec, resolution: float = 0.05,
+                    margin: float = 1.0, carve: bool = True, name: str = "scans") -> GridMap:
+    """Occupancy grid from scans ``(N, n_beams)`` taken at world laser poses ``(N, 3)`` (m, rad):
+    :func:`scan_counts` then :func:`grid_from_counts` (hit counting, with ``carve`` free-space
+    carving; occupancy = hits / (hits + passes), NaN where no beam reached)."""
+    return grid_from_counts(scan_counts(ranges, poses, laser, resolution, margin, carve), name)
 
 
 def rasterize(vmap: VectorMap, resolution: float, margin: float = 0.5, name: str | None = None) -> GridMap:

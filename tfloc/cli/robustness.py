@@ -1,0 +1,56 @@
+"""Write the robustness section of a run: RUN/robustness.md and RUN/figures/robustness.png.
+
+Success per matcher on every map style of the real logs and every changed world of the simulated
+office (datasets with an "axis" in their scenario.json, e.g. benchmarks/robustness.toml), with
+Wilson 95 % intervals, one table per log and the paired change against the as-built grid (real
+logs) or the uncluttered world (simulation).
+
+Example:
+  tfloc robustness results/robustness
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+HELP = "write RUN/robustness.md (success per map style and changed world) and its figure"
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("run", type=Path, metavar="RUN", help="run directory holding estimates.csv and run.json")
+    p.add_argument("--no-figures", action="store_true", help="skip the PNG figure")
+
+
+def run(args: argparse.Namespace) -> int:
+    from tfloc.errors import ResultsError
+    from tfloc.evaluation.metrics import prepare
+    from tfloc.evaluation.outcome import Thresholds
+    from tfloc.io.estimates import read_estimates
+    from tfloc.io.scenario import read_scenario
+    from tfloc.io.text import parse_text
+    from tfloc.report.robustness import (
+        axes_of,
+        paired_changes,
+        robustness_cells,
+        robustness_figure,
+        robustness_markdown,
+    )
+
+    run_json = args.run / "run.json"
+    if not run_json.is_file() or not (args.run / "estimates.csv").is_file():
+        raise ResultsError(f"{args.run}: no run.json or estimates.csv (run 'tfloc bench' first)")
+    doc = parse_text(run_json, ResultsError, "run.json file", json.loads, ValueError, "JSON")
+    datasets = doc.get("config", {}).get("datasets", []) if isinstance(doc, dict) else []
+    scenarios = [read_scenario(d if isinstance(d, str) else d.get("path", "")) for d in datasets]
+    axes = axes_of((s.name, s.extra) for s in scenarios)
+    prepared = prepare(read_estimates(args.run), Thresholds.from_run(doc))
+    cells, changes = robustness_cells(prepared, axes), paired_changes(prepared, axes)
+    fig = None if args.no_figures else robustness_figure(cells, args.run / "figures" / "robustness.png")
+    out = args.run / "robustness.md"
+    out.write_text(robustness_markdown(cells, changes, fig.relative_to(args.run).as_posix() if fig else None))
+    cells.to_csv(args.run / "robustness.csv", index=False, float_format="%.4g")
+    print(f"robustness: {out}", file=sys.stderr)
+    return 0
