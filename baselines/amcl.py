@@ -19,7 +19,14 @@ departure from Nav2's defaults, is in ``docs/baselines/amcl.md``. In short:
   between updates the estimate is the last one carried by the odometry (Nav2's map→odom transform).
 * The KLD bound uses pf.c's own ``pop_err`` 0.01 / ``pop_z`` 3 (Nav2 sets 0.05 / 0.99); the wheel
   does not expose them. It reports the whole particle set's mean, not the heaviest cluster's.
-* Random numbers: Nav2's ``drand48`` stream, seeded here (``seed``) after the filter is built.
+* Random numbers: the filter draws from the C library's ``drand48``; ``pf_alloc`` seeds it with
+  the clock and ``set_initial_pose`` with a process-wide counter. Here the counter is set to
+  ``seed`` before the initial draw (for the one build whose machine code we read; elsewhere only
+  the default zero-covariance start is reproducible) and ``srand48(seed)`` is called after it.
+* No global localization (Nav2's ``reinitialize_global_localization``): the wheel has
+  ``pf_init_model`` but nothing calls it. Random particle injection (``recovery_alpha_slow`` /
+  ``_fast`` > 0) draws free cells from a ``std::mt19937`` seeded by ``std::random_device``: such
+  runs do not repeat.
 
 A vector map is rasterised at 5 cm (as a user exports it for Nav2), a grid map is used as it is;
 both are handed over in map_server's trinary form (occupied 100, free 0, unknown -1).
@@ -170,9 +177,10 @@ class AmclTracker:
 
     # -- the Tracker protocol ------------------------------------------------------------------
     def start(self, map: Map, laser: LaserSpec, pose: Pose) -> None:
-        """Build the filter on ``map`` (grid as given, vector map rasterised at 5 cm) with every
-        particle drawn around ``pose`` (Nav2's ``set_initial_pose``; covariance from
-        ``initial_sigma_*``, zero by default as Nav2's ``initial_pose`` parameters)."""
+        """Build the filter on ``map`` (grid as given, vector map rasterised at 5 cm); the particles
+        are drawn around ``pose`` (carried by the first step's odometry) at the first step, Nav2's
+        ``set_initial_pose``, covariance from ``initial_sigma_*`` (zero by default, as Nav2 with
+        its ``initial_pose`` parameters)."""
         if not pose.is_finite():
             raise InvalidProblemError(f"amcl: starting pose is not finite: {pose}")
         c = self.config
@@ -186,13 +194,6 @@ class AmclTracker:
                        c.robot_model_type)
         f.set_map(occ)
         f.set_laser_pose(_amcl.Vector3D(0.0, 0.0, 0.0))
-        counter = _pdf_seed_counter()
-        if counter is not None:  # set_initial_pose draws the particles after srand48(++counter)
-            counter.value = c.seed % 2**31
-        f.set_initial_pose(_vec(pose), _amcl.create_diagonal_covariance(
-            c.initial_sigma_xy ** 2, c.initial_sigma_xy ** 2, c.initial_sigma_theta ** 2))
-        _libc.srand48(ctypes.c_long(c.seed))  # the motion model's and the resampler's draws
-        self.reproducible = counter is not None or (c.initial_sigma_xy == 0 and c.initial_sigma_theta == 0)
         self._filter, self._laser = f, laser
         self._range_max = (min(laser.max_range, c.laser_max_range) if c.laser_max_range > 0
                            else laser.max_range)
@@ -200,7 +201,18 @@ class AmclTracker:
         self._odom = Pose(0.0, 0.0, 0.0)          # the integrated odometry (its own frame)
         self._odom_at_update: Pose | None = None  # odometry at the last filter update
         self._pose_at_update = pose               # the filter's estimate at the last update
+        self._init_at: tuple[Pose, Pose] | None = (pose, self._odom)  # (pose, odometry) to start from
+        self._inits = 0
         self.updates = 0
+        self.reproducible = _pdf_seed_counter() is not None or (
+            c.initial_sigma_xy == 0 and c.initial_sigma_theta == 0)
+
+    def reset(self, pose: Pose) -> None:
+        """Start the filter again at ``pose`` (the current scan's), as Nav2 does on an initial-pose
+        message; the particles are drawn at the next step, carried by its odometry."""
+        if self._filter is None:
+            raise RuntimeError("AmclTracker.reset before start")
+        self._init_at, self._odom_at_update, self._pose_at_update = (pose, self._odom), None, pose
 
     def step(self, ranges: np.ndarray, odom_delta: Pose, stamp: float) -> Estimate:
         """One scan: integrate the odometry; update the filter when Nav2 would (the first scan,
@@ -209,6 +221,10 @@ class AmclTracker:
         if self._filter is None:
             raise RuntimeError("AmclTracker.step before start")
         self._odom = self._odom.compose(odom_delta)
+        if self._init_at is not None:
+            pose, odom = self._init_at
+            self._initialise(pose.compose(odom.between(self._odom)))
+            self._init_at = None
         update = self._odom_at_update is None or self._moved(self._odom_at_update, self._odom)
         if update:
             self._filter.update(self._scan(ranges), _vec(self._odom))
@@ -225,6 +241,20 @@ class AmclTracker:
                 "sigma_theta_rad": float(math.sqrt(max(cov[2, 2], 0.0)))}
         return Estimate(pose, True, 1 if update else 0, 0, info)
 
+    def _initialise(self, pose: Pose) -> None:
+        """Draw the particles around ``pose`` (the wheel's next update then applies no motion, as
+        Nav2's first scan after an initial pose), seeded: ``seed`` for the first start, + 1 for
+        each reset."""
+        c = self.config
+        seed = (c.seed + self._inits) % 2**31
+        counter = _pdf_seed_counter()
+        if counter is not None:  # set_initial_pose draws the particles after srand48(++counter)
+            counter.value = seed
+        self._filter.set_initial_pose(_vec(pose), _amcl.create_diagonal_covariance(
+            c.initial_sigma_xy ** 2, c.initial_sigma_xy ** 2, c.initial_sigma_theta ** 2))
+        _libc.srand48(ctypes.c_long(seed))  # the motion model's and the resampler's draws
+        self._inits += 1
+
     # -- helpers ---------------------------------------------------------------------------------
     def _moved(self, a: Pose, b: Pose) -> bool:
         """Nav2's ``shouldUpdateFilter``: odometry moved along x or y (odometry frame) or turned."""
@@ -233,14 +263,18 @@ class AmclTracker:
                 or abs(float(wrap_angle(b.theta - a.theta))) > c.update_min_a)
 
     def _scan(self, ranges: np.ndarray):  # noqa: ANN202 - an amcl.LaserScan
-        """The scan as Nav2 hands it to the sensor model: ``[range, bearing]`` pairs, ranges
-        clipped to ``range_max``; readings ≤ range min (and no-returns: inf, NaN) become range_max."""
+        """The scan as Nav2 hands it to the sensor model (``AmclNode::updateFilter``): ``[range,
+        bearing]`` pairs; a no-return (inf, NaN, ≥ the laser's max range) is +inf, as a REP 117
+        driver reports it; readings ≤ the minimum range become ``range_max`` (Nav2: "amcl doesn't
+        (yet) have a concept of min range")."""
         r = np.asarray(ranges, dtype=float)
         if r.shape != self._bearings.shape:
             raise InvalidProblemError(f"amcl: scan has {r.size} ranges, the laser {self._bearings.size} beams")
         rmax = self._range_max
         rmin = max(self.config.laser_min_range, 0.0)
-        r = np.where(np.isfinite(r) & (r > rmin), np.minimum(r, rmax), rmax)
+        with np.errstate(invalid="ignore"):
+            r = np.where(np.isfinite(r) & (r < self._laser.max_range), r, np.inf)
+            r = np.where(r <= rmin, rmax, r)
         scan = _amcl.LaserScan(r.size, rmax)
         scan.ranges = np.column_stack((r, self._bearings)).tolist()
         return scan

@@ -141,3 +141,23 @@ def test_a_grid_map_is_used_as_given(office) -> None:
     on_grid = [tracker.step(scans[k], truth[k - 1].between(p) if k else Pose(0.0, 0.0, 0.0), 0.2 * k)
                for k, p in enumerate(truth)]
     assert [e.pose for e in on_grid] == [e.pose for e in on_vector]
+
+
+def test_start_and_reset_are_carried_by_the_odometry(office) -> None:
+    """The start pose is the pose before the first step's odometry; ``reset`` (what a tracking loop
+    calls after a failure) starts the filter again at the current scan's pose."""
+    truth = corridor(12)
+    grid = amcl_grid(office)
+    scans = grid.raycast(np.array([p.as_array() for p in truth]), LASER)
+    before = Pose(0.8, 7.5, 0.0)  # 0.2 m behind the first scan's pose
+    tracker = AmclTracker()
+    tracker.start(office, LASER, before)
+    first = tracker.step(scans[0], before.between(truth[0]), 0.0)
+    assert first.info["updated"] and first.pose.distance_to(truth[0]) < 1e-9
+    for k in range(1, 6):
+        tracker.step(scans[k], truth[k - 1].between(truth[k]), 0.2 * k)
+    wrong = Pose(truth[5].x + 0.3, truth[5].y, 0.0)
+    tracker.reset(wrong)
+    est = tracker.step(scans[6], truth[5].between(truth[6]), 1.2)
+    assert est.info["updated"]
+    assert est.pose.distance_to(wrong.compose(truth[5].between(truth[6]))) < 1e-9
