@@ -18,7 +18,7 @@ import pytest
 import tfloc
 from tfloc.core.laser import LaserSpec
 from tfloc.core.pose import Pose
-from tfloc.core.tracker import is_tracker
+from tfloc.core.tracker import as_tracker, has_single_scan_mode, is_tracker
 from tfloc.errors import ParameterError
 
 pytest.importorskip("amcl")
@@ -57,7 +57,8 @@ def corridor(n: int = 170) -> list[Pose]:
 def test_registered_as_a_tracker_without_a_single_scan_mode() -> None:
     tracker = tfloc.get_matcher("amcl")
     assert isinstance(tracker, AmclTracker) and tracker.name == "amcl"
-    assert is_tracker(tracker) and not hasattr(tracker, "localize")
+    assert is_tracker(tracker) and not has_single_scan_mode(tracker) and as_tracker(tracker) is tracker
+    assert has_single_scan_mode(tfloc.get_matcher("tf-plus"))
 
 
 @pytest.mark.parametrize("bad", [{"min_particles": 0}, {"min_particles": 600, "max_particles": 500},
