@@ -48,6 +48,12 @@ def is_tracker(obj: object) -> bool:
     return callable(getattr(obj, "step", None)) and callable(getattr(obj, "start", None))
 
 
+def has_single_scan_mode(obj: object) -> bool:
+    """Whether ``obj`` localizes single scans (``localize``). A native tracker without it (AMCL)
+    runs on sequence datasets only: single-scan runs leave it out with one line."""
+    return callable(getattr(obj, "localize", None))
+
+
 class LocalTracker:
     """A single-scan matcher run as a tracker: each scan is localized from the prediction
     (last estimate ⊕ odometry increment); a declined scan keeps the prediction."""
