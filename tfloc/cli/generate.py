@@ -1,7 +1,9 @@
 """Generate the bundled office maps and the scenario datasets of the paper's protocol.
 
 Writes OUT/maps/office-{1,2,3}.geojson (rooms only, furnished, crowded) and
-OUT/scenarios/{office-pool,detail-1,detail-2,detail-3}. The same seed gives the same bytes.
+OUT/scenarios/{office-pool,detail-1,detail-2,detail-3}, and the global-localization datasets
+OUT/scenarios/global-office-{1,2,3} (evaluation) and global-dev-office-{1,2,3} (development;
+tfloc.datasets.global_sets). The same seeds give the same bytes.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ HELP = "generate the office maps and scenario datasets (reproducible from one se
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    from tfloc.datasets.global_sets import GLOBAL_SEED, OFFICE_SCANS
     from tfloc.datasets.synthetic import MASTER_SEED
 
     p.add_argument("--out", default="data", help="output root (default: data)")
@@ -25,9 +28,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--spurious", type=float, default=0.0, help="probability of a spurious short return (0)")
     p.add_argument("--clearance", type=float, default=0.3,
                    help="min distance of true and initial poses from geometry, metres (0.3)")
+    p.add_argument("--global-seed", type=int, default=GLOBAL_SEED,
+                   help=f"seed of the global-localization datasets (default {GLOBAL_SEED})")
+    p.add_argument("--global-scans", type=int, default=OFFICE_SCANS,
+                   help=f"scans per global-office-k dataset (default {OFFICE_SCANS})")
 
 
 def run(args: argparse.Namespace) -> int:
+    from tfloc.datasets.global_sets import generate_global_offices
     from tfloc.datasets.noise import NoiseModel
     from tfloc.datasets.synthetic import BundleSpec, generate_bundle
 
@@ -36,4 +44,5 @@ def run(args: argparse.Namespace) -> int:
                       noise=NoiseModel(args.sigma, args.dropout, args.spurious),
                       clearance_m=args.clearance)
     generate_bundle(args.out, spec, log=print)
+    generate_global_offices(args.out, args.global_seed, args.global_scans, noise=spec.noise, log=print)
     return 0

@@ -2,8 +2,10 @@
 
 Writes OUT/scenarios/real-csail-relations/ and real-csail-relations-perturbed/ (scan-to-scan, the
 1172 MIT CSAIL relations from the odometry guess and from perturbed guesses),
-OUT/scenarios/real-{intel,csail,aces}-scan-to-map/ (scan-to-map), and their grid maps
-OUT/maps/real-{intel,csail,aces}.yaml|.pgm.
+OUT/scenarios/real-{intel,csail,aces}-scan-to-map/ (scan-to-map), their grid maps
+OUT/maps/real-{intel,csail,aces}.yaml|.pgm, and the global-localization datasets
+OUT/scenarios/real-{intel,csail,aces}-global/ (evaluation) and global-dev-real-*/ (development;
+tfloc.datasets.global_sets).
 """
 
 from __future__ import annotations
@@ -28,10 +30,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from tfloc.datasets.global_sets import build_global_real
     from tfloc.datasets.real import build_all
     from tfloc.datasets.relations import build_relations
 
     for root in [*build_relations(args.real, args.out, args.seed),
-                 *build_all(args.real, args.out, args.seed, args.resolution)]:
+                 *build_all(args.real, args.out, args.seed, args.resolution),
+                 *build_global_real(args.real, args.out)]:
         print(root)
     return 0
