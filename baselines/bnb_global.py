@@ -37,13 +37,17 @@ written, with compiled kernels (:mod:`tfloc.baselines._bnb_kernels`). Choices an
 * **Local problems** (an initial guess): the same search within ±``linear_search_window`` = 7 m
   and ±``angular_search_window_deg`` = 30° of the guess (Cartographer's constraint-builder
   window); the harness's global datasets never use it.
-* Left out: Cartographer's adaptive voxel filter of the scan (every return is used).
+* **Adaptive voxel filter** of the scan, as Cartographer's constraint builder applies before
+  matching (``loop_closure_adaptive_voxel_filter``: ``voxel_max_length`` = 0.9 m,
+  ``voxel_min_num_points`` = 100): the coarsest voxel edge ≤ 0.9 m that keeps at least 100
+  returns (one per voxel, the first), by Cartographer's halving and binary search; a scan of at
+  most 100 returns is kept whole. It bounds the per-candidate cost on long-range scans.
 
 **Amortised per map** (``prepare``): the probability grid and its precomputed grids.
 **Per scan**: the rotated, discretised scans, the branch and bound, the refinement.
 
 ``score(problem, pose)`` is the matcher's own objective: ``1 −`` the mean interpolated grid
-probability of the scan's returns at ``pose`` (lower is better).
+probability of the scan's (voxel-filtered) returns at ``pose`` (lower is better).
 """
 
 from __future__ import annotations
@@ -75,10 +79,10 @@ class Config:
 
     RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params)
         "> 0": ("resolution", "sigma", "linear_search_window", "angular_search_window_deg",
-                "distinct_m", "distinct_deg", "occupied_space_weight"),
+                "distinct_m", "distinct_deg", "occupied_space_weight", "voxel_max_length"),
         ">= 0": ("translation_weight", "rotation_weight"),
         "[0, 1]": ("min_score",),
-        ">= 1": ("branch_and_bound_depth", "hypotheses", "refine_max_evals")}
+        ">= 1": ("branch_and_bound_depth", "hypotheses", "refine_max_evals", "voxel_min_num_points")}
 
     resolution: float = 0.05
     sigma: float = 0.05
@@ -94,6 +98,9 @@ class Config:
     translation_weight: float = 10.0
     rotation_weight: float = 1.0
     refine_max_evals: int = 50
+    voxel_filter: bool = True
+    voxel_max_length: float = 0.9
+    voxel_min_num_points: int = 100
 
 
 @dataclass(frozen=True, eq=False)
@@ -136,6 +143,40 @@ class ProbabilityGrid:
         """Bilinearly interpolated probability at world points ``(N, 2)`` (``P_MIN`` off the grid)."""
         g = (np.asarray(xy, dtype=float) - self.origin) / self.resolution
         return map_coordinates(self.prob, (g[:, 1], g[:, 0]), order=1, mode="constant", cval=P_MIN)
+
+
+def voxel_filter(points: np.ndarray, edge: float) -> np.ndarray:
+    """The first of ``points`` ``(N, 2)`` (metres) in each square voxel of ``edge`` metres, in order."""
+    keys = np.floor(points / edge).astype(np.int64)
+    _, first = np.unique(keys, axis=0, return_index=True)
+    return points[np.sort(first)]
+
+
+def adaptive_voxel_filter(points: np.ndarray, max_length: float, min_num_points: int) -> np.ndarray:
+    """Cartographer's ``AdaptiveVoxelFilter``: ``points`` filtered with the largest voxel edge
+    (≤ ``max_length``, found by halving then a binary search to 10 %) that keeps at least
+    ``min_num_points`` of them; all of them when there are no more than that, or when even an edge of
+    ``max_length``/100 keeps too few."""
+    if len(points) <= min_num_points:
+        return points
+    result = voxel_filter(points, max_length)
+    if len(result) >= min_num_points:
+        return result
+    high = max_length
+    while high > 1e-2 * max_length:
+        low = high / 2.0
+        result = voxel_filter(points, low)
+        if len(result) >= min_num_points:
+            while (high - low) / low > 1e-1:
+                mid = 0.5 * (low + high)
+                cand = voxel_filter(points, mid)
+                if len(cand) >= min_num_points:
+                    low, result = mid, cand
+                else:
+                    high = mid
+            return result
+        high /= 2.0
+    return result
 
 
 def build_probability_grid(map_: object, resolution: float, sigma: float, depth: int) -> ProbabilityGrid:
@@ -184,6 +225,12 @@ class BranchAndBoundGlobalMatcher(Configured):
         """Build the probability grid and its precomputed grids (once per map; untimed)."""
         self._grid(problem)
 
+    def _points(self, problem: Problem) -> np.ndarray:
+        """The scan's returns (sensor frame, metres), through the adaptive voxel filter if enabled."""
+        c = self.config
+        pts = problem.points
+        return adaptive_voxel_filter(pts, c.voxel_max_length, c.voxel_min_num_points) if c.voxel_filter else pts
+
     def _window(self, grid: ProbabilityGrid, problem: Problem, step: float):
         """Headings (radians) and the translation window (cells, inclusive) to search."""
         c = self.config
@@ -204,7 +251,7 @@ class BranchAndBoundGlobalMatcher(Configured):
         """Branch and bound over the whole map (global) or the window about the guess, then refine."""
         c = self.config
         grid = self._grid(problem)
-        pts = problem.points
+        pts = self._points(problem)
         step = angular_step(float(np.max(np.hypot(pts[:, 0], pts[:, 1]))), c.resolution)
         thetas, xr, yr = self._window(grid, problem, step)
         if xr[0] > xr[1] or yr[0] > yr[1]:
@@ -217,7 +264,7 @@ class BranchAndBoundGlobalMatcher(Configured):
         hk, hx, hy, hs, count, scored = branch_and_bound(
             grid.grids, grid.pad, offsets, xr[0], xr[1], yr[0], yr[1], float(min_sum),
             int(c.hypotheses), c.distinct_m / c.resolution, rot_steps)
-        info = {"headings": int(len(thetas)), "angular_step_deg": math.degrees(step),
+        info = {"headings": int(len(thetas)), "angular_step_deg": math.degrees(step), "points": int(len(pts)),
                 "candidates_scored": int(scored), "found": int(count)}
         if count == 0:
             info["status"] = "no-answer"
@@ -263,5 +310,5 @@ class BranchAndBoundGlobalMatcher(Configured):
         return 1.0 - float(np.mean(grid.probability_at(pose.transform(pts))))
 
     def score(self, problem: Problem, pose: Pose) -> float:
-        """``1 −`` the mean interpolated grid probability of the scan's returns at ``pose`` (lower is better)."""
-        return self._score(self._grid(problem), problem.points, pose)
+        """``1 −`` the mean interpolated grid probability of the (filtered) returns at ``pose`` (lower is better)."""
+        return self._score(self._grid(problem), self._points(problem), pose)

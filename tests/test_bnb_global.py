@@ -148,3 +148,17 @@ def test_no_pose_above_the_threshold_is_no_answer(test_room, lms200) -> None:
 def test_bad_parameters_are_rejected(key, value, message) -> None:
     with pytest.raises(ParameterError, match=message):
         get_matcher("bnb-global", **{key: value})
+
+
+def test_adaptive_voxel_filter_keeps_enough_points() -> None:
+    from tfloc.baselines.bnb_global import adaptive_voxel_filter, voxel_filter
+
+    rng = np.random.default_rng(3)
+    pts = rng.uniform(-20, 20, size=(361, 2))
+    out = adaptive_voxel_filter(pts, 0.9, 100)
+    assert 100 <= len(out) < 361 and set(map(tuple, out)) <= set(map(tuple, pts))
+    assert len(voxel_filter(pts, 0.9 * 1.2)) < 361  # a coarser edge would keep fewer
+    few = pts[:80]
+    assert adaptive_voxel_filter(few, 0.9, 100) is few  # at most min_num_points: kept whole
+    dense = np.column_stack((np.linspace(0, 1, 400), np.zeros(400)))  # 400 points on 1 m
+    assert len(adaptive_voxel_filter(dense, 0.9, 100)) >= 100
