@@ -5,8 +5,10 @@ OUT/scenarios/{office-pool,detail-1,detail-2,detail-3}, the simulated sequences
 OUT/scenarios/seq-* (a robot driving routes through the three floors with odometry, under
 labelled conditions: tfloc.datasets.sequences) and the changed-world datasets
 OUT/scenarios/changed-{clutter-0,clutter-10,clutter-25,furniture-gone} (the furnished office's
-map, scans with unmapped people and boxes or without the furniture; tfloc.datasets.changed_world).
-The same seeds give the same bytes.
+map, scans with unmapped people and boxes or without the furniture; tfloc.datasets.changed_world),
+and the global-localization datasets OUT/scenarios/global-office-{1,2,3} (evaluation) and
+global-dev-office-{1,2,3} (development; tfloc.datasets.global_sets). The same seeds give the
+same bytes.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ HELP = "generate the office maps and scenario datasets (reproducible from one se
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    from tfloc.datasets.global_sets import GLOBAL_SEED, OFFICE_SCANS
     from tfloc.datasets.synthetic import MASTER_SEED
 
     p.add_argument("--out", default="data", help="output root (default: data)")
@@ -32,10 +35,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="min distance of true and initial poses from geometry, metres (0.3)")
     p.add_argument("--no-sequences", action="store_true",
                    help="skip the sequence datasets seq-* (tracking)")
+    p.add_argument("--global-seed", type=int, default=GLOBAL_SEED,
+                   help=f"seed of the global-localization datasets (default {GLOBAL_SEED})")
+    p.add_argument("--global-scans", type=int, default=OFFICE_SCANS,
+                   help=f"scans per global-office-k dataset (default {OFFICE_SCANS})")
 
 
 def run(args: argparse.Namespace) -> int:
     from tfloc.datasets.changed_world import generate_changed_world
+    from tfloc.datasets.global_sets import generate_global_offices
     from tfloc.datasets.noise import NoiseModel
     from tfloc.datasets.synthetic import BundleSpec, generate_bundle
 
@@ -49,4 +57,5 @@ def run(args: argparse.Namespace) -> int:
 
         generate_sequences(args.out, SimSpec(noise=spec.noise), log=print)
     generate_changed_world(args.out, spec, log=print)
+    generate_global_offices(args.out, args.global_seed, args.global_scans, noise=spec.noise, log=print)
     return 0

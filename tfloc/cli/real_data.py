@@ -8,7 +8,9 @@ OUT/maps/real-{intel,csail,aces}.yaml|.pgm, OUT/scenarios/real-{intel,csail,aces
 map-style datasets
 OUT/scenarios/real-{intel,csail,aces}-<style>/ with their maps OUT/maps/styles/ (every 4th scan of
 each log on the same corrected scans drawn as other mapping tools draw them: as-built, hits-only,
-thick-1, thick-2, cartographer, gmapping, incomplete; tfloc.datasets.styles).
+thick-1, thick-2, cartographer, gmapping, incomplete; tfloc.datasets.styles), and the
+global-localization datasets OUT/scenarios/real-{intel,csail,aces}-global/ (evaluation) and global-dev-real-*/ (development;
+tfloc.datasets.global_sets).
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ import argparse
 from pathlib import Path
 
 HELP = ("build the real-log scenario datasets (MIT CSAIL relations, Intel/CSAIL/ACES scan-to-map, "
-        "and their map styles)")
+        "sequences, map styles and global sets)")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -34,6 +36,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from tfloc.datasets.global_sets import build_global_real
     from tfloc.datasets.real import build_all
     from tfloc.datasets.real_sequences import build_sequences
     from tfloc.datasets.relations import build_relations
@@ -42,6 +45,7 @@ def run(args: argparse.Namespace) -> int:
     for root in [*build_relations(args.real, args.out, args.seed),
                  *build_all(args.real, args.out, args.seed, args.resolution),
                  *build_sequences(args.real, args.out),
-                 *build_styles(args.real, args.out, args.seed, args.resolution)]:
+                 *build_styles(args.real, args.out, args.seed, args.resolution),
+                 *build_global_real(args.real, args.out)]:
         print(root)
     return 0

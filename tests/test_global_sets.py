@@ -1,0 +1,85 @@
+"""Global-localization datasets: mode, no guesses, poses in free space, bit-for-bit regeneration."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tfloc.core.matcher import check_solvable, get_matcher
+from tfloc.core.problem import Problem
+from tfloc.datasets.global_sets import (
+    DEV_SCANS,
+    OFFICE_SCANS,
+    REAL_MIN_SCANS,
+    generate_global_offices,
+)
+from tfloc.errors import InvalidProblemError
+from tfloc.io.geojson import read_vector_map
+from tfloc.io.scenario import GLOBAL, map_for, read_scans, read_scenario
+
+ROOT = Path(__file__).resolve().parents[1]
+SCEN = ROOT / "data" / "scenarios"
+
+
+def test_dev_office_sets_regenerate_bit_for_bit(tmp_path) -> None:
+    (tmp_path / "maps").mkdir()
+    for lv in (1, 2, 3):
+        shutil.copy(ROOT / "data" / "maps" / f"office-{lv}.geojson", tmp_path / "maps")
+    dirs = generate_global_offices(tmp_path, n=2, n_dev=DEV_SCANS)
+    for d in dirs:
+        if d.name.startswith("global-dev-office"):
+            for f in ("scenario.json", "scans.csv"):
+                assert (d / f).read_bytes() == (SCEN / d.name / f).read_bytes(), (d.name, f)
+    # the evaluation sets' first scans too (the generator draws scan by scan)
+    for lv in (1, 2, 3):
+        mine = (tmp_path / "scenarios" / f"global-office-{lv}" / "scans.csv").read_text().splitlines()
+        bundled = (SCEN / f"global-office-{lv}" / "scans.csv").read_text().splitlines()
+        assert mine[:3] == bundled[:3]
+
+
+@pytest.mark.parametrize("name, n_min", [("global-office-1", OFFICE_SCANS), ("global-office-2", OFFICE_SCANS),
+                                         ("global-office-3", OFFICE_SCANS),
+                                         ("real-intel-global", REAL_MIN_SCANS),
+                                         ("real-csail-global", REAL_MIN_SCANS),
+                                         ("real-aces-global", REAL_MIN_SCANS),
+                                         ("global-dev-office-2", DEV_SCANS),
+                                         ("global-dev-real-csail", DEV_SCANS)])
+def test_bundled_global_sets(name, n_min) -> None:
+    sc = read_scenario(SCEN / name)
+    assert sc.mode == GLOBAL
+    scans = read_scans(sc)
+    assert len(scans) >= n_min
+    assert all(s.initial is None and s.true is not None for s in scans)
+    m = map_for(sc, scans[0])
+    xy = np.array([[s.true.x, s.true.y] for s in scans])
+    assert m.in_bounds(xy).all()
+    sim = np.array([s.group == "sim" for s in scans])
+    assert m.is_free(xy[sim], 0.3).all()  # simulated poses keep their clearance
+    assert {s.group for s in scans} <= {"sim", "real"}
+    if name.startswith("real-"):
+        assert sum(s.group == "real" for s in scans) >= 400
+    headings = np.array([s.true.theta for s in scans])
+    if sim.sum() >= 50:  # spread over the free space and all headings
+        assert np.ptp(xy[sim, 0]) > 0.6 * (m.bounds[2] - m.bounds[0])
+        assert np.histogram(headings[sim], bins=4, range=(-np.pi, np.pi))[0].min() > 0.1 * sim.sum()
+
+
+def test_dev_and_evaluation_sets_are_disjoint() -> None:
+    for lv in (1, 2, 3):
+        ev = {(round(s.true.x, 3), round(s.true.y, 3)) for s in read_scans(read_scenario(SCEN / f"global-office-{lv}"))}
+        dev = {(round(s.true.x, 3), round(s.true.y, 3))
+               for s in read_scans(read_scenario(SCEN / f"global-dev-office-{lv}"))}
+        assert not ev & dev
+
+
+def test_a_local_matcher_gets_an_invalid_problem_not_a_crash() -> None:
+    sc = read_scenario(SCEN / "global-dev-office-1")
+    scan = read_scans(sc)[0]
+    m = read_vector_map(sc.map_path)
+    problem = Problem(m, sc.laser, scan.ranges, scan.initial)
+    with pytest.raises(InvalidProblemError, match="solves local problems only"):
+        check_solvable(get_matcher("csm-corr"), problem)
+    check_solvable(get_matcher("bnb-global"), problem)
