@@ -66,7 +66,7 @@ class PlaceIndex:
 
     Attributes:
         poses: ``(N, 3)`` the virtual scans' poses (metres, radians).
-        signatures: ``(N, D)`` their signatures.
+        signatures: ``(N, D)`` their signatures (the tree's own array, not a copy).
         tree: a ``cKDTree`` over ``signatures``.
         free_area_m2: the map's free area (m², counted on a 0.1 m lattice).
         build_cpu_s: CPU seconds the build took (0 if it was never built here: see ``loaded``).
@@ -84,9 +84,9 @@ class PlaceIndex:
 
     @property
     def nbytes(self) -> int:
-        """Bytes in memory: the arrays and the tree's own copy of the data and its index."""
+        """Bytes in memory: the poses, the signatures (the tree's array) and the tree's index."""
         t = self.tree
-        return int(self.poses.nbytes + self.signatures.nbytes + t.data.nbytes + t.indices.nbytes)
+        return int(self.poses.nbytes + t.data.nbytes + t.indices.nbytes)
 
     def query(self, signature: np.ndarray, count: int, separation: float,
               heading_separation: float, candidates: int = 8) -> tuple[np.ndarray, np.ndarray]:
@@ -176,7 +176,8 @@ def build_index(map_: Map, laser: LaserSpec, cfg: IndexConfig, key: str = "") ->
         ranges = np.atleast_2d(map_.raycast(poses[lo:lo + BATCH], laser))
         sig[lo:lo + BATCH] = signatures(ranges, laser, cfg.signature)
     area = free_area(map_)
-    return PlaceIndex(poses, sig, cKDTree(sig), area, time.process_time() - t0, False, key)
+    tree = cKDTree(sig)
+    return PlaceIndex(poses, tree.data, tree, area, time.process_time() - t0, False, key)
 
 
 def _save(path: Path, index: PlaceIndex) -> None:
@@ -198,7 +199,8 @@ def _load(path: Path, key: str) -> PlaceIndex | None:
         return None
     if poses.ndim != 2 or poses.shape[1] != 3 or len(sig) != len(poses) or len(poses) == 0:
         return None
-    return PlaceIndex(poses, sig, cKDTree(sig), float(meta[0]), float(meta[1]), True, key)
+    tree = cKDTree(sig)
+    return PlaceIndex(poses, tree.data, tree, float(meta[0]), float(meta[1]), True, key)
 
 
 def load_or_build(map_: Map, laser: LaserSpec, cfg: IndexConfig,

@@ -25,7 +25,6 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
-
 from scipy.spatial.distance import pdist
 
 from tfloc.core.laser import LaserSpec
