@@ -142,6 +142,19 @@ def index_growth(**params) -> list[dict]:
     return out
 
 
+def write(which: str, out: str) -> None:
+    """Write a simulated set as global datasets ``out/<map>-global`` (truth kept) and
+    ``out/<map>-global-blind`` (truth blanked), e.g. for ``tfloc localize``."""
+    from tfloc.io.scenario import Scan, write_scenario
+    for name, _, laser, scans in sets(which):
+        for suffix, keep in (("", True), ("-blind", False)):
+            rows = [Scan(f"g{i:03d}", "global", r, None, t if keep else None)
+                    for i, (t, r) in enumerate(scans)]
+            write_scenario(Path(out) / f"{name}-global{suffix}", f"{name}-global{suffix}",
+                           ROOT / "data" / "maps" / f"{name}.geojson", laser, rows,
+                           description=f"tf-global {which} set", mode="global")
+
+
 def main(argv: list[str]) -> None:
     limit_threads(1)
     cmd, *rest = argv
@@ -150,6 +163,8 @@ def main(argv: list[str]) -> None:
         print(json.dumps({"set": rest[0], **kv, **recall(rest[0], **kv)}), flush=True)
     elif cmd == "run":
         print(json.dumps({"set": rest[0], **kv, **run(rest[0], **kv)}), flush=True)
+    elif cmd == "write":
+        write(rest[0], rest[1])
     elif cmd == "index":
         index_growth(**{k: json.loads(v) for k, _, v in (a.partition("=") for a in rest)})
 

@@ -116,7 +116,9 @@ class TurningFunctionGlobalMatcher:
         """Build or load the place index and tf-plus's map view (map-only work, untimed by the
         harness)."""
         idx = self.index(problem)
-        self.resolver.prepare(dataclasses.replace(problem, initial=Pose.from_array(idx.poses[0])))
+        at = dataclasses.replace(problem, initial=Pose.from_array(idx.poses[0]))
+        self.resolver.prepare(at)
+        self.resolver.score(at, at.initial)     # the cost's kernels compiled or loaded
         if problem.initial is not None and self.config.local == "tf-plus":
             self.local.prepare(problem)
 
@@ -154,7 +156,10 @@ class TurningFunctionGlobalMatcher:
                 "signature_distance": float(sig_dist[0]) if len(sig_dist) else math.nan}
         return Estimate(hyps[0], True, len(entries), evaluations, info, hyps)
 
-    def score(self, problem: Problem, pose: Pose) -> float:
+    def score(self, problem: Problem, pose: Pose | None) -> float:
         """``tf-plus``'s selection objective at ``pose`` (the root mean square of the truncated
-        per-beam residuals, metres; :meth:`TurningFunctionPlusMatcher.score`)."""
+        per-beam residuals, metres; :meth:`TurningFunctionPlusMatcher.score`); NaN for no pose
+        (a warm-up that scores a global problem's missing guess)."""
+        if pose is None:
+            return math.nan
         return self.resolver.score(problem, pose)
