@@ -152,3 +152,31 @@ def test_hypotheses_are_distinct() -> None:
 def test_bad_parameters_are_refused(params, message) -> None:
     with pytest.raises(ParameterError, match=rf"matcher 'tf-global': {message}"):
         get_matcher("tf-global", **params)
+
+
+def test_a_kidnapped_tracker_notices_by_its_score_and_relocalizes(matcher, test_room, lms200) -> None:
+    from tfloc.relocalize.recovery import RecoveringTracker
+
+    tracker = RecoveringTracker(get_matcher("tf-plus"), matcher)
+    path = [Pose(2.0, 3.0 + 0.2 * k, 1.2) for k in range(4)]           # walking up the room
+    path += [Pose(8.6, 2.0 + 0.2 * k, 2.5) for k in range(5)]          # carried off, turned
+    step = Pose(0.2 * math.cos(0.37), 0.2 * math.sin(0.37), 0.0)      # what the wheels say
+    tracker.start(test_room, lms200, path[0])
+    rng = np.random.default_rng(3)
+    right, relocs = [], []
+    for k, true in enumerate(path[1:], 1):
+        ranges = test_room.raycast(true, lms200) + rng.normal(0, 0.01, lms200.n_beams)
+        est = tracker.step(ranges, step if k < 4 else Pose(0.2, 0.0, 0.0), float(k))
+        right.append(est.pose.distance_to(true) <= 0.10
+                     and abs(angdiff(est.pose.theta, true.theta)) <= math.radians(2.0))
+        relocs.append(est.info["relocalized"])
+    assert right[:3] == [True] * 3 and not any(relocs[:3])       # tracking: no false jump
+    assert not right[3]                                          # the kidnap: lost ...
+    assert any(right[4:6]) and right[-1] and any(relocs[4:])     # ... found within two scans
+
+
+def test_recovery_parameters_are_checked() -> None:
+    from tfloc.relocalize.recovery import RecoveringTracker
+
+    with pytest.raises(ParameterError, match="lost_after must be >= 1"):
+        RecoveringTracker(None, None, lost_after=0)
