@@ -21,6 +21,7 @@ LAYERS = (
     "tfloc.maps",        # vector and grid maps, ray casting, the distance field, the per-map cache
     "tfloc.paper",       # the paper's method (Algs. 1–5): `tf`
     "tfloc.tfplus",      # the project's own variant: `tf-plus`
+    "tfloc.relocalize",  # global relocalization: `tf-global` (a turning-function place index)
     "tfloc.baselines",   # one module per baseline matcher (baselines/ in the repository)
     "tfloc.io",          # file formats: maps, scenario datasets, estimates, logs, bags, TUM
     "tfloc.datasets",    # the protocol's bins and sampler, simulated and real datasets, bag import

@@ -1,0 +1,87 @@
+"""Tracking with recovery: a local matcher run along a sequence that notices by its own score
+that it is lost (a kidnapped robot, a bad start) and then asks a global matcher where it is.
+
+Each scan is localized by the local matcher from the prediction (last estimate ⊕ odometry
+increment, as :class:`tfloc.core.tracker.LocalTracker`) and scored by the local matcher's own
+objective at its answer (``tf-plus``'s: the root mean square of the truncated per-beam
+residuals, metres). After ``lost_after`` consecutive scans scoring above ``lost_score`` the
+tracker is *lost*: the global matcher answers the scan without a guess, and its answer replaces
+the local one if its score is lower and at most ``accept_score``; otherwise the tracker stays
+lost and asks again at the next scan. The true pose is never read. Units: metres, radians.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+from tfloc.core.laser import LaserSpec
+from tfloc.core.map import Map
+from tfloc.core.params import resolve_params
+from tfloc.core.pose import Pose
+from tfloc.core.problem import Estimate, Problem
+from tfloc.core.tracker import PREDICTED
+
+
+@dataclass(frozen=True)
+class RecoveryConfig:
+    """When a tracker counts itself lost and takes a global answer (metres of the local
+    matcher's score).
+
+    Attributes:
+        lost_score: a scan scoring above this is a bad match ...
+        lost_after: ... and this many in a row make the tracker lost.
+        accept_score: a global answer is taken only if its score is at most this (and lower
+            than the local answer's).
+    """
+
+    RULES: ClassVar[dict] = {"> 0": ("lost_score", "accept_score"), ">= 1": ("lost_after",)}
+
+    lost_score: float = 0.05
+    lost_after: int = 2
+    accept_score: float = 0.05
+
+
+class RecoveringTracker:
+    """A local matcher as a tracker, with a global matcher for when it is lost (see the module
+    notes). ``info`` of each step: ``score`` (the answer's), ``lost`` (the tracker counted itself
+    lost at this scan), ``relocalized`` (the global answer was taken)."""
+
+    def __init__(self, local, global_, config: RecoveryConfig | None = None, **overrides) -> None:
+        self.local, self.global_ = local, global_
+        self.config = resolve_params(RecoveryConfig, config, overrides)
+        self.name = f"{getattr(local, 'name', 'local')}+{getattr(global_, 'name', 'global')}"
+        self._map: Map | None = None
+        self._laser: LaserSpec | None = None
+        self.pose: Pose | None = None
+        self.bad = 0
+
+    def start(self, map: Map, laser: LaserSpec, pose: Pose) -> None:
+        self._map, self._laser, self.pose, self.bad = map, laser, pose, 0
+
+    def step(self, ranges, odom_delta: Pose, stamp: float, where: str = "scan") -> Estimate:
+        if self.pose is None:
+            raise RuntimeError("RecoveringTracker.step before start")
+        cfg = self.config
+        guess = self.pose.compose(odom_delta)
+        problem = Problem(self._map, self._laser, ranges, guess, where=where)
+        est = self.local.localize(problem)
+        if est.info.get("status") == "no-answer" or not est.pose.is_finite():
+            est = Estimate(guess, False, est.iterations, est.evaluations, {**est.info, "status": PREDICTED})
+        score = float(self.local.score(problem, est.pose))
+        self.bad = self.bad + 1 if not score <= cfg.lost_score else 0
+        lost = self.bad >= cfg.lost_after
+        relocalized = False
+        if lost:
+            found = self.global_.localize(Problem(self._map, self._laser, ranges, None, where=where))
+            if found.info.get("status") != "no-answer" and found.pose.is_finite():
+                g_score = float(self.global_.score(problem, found.pose))
+                if g_score <= cfg.accept_score and g_score < score:
+                    est = Estimate(found.pose, found.converged, found.iterations,
+                                   est.evaluations + found.evaluations,
+                                   {**found.info, "status": "ok"}, found.hypotheses)
+                    score, relocalized, self.bad = g_score, True, 0
+        self.pose = est.pose
+        return Estimate(est.pose, est.converged, est.iterations, est.evaluations,
+                        {**est.info, "score": score, "lost": lost, "relocalized": relocalized},
+                        est.hypotheses)
