@@ -19,33 +19,42 @@ def grid_scores_kernel(table: np.ndarray, origin_x: float, origin_y: float, reso
                        points: np.ndarray, positions: np.ndarray,
                        headings: np.ndarray) -> np.ndarray:
     """Mean distance-field value ``(N, H)`` of ``points`` ``(M, 2)`` at every position × heading
-    (indices clipped into the table, whose border holds the truncation value)."""
+    (indices clipped into the table, whose border holds the truncation value).
+
+    Per heading and point, the cell indices of all positions are computed first (a loop the
+    compiler vectorises), then their table values are added; each sum runs over the points in
+    order, so the scores are those of the plain triple loop, bit for bit."""
     ny, nx = table.shape
     n, h, m = positions.shape[0], headings.shape[0], points.shape[0]
-    out = np.empty((n, h))
-    rx = np.empty((h, m))
-    ry = np.empty((h, m))
+    qx = np.empty((h, m))
+    qy = np.empty((h, m))
     for j in range(h):
         c, s = math.cos(headings[j]), math.sin(headings[j])
         for i in range(m):
-            rx[j, i] = c * points[i, 0] - s * points[i, 1]
-            ry[j, i] = s * points[i, 0] + c * points[i, 1]
+            qx[j, i] = (c * points[i, 0] - s * points[i, 1]) - origin_x
+            qy[j, i] = (s * points[i, 0] + c * points[i, 1]) - origin_y
     inv = 1.0 / resolution
-    out[:, :] = 0.0
+    px = np.ascontiguousarray(positions[:, 0])
+    py = np.ascontiguousarray(positions[:, 1])
+    flat = table.ravel()
+    acc = np.zeros((h, n))
+    idx = np.empty(n, dtype=np.int64)
     # point-major, positions innermost: consecutive look-ups walk the lattice, which is local
     # in the table (cache-friendly), where scan-point-major order jumps across the map
     for j in range(h):
+        row = acc[j]
         for i in range(m):
-            qx, qy = rx[j, i] - origin_x, ry[j, i] - origin_y
+            x0, y0 = qx[j, i], qy[j, i]
             for p in range(n):
-                ix = int(math.floor((positions[p, 0] + qx) * inv))
-                iy = int(math.floor((positions[p, 1] + qy) * inv))
-                ix = min(max(ix, 0), nx - 1)
-                iy = min(max(iy, 0), ny - 1)
-                out[p, j] += table[iy, ix]
+                ix = min(max(np.int64(math.floor((px[p] + x0) * inv)), 0), nx - 1)
+                iy = min(max(np.int64(math.floor((py[p] + y0) * inv)), 0), ny - 1)
+                idx[p] = iy * nx + ix
+            for p in range(n):
+                row[p] += flat[idx[p]]
+    out = np.empty((n, h))
     for p in range(n):
         for j in range(h):
-            out[p, j] /= m
+            out[p, j] = acc[j, p] / m
     return out
 
 
