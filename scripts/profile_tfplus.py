@@ -83,7 +83,7 @@ def main() -> None:
     probs = sample(tuple(a.datasets), a.per, a.per_real)
     rows = []
     seen = set()
-    for ds, sid, prob in probs:
+    for ds, _sid, prob in probs:
         if ds not in seen:
             seen.add(ds)
             m.prepare(prob)

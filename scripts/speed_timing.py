@@ -40,8 +40,8 @@ def main() -> None:
         pass
     import numpy as np
 
-    from tfloc.core.matcher import get_matcher
     import tfloc
+    from tfloc.core.matcher import get_matcher
     print("tfloc from", os.path.dirname(tfloc.__file__), file=sys.stderr)
 
     probs = sample(tuple(a.datasets), a.per, a.per_real)

@@ -7,7 +7,6 @@ import math
 
 import numpy as np
 import pytest
-
 from _tf_cases import TRUE, noisy_scan
 
 from tfloc.core.laser import LaserSpec
