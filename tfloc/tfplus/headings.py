@@ -11,6 +11,8 @@ through the sensor origin (:func:`tfloc.paper.shape.scan_polygon`) are not walls
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from tfloc.paper.turning import TurningFunction
@@ -25,9 +27,18 @@ def edge_histogram(tf: TurningFunction, bins: int, smoothing: float, skip_closur
         lengths, angles = lengths[1:-1], angles[1:-1]
     width = 2 * np.pi / bins
     raw = np.bincount(np.minimum((angles / width).astype(np.int64), bins - 1), lengths, bins)
+    return np.real(np.fft.ifft(np.fft.fft(raw) * _kernel_spectrum(bins, float(smoothing))))
+
+
+@lru_cache(maxsize=8)
+def _kernel_spectrum(bins: int, smoothing: float) -> np.ndarray:
+    """FFT of the circular Gaussian (``smoothing`` radians) over ``bins`` bins (read-only; it
+    depends on the parameters only, so it is made once)."""
+    width = 2 * np.pi / bins
     d = (np.arange(bins) + bins // 2) % bins - bins // 2            # circular bin offsets
-    kernel = np.exp(-0.5 * (d * width / smoothing) ** 2)
-    return np.real(np.fft.ifft(np.fft.fft(raw) * np.fft.fft(kernel)))
+    spectrum = np.fft.fft(np.exp(-0.5 * (d * width / smoothing) ** 2))
+    spectrum.setflags(write=False)
+    return spectrum
 
 
 def rotation_candidates(real: TurningFunction, virtual: TurningFunction, max_rotation: float,
