@@ -57,8 +57,10 @@ from tfloc.core.params import Configured
 from tfloc.core.pose import Pose, wrap_angle
 from tfloc.core.problem import Estimate, Problem
 from tfloc.errors import ParameterError
+from tfloc.maps.inside import SURE
+from tfloc.maps.vector import VectorMap
 
-from .kernels import scan_errors
+from .kernels import function1_kernel, scan_errors
 from .shape import ShapeConfig, scan_turning_function
 from .turning import Match, TurningFunction, match, match_l1
 
@@ -179,6 +181,27 @@ class _Cost:
             float(cfg.straw_t), float(cfg.line_threshold), bool(cfg.close_through_origin),
             cfg.resampling == "path", cfg.err_norm == "l1", self.real.breaks, self.real.angles,
             float(cfg.penalty))
+        self._vector = None
+        m = self.problem.map
+        if _FUSED and isinstance(m, VectorMap):   # Function1 in one compiled call
+            rings = m.free_rings()
+            self._vector = (self._offsets, np.zeros((0, 4)) if rings is None else rings.segs,
+                            -1.0 if rings is None else SURE, np.asarray(laser.angles, dtype=float),
+                            m.segments)
+
+    def _function1_vector(self, x: float, y: float, theta_v: float) -> tuple[float, float, float]:
+        """:meth:`function1`'s evaluation on a vector map: one compiled call
+        (:func:`tfloc.paper.kernels.function1_kernel`), shapely only near the free space's
+        boundary; the same values as the general path."""
+        offsets, rings, sure, angles, segs = self._vector
+        code, err, heading, rot = function1_kernel(x, y, theta_v, offsets, rings, sure, angles,
+                                                   segs, *self._kernel_args)
+        if code < 0:
+            if not self.problem.map.is_free(np.array([[x, y]]))[0]:
+                return float(self.config.penalty), float(theta_v + offsets[0]), 0.0
+            code, err, heading, rot = function1_kernel(x, y, theta_v, offsets, rings, -1.0, angles,
+                                                       segs, *self._kernel_args)
+        return float(err), float(heading), float(rot)
 
     def _scan_errors(self, scans: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Err and rotation offset (radians, in [-π, π)) of each virtual scan ``(P, n_beams)``."""
@@ -215,6 +238,10 @@ class _Cost:
         Returns (Err, heading of the best orientation, its rotation offset)."""
         key = (float(xy[0]), float(xy[1]))
         hit = self.cache.get(key)
+        if hit is None and self._vector is not None:
+            hit = self._function1_vector(key[0], key[1], theta_v)
+            self.evaluations += len(self._offsets)
+            self.cache[key] = hit
         if hit is None:
             th = theta_v + self._offsets
             poses = np.empty((len(th), 3))
