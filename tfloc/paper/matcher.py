@@ -61,6 +61,7 @@ from tfloc.maps.inside import SURE
 from tfloc.maps.vector import VectorMap
 
 from .kernels import function1_kernel, scan_errors
+from .search_kernel import search_kernel
 from .shape import ShapeConfig, scan_turning_function
 from .turning import Match, TurningFunction, match, match_l1
 
@@ -317,6 +318,10 @@ class TurningFunctionMatcher(Configured):
             return Estimate(problem.initial, False, 0, 0, {"status": "no-answer",
                                                            "reason": "real scan has < 3 polygon edges"})
         cost = _Cost(problem, cfg, real)
+        if cost._vector is not None:
+            est = self._search_compiled(problem, cost)
+            if est is not None:
+                return est
         rng = np.random.default_rng(cfg.seed)
         pose, size, iters, converged = problem.initial, cfg.simplex_size, 0, False
         err, outer = cost.function1(pose.xy, pose.theta)[0], 0
@@ -339,6 +344,24 @@ class TurningFunctionMatcher(Configured):
             err, pose = best
         return Estimate(pose, converged, iters, cost.evaluations,
                         {"err": float(err), "outer": outer, "corners": int(real.n_edges)})
+
+    def _search_compiled(self, problem: Problem, cost: _Cost) -> Estimate | None:
+        """The search below in one compiled call on a vector map
+        (:func:`tfloc.paper.search_kernel.search_kernel`: the same steps and values); ``None``
+        where it gave up (then the Python search runs)."""
+        cfg = self.config
+        phis = np.random.default_rng(cfg.seed).uniform(0.0, 2.0 * math.pi, cfg.max_outer)
+        ok, x, y, th, converged, iters, misses, err, outer = search_kernel(
+            problem.initial.x, problem.initial.y, problem.initial.theta, phis,
+            float(cfg.simplex_size), float(cfg.xy_tol), float(cfg.theta_tol),
+            float(cfg.err_threshold), int(cfg.max_iterations), int(cfg.max_outer),
+            bool(cfg.rotation_correction), float(cfg.heading_clamp), bool(cfg.keep_best),
+            (*cost._vector, *cost._kernel_args))
+        if not ok:
+            return None
+        return Estimate(Pose(float(x), float(y), float(th)), bool(converged), int(iters),
+                        int(misses) * cfg.n_orientations,
+                        {"err": float(err), "outer": int(outer), "corners": int(cost.real.n_edges)})
 
     def score(self, problem: Problem, pose: Pose) -> float:
         """Eq. 13's Err at exactly ``pose`` (no orientation search); ``penalty`` if degenerate."""

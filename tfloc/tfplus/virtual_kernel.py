@@ -7,7 +7,7 @@ is some 20 numpy calls and temporaries per iteration, more than the arithmetic i
 same steps run in one numba call, with the same arithmetic in the same order (the ray cast is
 :func:`tfloc.maps._raycast.raycast_segments` itself; the beam directions' cos/sin come from
 numpy, computed once by the caller), so the refined poses are identical
-(``tests/test_tfplus_fused.py`` compares them with the step-by-step path bit for bit).
+(``tests/test_fused_equivalence.py`` compares them with the step-by-step path bit for bit).
 """
 
 from __future__ import annotations

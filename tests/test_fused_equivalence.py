@@ -4,6 +4,7 @@ bit, as the step-by-step code they replace (the faster path is switched off to c
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,6 +14,8 @@ from tfloc.core.laser import LaserSpec
 from tfloc.tfplus import refine as refine_module
 from tfloc.tfplus.refine import RefineConfig, _virtual_geometry, refine
 from tfloc.tfplus.virtual_kernel import virtual_geometry_kernel
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def _poses(rng: np.random.Generator, n: int) -> np.ndarray:
@@ -74,3 +77,39 @@ def test_grid_scores_kernel_equals_the_plain_sum(test_room, lms200) -> None:
         expect += table[iy.astype(int), ix.astype(int)]
     got = grid_scores_kernel(table, float(ox), float(oy), f.resolution, points, positions, headings)
     assert got.tobytes() == (expect / len(points)).tobytes()
+
+
+def _office_problems(count: int):
+    """The first ``count`` scans of each offset cell of detail-1 (the furnished office)."""
+    from tfloc.harness.task import load_dataset, problem_of
+
+    scenario, scans = load_dataset(str(ROOT / "data" / "scenarios" / "detail-1"))
+    seen: dict[str, int] = {}
+    out = []
+    for s in scans.values():
+        if seen.get(s.group, 0) < count:
+            seen[s.group] = seen.get(s.group, 0) + 1
+            out.append(problem_of(scenario, s))
+    return out
+
+
+@pytest.mark.parametrize("name", ["tf", "tf-best"])
+def test_compiled_tf_search_gives_the_python_answers(name: str,
+                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    from tfloc.core.matcher import get_matcher
+    from tfloc.paper import matcher as paper_matcher
+
+    m = get_matcher(name)
+    for problem in _office_problems(1):
+        fast = m.localize(problem)
+        monkeypatch.setattr(paper_matcher, "_FUSED", False)
+        slow = m.localize(problem)
+        monkeypatch.setattr(paper_matcher, "_FUSED", True)
+        assert (fast.pose, fast.converged, fast.iterations, fast.evaluations, fast.info) == \
+            (slow.pose, slow.converged, slow.iterations, slow.evaluations, slow.info)
+
+
+def test_simplex_directions_drawn_at_once_equal_one_by_one() -> None:
+    rng = np.random.default_rng(7)
+    one_by_one = [rng.uniform(0.0, 2.0 * math.pi) for _ in range(8)]
+    assert np.array_equal(np.random.default_rng(7).uniform(0.0, 2.0 * math.pi, 8), one_by_one)
