@@ -1,7 +1,8 @@
 """A compiled point-in-area test that gives shapely's answers, for many single-point queries.
 
 ``shapely.contains_xy`` / ``intersects_xy`` cost a few microseconds per call whatever the number of
-points, and ``tf`` asks one point per cost evaluation (hundreds per scan). :class:`Rings` holds the
+points, and ``tf`` asks one point per cost evaluation (hundreds per scan); for many points at
+once shapely's indexed test is the faster and answers (more than :data:`FEW` points). :class:`Rings` holds the
 boundary segments of a valid (Multi)Polygon and answers by crossing parity, compiled; a point
 closer than :data:`SURE` metres to the boundary is *unsure* and left to shapely, so every answer is
 shapely's: away from the boundary the parity of a valid polygon's rings is the interior (the
@@ -19,6 +20,7 @@ from numba import njit
 from shapely.geometry.base import BaseGeometry
 
 SURE = 1e-7  # metres from the boundary beyond which the compiled test decides alone
+FEW = 8      # queries of more points go to shapely (its prepared geometry is indexed)
 
 
 @njit(cache=True, nogil=True)
@@ -73,10 +75,12 @@ class Rings:
         the interior or on the boundary (True: ``intersects_xy``)."""
         x = np.ascontiguousarray(xy[:, 0], dtype=float)
         y = np.ascontiguousarray(xy[:, 1], dtype=float)
+        test = shapely.intersects_xy if boundary else shapely.contains_xy
+        if len(x) > FEW:       # shapely's indexed test is the faster for many points
+            return test(self.geom, x, y)
         code = inside_kernel(x, y, self.segs, SURE)
         out = code == 1
         unsure = code < 0
         if unsure.any():
-            test = shapely.intersects_xy if boundary else shapely.contains_xy
             out[unsure] = test(self.geom, x[unsure], y[unsure])
         return out
