@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from _tf_cases import TRUE, noisy_scan
+from numba import njit
 
 from tfloc.core.laser import LaserSpec
 from tfloc.tfplus import refine as refine_module
@@ -113,3 +114,59 @@ def test_simplex_directions_drawn_at_once_equal_one_by_one() -> None:
     rng = np.random.default_rng(7)
     one_by_one = [rng.uniform(0.0, 2.0 * math.pi) for _ in range(8)]
     assert np.array_equal(np.random.default_rng(7).uniform(0.0, 2.0 * math.pi, 8), one_by_one)
+
+
+@njit(cache=False)
+def _pairs_reference(points, delta, q, normal, angle_min, resolution, window, gate):
+    """The point-to-line pairing as it was written before the speed work (exact atan2, NaN tests
+    in the window, the Jacobian as a tuple)."""
+    k_n, m = delta.shape[0], points.shape[0]
+    n = q.shape[1]
+    hh = np.zeros((k_n, 3, 3))
+    gg = np.zeros((k_n, 3))
+    res = np.full((k_n, m), np.nan)
+    for k in range(k_n):
+        c, s = math.cos(delta[k, 2]), math.sin(delta[k, 2])
+        for i in range(m):
+            rx = c * points[i, 0] - s * points[i, 1]
+            ry = s * points[i, 0] + c * points[i, 1]
+            x, y = rx + delta[k, 0], ry + delta[k, 1]
+            j0 = int(round((math.atan2(y, x) - angle_min) / resolution))
+            best, bj = gate * gate, -1
+            for j in range(max(j0 - window, 0), min(j0 + window + 1, n)):
+                qx = q[k, j, 0]
+                if math.isnan(qx) or math.isnan(normal[k, j, 0]):
+                    continue
+                d2 = (x - qx) ** 2 + (y - q[k, j, 1]) ** 2
+                if d2 < best:
+                    best, bj = d2, j
+            if bj < 0:
+                continue
+            nx, ny = normal[k, bj, 0], normal[k, bj, 1]
+            r = nx * (x - q[k, bj, 0]) + ny * (y - q[k, bj, 1])
+            res[k, i] = r
+            jac = (nx, ny, -nx * ry + ny * rx)
+            for a in range(3):
+                gg[k, a] += jac[a] * r
+                for b in range(3):
+                    hh[k, a, b] += jac[a] * jac[b]
+    return hh, gg, res
+
+
+def test_pairs_kernel_equals_the_reference(test_room, lms200) -> None:
+    from tfloc.tfplus.kernels import pairs_kernel
+
+    rng = np.random.default_rng(11)
+    points = lms200.to_points(noisy_scan(test_room, lms200, TRUE, 3))
+    # points on every bearing, including exact half steps between beams
+    half = lms200.angle_min + (np.arange(lms200.n_beams - 1) + 0.5) * lms200.resolution
+    points = np.vstack((points, 2.0 * np.column_stack((np.cos(half), np.sin(half)))))
+    for gate in (0.05, 0.5):
+        poses = _poses(rng, 4)
+        q, normal = _virtual_geometry(test_room.raycast(poses, lms200), lms200)
+        delta = rng.normal(0.0, 0.02, (4, 3)) if gate > 0.1 else np.zeros((4, 3))
+        got = pairs_kernel(points, delta, q, normal, lms200.angle_min, lms200.resolution, 6, gate)
+        ref = _pairs_reference(points, delta, q, normal, lms200.angle_min, lms200.resolution, 6,
+                               gate)
+        for a, b in zip(got, ref, strict=True):
+            assert a.tobytes() == b.tobytes()
