@@ -12,6 +12,7 @@ from _tf_cases import TRUE, noisy_scan
 from numba import njit
 
 from tfloc.core.laser import LaserSpec
+from tfloc.core.pose import Pose
 from tfloc.tfplus import refine as refine_module
 from tfloc.tfplus.refine import RefineConfig, _virtual_geometry, refine
 from tfloc.tfplus.virtual_kernel import virtual_geometry_kernel
@@ -170,3 +171,47 @@ def test_pairs_kernel_equals_the_reference(test_room, lms200) -> None:
                                gate)
         for a, b in zip(got, ref, strict=True):
             assert a.tobytes() == b.tobytes()
+
+
+def test_rotation_candidates_equal_the_step_by_step_histograms(test_room, lms200) -> None:
+    from tfloc.paper.shape import ShapeConfig, scan_turning_function
+    from tfloc.tfplus.headings import edge_histogram, rotation_candidates
+
+    shape = ShapeConfig(spacing=0.05)
+    rng = np.random.default_rng(4)
+    real = scan_turning_function(noisy_scan(test_room, lms200, TRUE, 1), lms200, shape)
+    for pose in _poses(rng, 12):
+        virtual = scan_turning_function(test_room.raycast(pose, lms200), lms200, shape)
+        for skip in (True, False):
+            hr = edge_histogram(real, 720, math.radians(1.0), skip)
+            hv = edge_histogram(virtual, 720, math.radians(1.0), skip)
+            corr = np.real(np.fft.ifft(np.fft.fft(hr) * np.conj(np.fft.fft(hv))))
+            k = int(np.floor(math.radians(20) / (2 * np.pi / 720)))
+            c = corr[np.arange(-k, k + 1) % 720]
+            peak = (c >= np.roll(c, 1)) & (c >= np.roll(c, -1))
+            peak[0] = peak[-1] = False
+            order = np.argsort(-np.where(peak, c, -np.inf))[:3]
+            order = order[peak[order]]
+            if len(order) == 0:
+                order = np.array([int(np.argmax(c))])
+            expect = np.arange(-k, k + 1)[order] * (2 * np.pi / 720)
+            got = rotation_candidates(real, virtual, math.radians(20), 3, skip_closure=skip)
+            assert got.tobytes() == expect.tobytes()
+
+
+def test_tf_plus_turning_function_equals_the_step_by_step_one(test_room, lms200) -> None:
+    from tfloc.paper.shape import ShapeConfig, scan_turning_function
+    from tfloc.tfplus.matcher import _turning_function
+
+    rng = np.random.default_rng(6)
+    for shape in (ShapeConfig(spacing=0.05), ShapeConfig(spacing=0.05, resampling="path"),
+                  ShapeConfig(close_through_origin=False)):
+        for seed, pose in enumerate(_poses(rng, 6)):
+            ranges = noisy_scan(test_room, lms200, Pose(*pose), seed)
+            ranges[::23] = np.inf
+            a, b = scan_turning_function(ranges, lms200, shape), _turning_function(ranges, lms200, shape)
+            assert a.breaks.tobytes() == b.breaks.tobytes()
+            assert a.angles.tobytes() == b.angles.tobytes()
+    few = np.full(lms200.n_beams, np.inf)
+    few[90:92] = 2.0
+    assert scan_turning_function(few, lms200) is None and _turning_function(few, lms200, ShapeConfig()) is None
