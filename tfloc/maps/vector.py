@@ -14,6 +14,7 @@ from tfloc.core.map import as_pose_array
 from tfloc.core.pose import Pose
 
 from ._raycast import raycast_segments
+from .inside import Rings
 
 
 def _segments_of(geom: BaseGeometry) -> np.ndarray:
@@ -104,16 +105,36 @@ class VectorMap:
             self._free_cache[key] = free
         return self._free_cache[key]
 
+    def _rings(self, key: object, geom: BaseGeometry) -> Rings | None:
+        """The compiled point-in-area test of ``geom`` (:mod:`tfloc.maps.inside`), made once."""
+        if key not in self._free_cache:
+            self._free_cache[key] = Rings.of(geom)
+        return self._free_cache[key]
+
+    def free_rings(self, clearance: float = 0.0) -> Rings | None:
+        """The compiled test behind :meth:`is_free` (``None``: shapely answers), for callers that
+        run it inside their own compiled code."""
+        return self._rings(("rings", round(float(clearance), 9)), self._free_space(clearance))
+
     def is_free(self, xy: np.ndarray, clearance: float = 0.0) -> np.ndarray:
-        """Which ``(N, 2)`` points are in free space at least ``clearance`` metres from geometry."""
+        """Which ``(N, 2)`` points are in free space at least ``clearance`` metres from geometry
+        (shapely's ``contains_xy``; answered by the compiled :class:`~tfloc.maps.inside.Rings`,
+        which defers to shapely near the boundary)."""
         p = np.asarray(xy, dtype=float).reshape(-1, 2)
+        rings = self.free_rings(clearance)
+        if rings is not None:
+            return rings.contains(p, boundary=False)
         return shapely.contains_xy(self._free_space(clearance), p[:, 0], p[:, 1])
 
     def in_bounds(self, xy: np.ndarray) -> np.ndarray:
-        """Which ``(N, 2)`` points lie inside the mapped area (boundary included)."""
+        """Which ``(N, 2)`` points lie inside the mapped area (boundary included; shapely's
+        ``intersects_xy``, answered as :meth:`is_free` is)."""
         p = np.asarray(xy, dtype=float).reshape(-1, 2)
         area = self.area
         shapely.prepare(area)
+        rings = self._rings("area-rings", area)
+        if rings is not None:
+            return rings.contains(p, boundary=True)
         return shapely.intersects_xy(area, p[:, 0], p[:, 1])
 
     def sample_points(self, spacing: float) -> tuple[np.ndarray, np.ndarray]:

@@ -15,6 +15,8 @@ import numpy as np
 from numba import njit
 
 from tfloc.core.laser import _returns_to_points
+from tfloc.maps._raycast import raycast_segments
+from tfloc.maps.inside import inside_kernel
 
 from .corners import _shortstraw
 from .turning import TWO_PI, _match, _match_l1, _turning
@@ -72,3 +74,39 @@ def scan_errors(scans: np.ndarray, directions: np.ndarray, max_range: float, spa
             err[p] = np.sqrt(max(e2, 0.0))
         rot[p] = wrap_rotation(r)
     return err, rot
+
+
+@njit(cache=True, nogil=True)
+def function1_kernel(x: float, y: float, theta_v: float, offsets: np.ndarray, rings: np.ndarray,
+                     sure: float, rel_angles: np.ndarray, segs: np.ndarray, directions: np.ndarray,
+                     max_range: float, spacing: float, window: int, t: float,
+                     line_threshold: float, close_through_origin: bool, along_path: bool,
+                     l1: bool, real_breaks: np.ndarray, real_angles: np.ndarray,
+                     penalty: float) -> tuple[int, float, float, float]:
+    """Alg. 5's Function1 at ``(x, y)`` on a vector map (segments ``segs``), in one call: whether
+    the position is free (:func:`tfloc.maps.inside.inside_kernel` on the free space's ``rings``;
+    ``sure`` < 0 skips the test, the caller having made it), the virtual scans of the headings
+    ``theta_v + offsets`` (:func:`tfloc.maps._raycast.raycast_segments`), their Err and rotation
+    offsets (:func:`scan_errors`) and the best of them (the first lowest Err, as ``np.argmin``).
+
+    Returns ``(code, Err, heading, rotation)``: code 1 answered, 0 not free (the rest unset),
+    -1 too near the free space's boundary to say (ask shapely, then call again with ``sure`` < 0)."""
+    if sure >= 0.0:
+        code = inside_kernel(np.array([x]), np.array([y]), rings, sure)[0]
+        if code != 1:
+            return np.int64(code), penalty, theta_v + offsets[0], 0.0
+    n = offsets.shape[0]
+    poses = np.empty((n, 3))
+    for k in range(n):
+        poses[k, 0], poses[k, 1], poses[k, 2] = x, y, theta_v + offsets[k]
+    scans = raycast_segments(poses, rel_angles, segs, max_range)
+    err, rot = scan_errors(scans, directions, max_range, spacing, window, t, line_threshold,
+                           close_through_origin, along_path, l1, real_breaks, real_angles, penalty)
+    b = 0
+    for k in range(n):
+        if np.isnan(err[k]):
+            b = k
+            break
+        if err[k] < err[b]:
+            b = k
+    return np.int64(1), err[b], poses[b, 2], rot[b]

@@ -57,8 +57,11 @@ from tfloc.core.params import Configured
 from tfloc.core.pose import Pose, wrap_angle
 from tfloc.core.problem import Estimate, Problem
 from tfloc.errors import ParameterError
+from tfloc.maps.inside import SURE
+from tfloc.maps.vector import VectorMap
 
-from .kernels import scan_errors
+from .kernels import function1_kernel, scan_errors
+from .search_kernel import search_kernel
 from .shape import ShapeConfig, scan_turning_function
 from .turning import Match, TurningFunction, match, match_l1
 
@@ -179,6 +182,27 @@ class _Cost:
             float(cfg.straw_t), float(cfg.line_threshold), bool(cfg.close_through_origin),
             cfg.resampling == "path", cfg.err_norm == "l1", self.real.breaks, self.real.angles,
             float(cfg.penalty))
+        self._vector = None
+        m = self.problem.map
+        if _FUSED and isinstance(m, VectorMap):   # Function1 in one compiled call
+            rings = m.free_rings()
+            self._vector = (self._offsets, np.zeros((0, 4)) if rings is None else rings.segs,
+                            -1.0 if rings is None else SURE, np.asarray(laser.angles, dtype=float),
+                            m.segments)
+
+    def _function1_vector(self, x: float, y: float, theta_v: float) -> tuple[float, float, float]:
+        """:meth:`function1`'s evaluation on a vector map: one compiled call
+        (:func:`tfloc.paper.kernels.function1_kernel`), shapely only near the free space's
+        boundary; the same values as the general path."""
+        offsets, rings, sure, angles, segs = self._vector
+        code, err, heading, rot = function1_kernel(x, y, theta_v, offsets, rings, sure, angles,
+                                                   segs, *self._kernel_args)
+        if code < 0:
+            if not self.problem.map.is_free(np.array([[x, y]]))[0]:
+                return float(self.config.penalty), float(theta_v + offsets[0]), 0.0
+            code, err, heading, rot = function1_kernel(x, y, theta_v, offsets, rings, -1.0, angles,
+                                                       segs, *self._kernel_args)
+        return float(err), float(heading), float(rot)
 
     def _scan_errors(self, scans: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Err and rotation offset (radians, in [-π, π)) of each virtual scan ``(P, n_beams)``."""
@@ -215,6 +239,10 @@ class _Cost:
         Returns (Err, heading of the best orientation, its rotation offset)."""
         key = (float(xy[0]), float(xy[1]))
         hit = self.cache.get(key)
+        if hit is None and self._vector is not None:
+            hit = self._function1_vector(key[0], key[1], theta_v)
+            self.evaluations += len(self._offsets)
+            self.cache[key] = hit
         if hit is None:
             th = theta_v + self._offsets
             poses = np.empty((len(th), 3))
@@ -290,6 +318,10 @@ class TurningFunctionMatcher(Configured):
             return Estimate(problem.initial, False, 0, 0, {"status": "no-answer",
                                                            "reason": "real scan has < 3 polygon edges"})
         cost = _Cost(problem, cfg, real)
+        if cost._vector is not None:
+            est = self._search_compiled(problem, cost)
+            if est is not None:
+                return est
         rng = np.random.default_rng(cfg.seed)
         pose, size, iters, converged = problem.initial, cfg.simplex_size, 0, False
         err, outer = cost.function1(pose.xy, pose.theta)[0], 0
@@ -312,6 +344,24 @@ class TurningFunctionMatcher(Configured):
             err, pose = best
         return Estimate(pose, converged, iters, cost.evaluations,
                         {"err": float(err), "outer": outer, "corners": int(real.n_edges)})
+
+    def _search_compiled(self, problem: Problem, cost: _Cost) -> Estimate | None:
+        """The search below in one compiled call on a vector map
+        (:func:`tfloc.paper.search_kernel.search_kernel`: the same steps and values); ``None``
+        where it gave up (then the Python search runs)."""
+        cfg = self.config
+        phis = np.random.default_rng(cfg.seed).uniform(0.0, 2.0 * math.pi, cfg.max_outer)
+        ok, x, y, th, converged, iters, misses, err, outer = search_kernel(
+            problem.initial.x, problem.initial.y, problem.initial.theta, phis,
+            float(cfg.simplex_size), float(cfg.xy_tol), float(cfg.theta_tol),
+            float(cfg.err_threshold), int(cfg.max_iterations), int(cfg.max_outer),
+            bool(cfg.rotation_correction), float(cfg.heading_clamp), bool(cfg.keep_best),
+            (*cost._vector, *cost._kernel_args))
+        if not ok:
+            return None
+        return Estimate(Pose(float(x), float(y), float(th)), bool(converged), int(iters),
+                        int(misses) * cfg.n_orientations,
+                        {"err": float(err), "outer": int(outer), "corners": int(cost.real.n_edges)})
 
     def score(self, problem: Problem, pose: Pose) -> float:
         """Eq. 13's Err at exactly ``pose`` (no orientation search); ``penalty`` if degenerate."""

@@ -12,6 +12,8 @@ every candidate, then on all points for a shortlist. The best few candidates, at
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from tfloc.core.map import Map
@@ -25,17 +27,25 @@ def lattice(map_: Map, field: MapView, centre: np.ndarray, radius: float, step: 
     """Free lattice positions ``(N, 2)`` (metres) within ``radius`` of ``centre``, centre first,
     at least ``clearance`` from the map's points (by the distance field: a clearance query to
     the map itself can cost more than the whole search on a map used once)."""
+    xy = centre[None, :] + _offsets(float(radius), float(step))
+    keep = field(xy) >= clearance
+    keep[keep] = map_.in_bounds(xy[keep])
+    keep[keep] = map_.is_free(xy[keep])
+    return xy[keep]
+
+
+@lru_cache(maxsize=16)
+def _offsets(radius: float, step: float) -> np.ndarray:
+    """Lattice offsets ``(N, 2)`` (metres) within ``radius``, nearest first (read-only; they
+    depend on the configuration only, so they are made once)."""
     k = int(np.floor(radius / step))
     g = np.arange(-k, k + 1) * step
     gx, gy = np.meshgrid(g, g)
     off = np.column_stack((gx.ravel(), gy.ravel()))
     off = off[np.hypot(off[:, 0], off[:, 1]) <= radius + 1e-9]
     off = off[np.argsort(np.hypot(off[:, 0], off[:, 1]), kind="stable")]
-    xy = centre[None, :] + off
-    keep = field(xy) >= clearance
-    keep[keep] = map_.in_bounds(xy[keep])
-    keep[keep] = map_.is_free(xy[keep])
-    return xy[keep]
+    off.setflags(write=False)
+    return off
 
 
 def grid_scores(field: MapView, points: np.ndarray, positions: np.ndarray,

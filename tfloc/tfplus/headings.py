@@ -11,7 +11,10 @@ through the sensor origin (:func:`tfloc.paper.shape.scan_polygon`) are not walls
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
+from numba import njit
 
 from tfloc.paper.turning import TurningFunction
 
@@ -25,9 +28,37 @@ def edge_histogram(tf: TurningFunction, bins: int, smoothing: float, skip_closur
         lengths, angles = lengths[1:-1], angles[1:-1]
     width = 2 * np.pi / bins
     raw = np.bincount(np.minimum((angles / width).astype(np.int64), bins - 1), lengths, bins)
+    return np.real(np.fft.ifft(np.fft.fft(raw) * _kernel_spectrum(bins, float(smoothing))))
+
+
+@njit(cache=True, nogil=True)
+def _raw_histograms(real_breaks: np.ndarray, real_angles: np.ndarray, virtual_breaks: np.ndarray,
+                    virtual_angles: np.ndarray, bins: int, skip_closure: bool) -> np.ndarray:
+    """:func:`edge_histogram`'s histograms before smoothing, of the real (row 0) and the virtual
+    (row 1) turning function, ``(2, bins)``: the same values as its numpy steps (Python's float
+    ``%`` is ``np.mod``; weights added in edge order as ``np.bincount`` adds them)."""
+    out = np.zeros((2, bins))
+    width = 2 * np.pi / bins
+    for row in range(2):
+        breaks = real_breaks if row == 0 else virtual_breaks
+        angles = real_angles if row == 0 else virtual_angles
+        n = angles.shape[0]
+        lo, hi = (1, n - 1) if skip_closure and n > 3 else (0, n)
+        for i in range(lo, hi):
+            b = min(np.int64((angles[i] % (2 * np.pi)) / width), bins - 1)
+            out[row, b] += breaks[i + 1] - breaks[i]
+    return out
+
+
+@lru_cache(maxsize=8)
+def _kernel_spectrum(bins: int, smoothing: float) -> np.ndarray:
+    """FFT of the circular Gaussian (``smoothing`` radians) over ``bins`` bins (read-only; it
+    depends on the parameters only, so it is made once)."""
+    width = 2 * np.pi / bins
     d = (np.arange(bins) + bins // 2) % bins - bins // 2            # circular bin offsets
-    kernel = np.exp(-0.5 * (d * width / smoothing) ** 2)
-    return np.real(np.fft.ifft(np.fft.fft(raw) * np.fft.fft(kernel)))
+    spectrum = np.fft.fft(np.exp(-0.5 * (d * width / smoothing) ** 2))
+    spectrum.setflags(write=False)
+    return spectrum
 
 
 def rotation_candidates(real: TurningFunction, virtual: TurningFunction, max_rotation: float,
@@ -35,9 +66,12 @@ def rotation_candidates(real: TurningFunction, virtual: TurningFunction, max_rot
                         skip_closure: bool = True) -> np.ndarray:
     """Up to ``count`` rotation offsets (radians, real = virtual rotated by it), best first:
     the highest local maxima of the histograms' circular cross-correlation within ±max_rotation."""
-    hr = edge_histogram(real, bins, smoothing, skip_closure)
-    hv = edge_histogram(virtual, bins, smoothing, skip_closure)
-    corr = np.real(np.fft.ifft(np.fft.fft(hr) * np.conj(np.fft.fft(hv))))   # corr[k]: hv shifted by k
+    # edge_histogram of both at once: the raw histograms compiled, the two rows' FFTs in one call
+    raw = _raw_histograms(real.breaks, real.angles, virtual.breaks, virtual.angles, bins,
+                          skip_closure)
+    smooth = np.real(np.fft.ifft(np.fft.fft(raw) * _kernel_spectrum(bins, float(smoothing))))
+    spectrum_r, spectrum_v = np.fft.fft(smooth)
+    corr = np.real(np.fft.ifft(spectrum_r * np.conj(spectrum_v)))   # corr[k]: hv shifted by k
     width = 2 * np.pi / bins
     k = int(np.floor(max_rotation / width))
     shifts = np.arange(-k, k + 1)

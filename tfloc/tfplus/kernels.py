@@ -12,6 +12,7 @@ import numpy as np
 from numba import njit
 
 from tfloc.maps._gridcast import _entry, _start, _step
+from tfloc.maps._raycast import _atan2
 
 
 @njit(cache=True, nogil=True)
@@ -19,33 +20,42 @@ def grid_scores_kernel(table: np.ndarray, origin_x: float, origin_y: float, reso
                        points: np.ndarray, positions: np.ndarray,
                        headings: np.ndarray) -> np.ndarray:
     """Mean distance-field value ``(N, H)`` of ``points`` ``(M, 2)`` at every position × heading
-    (indices clipped into the table, whose border holds the truncation value)."""
+    (indices clipped into the table, whose border holds the truncation value).
+
+    Per heading and point, the cell indices of all positions are computed first (a loop the
+    compiler vectorises), then their table values are added; each sum runs over the points in
+    order, so the scores are those of the plain triple loop, bit for bit."""
     ny, nx = table.shape
     n, h, m = positions.shape[0], headings.shape[0], points.shape[0]
-    out = np.empty((n, h))
-    rx = np.empty((h, m))
-    ry = np.empty((h, m))
+    qx = np.empty((h, m))
+    qy = np.empty((h, m))
     for j in range(h):
         c, s = math.cos(headings[j]), math.sin(headings[j])
         for i in range(m):
-            rx[j, i] = c * points[i, 0] - s * points[i, 1]
-            ry[j, i] = s * points[i, 0] + c * points[i, 1]
+            qx[j, i] = (c * points[i, 0] - s * points[i, 1]) - origin_x
+            qy[j, i] = (s * points[i, 0] + c * points[i, 1]) - origin_y
     inv = 1.0 / resolution
-    out[:, :] = 0.0
+    px = np.ascontiguousarray(positions[:, 0])
+    py = np.ascontiguousarray(positions[:, 1])
+    flat = table.ravel()
+    acc = np.zeros((h, n))
+    idx = np.empty(n, dtype=np.int64)
     # point-major, positions innermost: consecutive look-ups walk the lattice, which is local
     # in the table (cache-friendly), where scan-point-major order jumps across the map
     for j in range(h):
+        row = acc[j]
         for i in range(m):
-            qx, qy = rx[j, i] - origin_x, ry[j, i] - origin_y
+            x0, y0 = qx[j, i], qy[j, i]
             for p in range(n):
-                ix = int(math.floor((positions[p, 0] + qx) * inv))
-                iy = int(math.floor((positions[p, 1] + qy) * inv))
-                ix = min(max(ix, 0), nx - 1)
-                iy = min(max(iy, 0), ny - 1)
-                out[p, j] += table[iy, ix]
+                ix = min(max(np.int64(math.floor((px[p] + x0) * inv)), 0), nx - 1)
+                iy = min(max(np.int64(math.floor((py[p] + y0) * inv)), 0), ny - 1)
+                idx[p] = iy * nx + ix
+            for p in range(n):
+                row[p] += flat[idx[p]]
+    out = np.empty((n, h))
     for p in range(n):
         for j in range(h):
-            out[p, j] /= m
+            out[p, j] = acc[j, p] / m
     return out
 
 
@@ -92,6 +102,17 @@ def separated_kernel(poses: np.ndarray, count: int, separation: float) -> np.nda
 
 
 @njit(cache=True, nogil=True)
+def _bearing_index(x: float, y: float, angle_min: float, resolution: float) -> int:
+    """``round((atan2(y, x) − angle_min) / resolution)``, the beam nearest the bearing of
+    ``(x, y)``: from the cheap :func:`~tfloc.maps._raycast._atan2` (error below 1e-5 rad), and
+    from ``math.atan2`` where the two could round differently (within 1e-4 rad of a half step)."""
+    v = (_atan2(y, x) - angle_min) / resolution
+    if abs(v - math.floor(v) - 0.5) > 1e-4 / resolution:
+        return int(math.floor(v + 0.5))
+    return int(round((math.atan2(y, x) - angle_min) / resolution))
+
+
+@njit(cache=True, nogil=True)
 def pairs_kernel(points: np.ndarray, delta: np.ndarray, q: np.ndarray, normal: np.ndarray,
                  angle_min: float, resolution: float, window: int, gate: float,
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -109,19 +130,24 @@ def pairs_kernel(points: np.ndarray, delta: np.ndarray, q: np.ndarray, normal: n
     hh = np.zeros((k_n, 3, 3))
     gg = np.zeros((k_n, 3))
     res = np.full((k_n, m), np.nan)
+    vx = np.empty(n)          # a candidate's virtual points, +inf where there is none (never
+    vy = np.empty(n)          # nearer than the gate: the same pairs as skipping them)
     for k in range(k_n):
+        for j in range(n):
+            if math.isnan(q[k, j, 0]) or math.isnan(normal[k, j, 0]):
+                vx[j], vy[j] = np.inf, 0.0
+            else:
+                vx[j], vy[j] = q[k, j, 0], q[k, j, 1]
         c, s = math.cos(delta[k, 2]), math.sin(delta[k, 2])
         for i in range(m):
             rx = c * points[i, 0] - s * points[i, 1]
             ry = s * points[i, 0] + c * points[i, 1]
             x, y = rx + delta[k, 0], ry + delta[k, 1]
-            j0 = int(round((math.atan2(y, x) - angle_min) / resolution))
+            j0 = _bearing_index(x, y, angle_min, resolution)
             best, bj = gate * gate, -1
             for j in range(max(j0 - window, 0), min(j0 + window + 1, n)):
-                qx = q[k, j, 0]
-                if math.isnan(qx) or math.isnan(normal[k, j, 0]):
-                    continue
-                d2 = (x - qx) ** 2 + (y - q[k, j, 1]) ** 2
+                dx, dy = x - vx[j], y - vy[j]
+                d2 = dx * dx + dy * dy
                 if d2 < best:
                     best, bj = d2, j
             if bj < 0:
@@ -129,11 +155,19 @@ def pairs_kernel(points: np.ndarray, delta: np.ndarray, q: np.ndarray, normal: n
             nx, ny = normal[k, bj, 0], normal[k, bj, 1]
             r = nx * (x - q[k, bj, 0]) + ny * (y - q[k, bj, 1])
             res[k, i] = r
-            jac = (nx, ny, -nx * ry + ny * rx)
-            for a in range(3):
-                gg[k, a] += jac[a] * r
-                for b in range(3):
-                    hh[k, a, b] += jac[a] * jac[b]
+            j0_, j1_, j2_ = nx, ny, -nx * ry + ny * rx
+            gg[k, 0] += j0_ * r
+            gg[k, 1] += j1_ * r
+            gg[k, 2] += j2_ * r
+            hh[k, 0, 0] += j0_ * j0_
+            hh[k, 0, 1] += j0_ * j1_
+            hh[k, 0, 2] += j0_ * j2_
+            hh[k, 1, 0] += j1_ * j0_
+            hh[k, 1, 1] += j1_ * j1_
+            hh[k, 1, 2] += j1_ * j2_
+            hh[k, 2, 0] += j2_ * j0_
+            hh[k, 2, 1] += j2_ * j1_
+            hh[k, 2, 2] += j2_ * j2_
     return hh, gg, res
 
 

@@ -51,13 +51,15 @@ from typing import ClassVar
 
 import numpy as np
 
+from tfloc.core.laser import LaserSpec
 from tfloc.core.map import Map
 from tfloc.core.params import Configured
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
 from tfloc.maps.grid import GridMap
+from tfloc.paper.kernels import scan_turning
 from tfloc.paper.shape import ShapeConfig, scan_turning_function
-from tfloc.paper.turning import match
+from tfloc.paper.turning import TurningFunction, match
 
 from .coarse import best_candidates, lattice, pose_scores, search
 from .cost import scan_cost
@@ -184,14 +186,25 @@ def heading_seeds(problem: Problem, cfg: TfPlusConfig) -> tuple[np.ndarray, dict
     else:
         heads.append(th0 + offsets)
     if cfg.tf_seed:
-        real = scan_turning_function(problem.ranges, problem.laser, cfg.shape)
-        virtual = scan_turning_function(problem.map.raycast(problem.initial, problem.laser),
-                                        problem.laser, cfg.shape)
+        real = _turning_function(problem.ranges, problem.laser, cfg.shape)
+        virtual = _turning_function(problem.map.raycast(problem.initial, problem.laser),
+                                    problem.laser, cfg.shape)
         if real is not None and virtual is not None:
             rots = rotation_candidates(real, virtual, cfg.max_rotation, cfg.rotation_seeds)
             heads += [th0 - r + offsets for r in rots]
             info = {"tf_rotations": [float(r) for r in rots]}
     return np.concatenate(heads), info
+
+
+def _turning_function(ranges: np.ndarray, laser: LaserSpec,
+                      shape: ShapeConfig) -> TurningFunction | None:
+    """:func:`tfloc.paper.shape.scan_turning_function` in one compiled call
+    (:func:`tfloc.paper.kernels.scan_turning`, the same kernels in the same order)."""
+    breaks, angles = scan_turning(np.asarray(ranges, dtype=float), laser.directions,
+                                  float(laser.max_range), float(shape.spacing), int(shape.window),
+                                  float(shape.straw_t), float(shape.line_threshold),
+                                  bool(shape.close_through_origin), shape.resampling == "path")
+    return TurningFunction(breaks, angles) if len(angles) >= 3 else None
 
 
 def tf_errs(problem: Problem, poses: np.ndarray, cfg: TfPlusConfig) -> np.ndarray:

@@ -54,9 +54,13 @@ import numpy as np
 from tfloc.core.laser import LaserSpec
 from tfloc.core.map import Map
 from tfloc.core.pose import wrap_angle
+from tfloc.maps.vector import VectorMap
 
 from .kernels import face_depths_kernel, field_pairs_kernel, pairs_kernel, refine_field_kernel
 from .view import MapView
+from .virtual_kernel import refine_virtual_kernel
+
+_FUSED = True  # refine on vector maps in compiled runs (tests switch it off to compare)
 
 
 @dataclass(frozen=True)
@@ -170,6 +174,8 @@ def refine(map_: Map, laser: LaserSpec, points: np.ndarray, poses: np.ndarray,
     points = np.ascontiguousarray(points, dtype=float)
     cfg = config
     gates = np.geomspace(cfg.gate_start, cfg.gate_end, max(cfg.iterations, 1))
+    if _FUSED and isinstance(map_, VectorMap):
+        return _refine_vector(map_, laser, points, poses, cfg, gates[:cfg.iterations])
     for it in range(cfg.iterations):
         q, normal = _virtual_geometry(map_.raycast(poses, laser), laser)
         delta = np.zeros_like(poses)
@@ -184,6 +190,40 @@ def refine(map_: Map, laser: LaserSpec, points: np.ndarray, poses: np.ndarray,
         if it + 1 == cfg.prune_after and len(poses) > cfg.keep:
             poses = _prune(poses, truncated_cost(np.abs(r), cfg.inlier_distance), cfg.keep)
     return poses
+
+
+def _refine_vector(map_: VectorMap, laser: LaserSpec, points: np.ndarray, poses: np.ndarray,
+                   cfg: RefineConfig, gates: np.ndarray) -> np.ndarray:
+    """:func:`refine` on a vector map in compiled runs of iterations
+    (:func:`~tfloc.tfplus.virtual_kernel.refine_virtual_kernel`), pruning between them: the same
+    poses as the step-by-step loop, without its per-iteration Python and numpy overhead."""
+    angles = np.asarray(laser.angles, dtype=float)
+    cos_a, sin_a = _beam_trig(laser)
+    prune_at = 0 < cfg.prune_after <= len(gates)     # as the loop: after iteration prune_after
+    cut = cfg.prune_after if prune_at else len(gates)
+    for part, prune in ((gates[:cut], prune_at), (gates[cut:], False)):
+        if len(part) == 0:
+            continue
+        poses, r = refine_virtual_kernel(poses, points, angles, cos_a, sin_a,
+                                         float(laser.angle_min), float(laser.resolution),
+                                         map_.segments, float(laser.max_range),
+                                         np.ascontiguousarray(part), cfg.inner, cfg.window,
+                                         cfg.damping)
+        if prune and len(poses) > cfg.keep:
+            poses = _prune(poses, truncated_cost(np.abs(r), cfg.inlier_distance), cfg.keep)
+    return poses
+
+
+_TRIG: dict = {}
+
+
+def _beam_trig(laser: LaserSpec) -> tuple[np.ndarray, np.ndarray]:
+    """``(cos, sin)`` of the beam angles, as numpy computes them (cached per laser)."""
+    key = (laser.angle_min, laser.resolution, laser.n_beams)
+    hit = _TRIG.get(key)
+    if hit is None:
+        hit = _TRIG[key] = (np.cos(laser.angles), np.sin(laser.angles))
+    return hit
 
 
 def _prune(poses: np.ndarray, cost: np.ndarray, keep: int, same: float = 0.05) -> np.ndarray:

@@ -1,0 +1,217 @@
+"""The compiled paths of ``tf-plus`` and ``tf`` added for speed give the same answers, bit for
+bit, as the step-by-step code they replace (the faster path is switched off to compare)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from _tf_cases import TRUE, noisy_scan
+from numba import njit
+
+from tfloc.core.laser import LaserSpec
+from tfloc.core.pose import Pose
+from tfloc.tfplus import refine as refine_module
+from tfloc.tfplus.refine import RefineConfig, _virtual_geometry, refine
+from tfloc.tfplus.virtual_kernel import virtual_geometry_kernel
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _poses(rng: np.random.Generator, n: int) -> np.ndarray:
+    """``n`` poses up to 0.4 m / 6° from the test pose."""
+    return np.column_stack((TRUE.x + rng.uniform(-0.4, 0.4, n), TRUE.y + rng.uniform(-0.4, 0.4, n),
+                            TRUE.theta + rng.uniform(-0.1, 0.1, n)))
+
+
+def test_virtual_geometry_kernel_matches_numpy() -> None:
+    laser = LaserSpec.lms200()
+    rng = np.random.default_rng(3)
+    ranges = rng.uniform(0.5, 12.0, (5, laser.n_beams))
+    ranges[:, ::17] = np.inf                      # no returns, and runs of repeated points
+    ranges[1, 40:44] = ranges[1, 39]
+    ranges[2, 60:62] = 0.0
+    ranges[3] = ranges[3, 0]
+    q, n = _virtual_geometry(ranges, laser)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        kq, kn = virtual_geometry_kernel(ranges, np.cos(laser.angles), np.sin(laser.angles),
+                                         float(laser.max_range))
+    np.testing.assert_array_equal(kq, q)
+    np.testing.assert_array_equal(kn, n)
+
+
+@pytest.mark.parametrize("config", [RefineConfig(), RefineConfig(prune_after=0),
+                                    RefineConfig(iterations=3, prune_after=3, keep=1),
+                                    RefineConfig(iterations=4, inner=1, prune_after=9)])
+def test_fused_vector_refinement_is_bit_identical(config: RefineConfig, test_room, lms200,
+                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    rng = np.random.default_rng(5)
+    for seed in range(6):
+        points = lms200.to_points(noisy_scan(test_room, lms200, TRUE, seed))
+        poses = _poses(rng, 4)
+        fused = refine(test_room, lms200, points, poses, config)
+        monkeypatch.setattr(refine_module, "_FUSED", False)
+        loop = refine(test_room, lms200, points, poses, config)
+        monkeypatch.setattr(refine_module, "_FUSED", True)
+        assert fused.shape == loop.shape and fused.tobytes() == loop.tobytes()
+
+
+def test_grid_scores_kernel_equals_the_plain_sum(test_room, lms200) -> None:
+    from tfloc.maps.fields import distance_field
+    from tfloc.tfplus.kernels import grid_scores_kernel
+
+    f = distance_field(test_room, 0.05, 0.3)
+    points = np.ascontiguousarray(lms200.to_points(noisy_scan(test_room, lms200, TRUE))[::9])
+    rng = np.random.default_rng(2)
+    positions = rng.uniform(-1.0, 9.0, (300, 2))      # some outside the table: clipped
+    headings = rng.uniform(-math.pi, math.pi, 7)
+    table, (ox, oy) = f.distance, f.corner
+    ny, nx = table.shape
+    expect = np.zeros((len(positions), len(headings)))
+    for i in range(len(points)):                     # the sum over the points, in order
+        c, s = np.cos(headings), np.sin(headings)
+        qx = (c * points[i, 0] - s * points[i, 1]) - ox
+        qy = (s * points[i, 0] + c * points[i, 1]) - oy
+        ix = np.clip(np.floor((positions[:, :1] + qx) * (1.0 / f.resolution)), 0, nx - 1)
+        iy = np.clip(np.floor((positions[:, 1:] + qy) * (1.0 / f.resolution)), 0, ny - 1)
+        expect += table[iy.astype(int), ix.astype(int)]
+    got = grid_scores_kernel(table, float(ox), float(oy), f.resolution, points, positions, headings)
+    assert got.tobytes() == (expect / len(points)).tobytes()
+
+
+def _office_problems(count: int):
+    """The first ``count`` scans of each offset cell of detail-1 (the furnished office)."""
+    from tfloc.harness.task import load_dataset, problem_of
+
+    scenario, scans = load_dataset(str(ROOT / "data" / "scenarios" / "detail-1"))
+    seen: dict[str, int] = {}
+    out = []
+    for s in scans.values():
+        if seen.get(s.group, 0) < count:
+            seen[s.group] = seen.get(s.group, 0) + 1
+            out.append(problem_of(scenario, s))
+    return out
+
+
+@pytest.mark.parametrize("name", ["tf", "tf-best"])
+def test_compiled_tf_search_gives_the_python_answers(name: str,
+                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    from tfloc.core.matcher import get_matcher
+    from tfloc.paper import matcher as paper_matcher
+
+    m = get_matcher(name)
+    for problem in _office_problems(1):
+        fast = m.localize(problem)
+        monkeypatch.setattr(paper_matcher, "_FUSED", False)
+        slow = m.localize(problem)
+        monkeypatch.setattr(paper_matcher, "_FUSED", True)
+        assert (fast.pose, fast.converged, fast.iterations, fast.evaluations, fast.info) == \
+            (slow.pose, slow.converged, slow.iterations, slow.evaluations, slow.info)
+
+
+def test_simplex_directions_drawn_at_once_equal_one_by_one() -> None:
+    rng = np.random.default_rng(7)
+    one_by_one = [rng.uniform(0.0, 2.0 * math.pi) for _ in range(8)]
+    assert np.array_equal(np.random.default_rng(7).uniform(0.0, 2.0 * math.pi, 8), one_by_one)
+
+
+@njit(cache=False)
+def _pairs_reference(points, delta, q, normal, angle_min, resolution, window, gate):
+    """The point-to-line pairing as it was written before the speed work (exact atan2, NaN tests
+    in the window, the Jacobian as a tuple)."""
+    k_n, m = delta.shape[0], points.shape[0]
+    n = q.shape[1]
+    hh = np.zeros((k_n, 3, 3))
+    gg = np.zeros((k_n, 3))
+    res = np.full((k_n, m), np.nan)
+    for k in range(k_n):
+        c, s = math.cos(delta[k, 2]), math.sin(delta[k, 2])
+        for i in range(m):
+            rx = c * points[i, 0] - s * points[i, 1]
+            ry = s * points[i, 0] + c * points[i, 1]
+            x, y = rx + delta[k, 0], ry + delta[k, 1]
+            j0 = int(round((math.atan2(y, x) - angle_min) / resolution))
+            best, bj = gate * gate, -1
+            for j in range(max(j0 - window, 0), min(j0 + window + 1, n)):
+                qx = q[k, j, 0]
+                if math.isnan(qx) or math.isnan(normal[k, j, 0]):
+                    continue
+                d2 = (x - qx) ** 2 + (y - q[k, j, 1]) ** 2
+                if d2 < best:
+                    best, bj = d2, j
+            if bj < 0:
+                continue
+            nx, ny = normal[k, bj, 0], normal[k, bj, 1]
+            r = nx * (x - q[k, bj, 0]) + ny * (y - q[k, bj, 1])
+            res[k, i] = r
+            jac = (nx, ny, -nx * ry + ny * rx)
+            for a in range(3):
+                gg[k, a] += jac[a] * r
+                for b in range(3):
+                    hh[k, a, b] += jac[a] * jac[b]
+    return hh, gg, res
+
+
+def test_pairs_kernel_equals_the_reference(test_room, lms200) -> None:
+    from tfloc.tfplus.kernels import pairs_kernel
+
+    rng = np.random.default_rng(11)
+    points = lms200.to_points(noisy_scan(test_room, lms200, TRUE, 3))
+    # points on every bearing, including exact half steps between beams
+    half = lms200.angle_min + (np.arange(lms200.n_beams - 1) + 0.5) * lms200.resolution
+    points = np.vstack((points, 2.0 * np.column_stack((np.cos(half), np.sin(half)))))
+    for gate in (0.05, 0.5):
+        poses = _poses(rng, 4)
+        q, normal = _virtual_geometry(test_room.raycast(poses, lms200), lms200)
+        delta = rng.normal(0.0, 0.02, (4, 3)) if gate > 0.1 else np.zeros((4, 3))
+        got = pairs_kernel(points, delta, q, normal, lms200.angle_min, lms200.resolution, 6, gate)
+        ref = _pairs_reference(points, delta, q, normal, lms200.angle_min, lms200.resolution, 6,
+                               gate)
+        for a, b in zip(got, ref, strict=True):
+            assert a.tobytes() == b.tobytes()
+
+
+def test_rotation_candidates_equal_the_step_by_step_histograms(test_room, lms200) -> None:
+    from tfloc.paper.shape import ShapeConfig, scan_turning_function
+    from tfloc.tfplus.headings import edge_histogram, rotation_candidates
+
+    shape = ShapeConfig(spacing=0.05)
+    rng = np.random.default_rng(4)
+    real = scan_turning_function(noisy_scan(test_room, lms200, TRUE, 1), lms200, shape)
+    for pose in _poses(rng, 12):
+        virtual = scan_turning_function(test_room.raycast(pose, lms200), lms200, shape)
+        for skip in (True, False):
+            hr = edge_histogram(real, 720, math.radians(1.0), skip)
+            hv = edge_histogram(virtual, 720, math.radians(1.0), skip)
+            corr = np.real(np.fft.ifft(np.fft.fft(hr) * np.conj(np.fft.fft(hv))))
+            k = int(np.floor(math.radians(20) / (2 * np.pi / 720)))
+            c = corr[np.arange(-k, k + 1) % 720]
+            peak = (c >= np.roll(c, 1)) & (c >= np.roll(c, -1))
+            peak[0] = peak[-1] = False
+            order = np.argsort(-np.where(peak, c, -np.inf))[:3]
+            order = order[peak[order]]
+            if len(order) == 0:
+                order = np.array([int(np.argmax(c))])
+            expect = np.arange(-k, k + 1)[order] * (2 * np.pi / 720)
+            got = rotation_candidates(real, virtual, math.radians(20), 3, skip_closure=skip)
+            assert got.tobytes() == expect.tobytes()
+
+
+def test_tf_plus_turning_function_equals_the_step_by_step_one(test_room, lms200) -> None:
+    from tfloc.paper.shape import ShapeConfig, scan_turning_function
+    from tfloc.tfplus.matcher import _turning_function
+
+    rng = np.random.default_rng(6)
+    for shape in (ShapeConfig(spacing=0.05), ShapeConfig(spacing=0.05, resampling="path"),
+                  ShapeConfig(close_through_origin=False)):
+        for seed, pose in enumerate(_poses(rng, 6)):
+            ranges = noisy_scan(test_room, lms200, Pose(*pose), seed)
+            ranges[::23] = np.inf
+            a, b = scan_turning_function(ranges, lms200, shape), _turning_function(ranges, lms200, shape)
+            assert a.breaks.tobytes() == b.breaks.tobytes()
+            assert a.angles.tobytes() == b.angles.tobytes()
+    few = np.full(lms200.n_beams, np.inf)
+    few[90:92] = 2.0
+    assert scan_turning_function(few, lms200) is None and _turning_function(few, lms200, ShapeConfig()) is None

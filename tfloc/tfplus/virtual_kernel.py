@@ -1,0 +1,106 @@
+"""The refinement against virtual scans on a vector map (:func:`tfloc.tfplus.refine.refine`),
+fused into one compiled call per run of iterations.
+
+Each iteration of :func:`~tfloc.tfplus.refine.refine` ray-casts the candidates' virtual scans,
+derives their points and line normals, and makes ``inner`` Gauss–Newton steps; from Python that
+is some 20 numpy calls and temporaries per iteration, more than the arithmetic itself. Here the
+same steps run in one numba call, with the same arithmetic in the same order (the ray cast is
+:func:`tfloc.maps._raycast.raycast_segments` itself; the beam directions' cos/sin come from
+numpy, computed once by the caller), so the refined poses are identical
+(``tests/test_fused_equivalence.py`` compares them with the step-by-step path bit for bit).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from tfloc.maps._raycast import raycast_segments
+
+from .kernels import pairs_kernel
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def virtual_geometry_kernel(ranges: np.ndarray, cos_a: np.ndarray, sin_a: np.ndarray,
+                            max_range: float) -> tuple[np.ndarray, np.ndarray]:
+    """Virtual points ``(K, n, 2)`` (NaN for no return) and unit line normals ``(K, n, 2)`` of
+    the virtual scans ``ranges`` ``(K, n)`` (metres; beam directions ``cos_a``, ``sin_a``):
+    :func:`tfloc.tfplus.refine._virtual_geometry`, element by element."""
+    k_n, n = ranges.shape
+    q = np.empty((k_n, n, 2))
+    normal = np.empty((k_n, n, 2))
+    nan, inf = np.nan, np.inf
+    for k in range(k_n):
+        for b in range(n):
+            r = ranges[k, b]
+            if not (np.isfinite(r) and r > 0.0 and r < max_range):
+                r = nan
+            q[k, b, 0] = cos_a[b] * r
+            q[k, b, 1] = sin_a[b] * r
+        for b in range(n):
+            if b < n - 1:
+                fx, fy = q[k, b + 1, 0] - q[k, b, 0], q[k, b + 1, 1] - q[k, b, 1]
+            else:
+                fx, fy = nan, nan
+            if b > 0:
+                bx, by = q[k, b, 0] - q[k, b - 1, 0], q[k, b, 1] - q[k, b - 1, 1]
+            else:
+                bx, by = nan, nan
+            lf, lb = math.hypot(fx, fy), math.hypot(bx, by)
+            if math.isnan(lf):
+                lf = inf
+            if math.isnan(lb):
+                lb = inf
+            if lf < 3 * lb and lb < 3 * lf:      # central difference on smooth stretches
+                tx, ty = fx + bx, fy + by
+            elif lf <= lb:                      # the shorter side across a jump or a corner
+                tx, ty = fx, fy
+            else:
+                tx, ty = bx, by
+            norm = math.hypot(tx, ty)
+            normal[k, b, 0] = -ty / norm                # numpy's x / 0 (error_model)
+            normal[k, b, 1] = tx / norm
+    return q, normal
+
+
+@njit(cache=True, nogil=True)
+def refine_virtual_kernel(poses: np.ndarray, points: np.ndarray, rel_angles: np.ndarray,
+                          cos_a: np.ndarray, sin_a: np.ndarray, angle_min: float,
+                          resolution: float, segs: np.ndarray, max_range: float,
+                          gates: np.ndarray, inner: int, window: int,
+                          damping: float) -> tuple[np.ndarray, np.ndarray]:
+    """Iterations of :func:`tfloc.tfplus.refine.refine` on a vector map (segments ``segs``), one
+    per gate of ``gates``: the refined poses ``(K, 3)`` and the signed residuals ``(K, M)`` of
+    the last Gauss–Newton step of the last iteration (NaN: unpaired), which the pruning ranks
+    by. ``rel_angles`` are the beam angles (radians, relative to the heading), ``cos_a``/
+    ``sin_a`` their cos/sin as numpy computes them, ``angle_min``/``resolution`` the laser's
+    (radians)."""
+    poses = poses.copy()
+    k_n, m = poses.shape[0], points.shape[0]
+    r = np.full((k_n, m), np.nan)
+    eye = np.eye(3)
+    for it in range(gates.shape[0]):
+        virtual = raycast_segments(poses, rel_angles, segs, max_range)
+        q, normal = virtual_geometry_kernel(virtual, cos_a, sin_a, max_range)
+        delta = np.zeros_like(poses)
+        for _ in range(inner):
+            h, g, r = pairs_kernel(points, delta, q, normal, angle_min, resolution, window,
+                                   gates[it])
+            for k in range(k_n):
+                paired = 0
+                for i in range(m):
+                    if not math.isnan(r[k, i]):
+                        paired += 1
+                if paired >= 3:
+                    step = np.linalg.solve(h[k] + damping * eye, g[k])
+                    for a in range(3):
+                        delta[k, a] -= step[a]
+        for k in range(k_n):
+            c, s = math.cos(poses[k, 2]), math.sin(poses[k, 2])
+            x = poses[k, 0] + c * delta[k, 0] - s * delta[k, 1]
+            y = poses[k, 1] + s * delta[k, 0] + c * delta[k, 1]
+            poses[k, 0], poses[k, 1] = x, y
+            poses[k, 2] = (poses[k, 2] + delta[k, 2] + np.pi) % (2.0 * np.pi) - np.pi
+    return poses, r
