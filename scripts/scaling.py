@@ -92,8 +92,8 @@ class StudyConfig:
     lasers: tuple[tuple[float, float], ...] = ((180.0, 1.0), (180.0, 0.5), (180.0, 0.25), (270.0, 0.25))
     max_range_m: float = 10.0
     resolution_m: float = 0.05
-    scans_per_level: int = 27          # area and beam axes: 3 per offset cell
-    scans_per_offset_bin: int = 18     # offset axis: 6 per cell of each distance bin
+    scans_per_level: int = 45          # area and beam axes: 5 per offset cell
+    scans_per_offset_bin: int = 30     # offset axis: 10 per cell of each distance bin
     matchers: tuple[str, ...] = ()     # () = every registered matcher
     budget_ms: float = 250.0
     prep_budget_s: float = 120.0
@@ -170,10 +170,61 @@ def fresh_copy(m: VectorMap | GridMap) -> VectorMap | GridMap:
 
 
 def rss_mb() -> float:
-    """This process's resident memory (MB, psutil)."""
+    """This process's resident memory (MB, psutil) after a garbage collection and
+    ``malloc_trim(0)`` (glibc returns its free heap pages to the OS), so that memory freed earlier
+    and kept by the allocator does not hide or inflate what a step keeps."""
     import psutil
 
+    gc.collect()
+    _malloc_trim()
     return psutil.Process().memory_info().rss / 2**20
+
+
+def _malloc_trim() -> None:
+    try:
+        import ctypes
+
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):
+        pass
+
+
+def reset_peak() -> bool:
+    """Reset this process's peak resident memory (Linux: ``/proc/self/clear_refs`` ← 5)."""
+    try:
+        Path("/proc/self/clear_refs").write_text("5")
+        return True
+    except OSError:
+        return False
+
+
+def peak_mb() -> float:
+    """This process's peak resident memory since :func:`reset_peak` (MB; VmHWM), NaN if unknown."""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) / 1024.0
+    except OSError:
+        pass
+    return math.nan
+
+
+class MemoryProbe:
+    """CPU and wall time, retained and peak resident memory (MB) of a block of code:
+    ``with MemoryProbe() as m: ...`` then ``m.cpu_s``, ``m.wall_s``, ``m.retained_mb``,
+    ``m.peak_mb`` (the peak above the memory before; NaN where the OS cannot tell)."""
+
+    def __enter__(self) -> MemoryProbe:
+        self._r0 = rss_mb()
+        self._peak = reset_peak()
+        self._c0, self._w0 = time.process_time(), time.perf_counter()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.cpu_s = time.process_time() - self._c0
+        self.wall_s = time.perf_counter() - self._w0
+        self.peak_mb = peak_mb() - self._r0 if self._peak else math.nan
+        self.retained_mb = rss_mb() - self._r0
 
 
 def build_levels(cfg: StudyConfig, tile: VectorMap) -> tuple[list[Level], list[dict]]:
@@ -210,17 +261,16 @@ def _map_builder(tile: VectorMap, t: Tiling, kind: str, resolution: float, prep:
 
     def build() -> VectorMap | GridMap:
         if "map" not in box:
-            gc.collect()
-            r0, c0, w0 = rss_mb(), time.process_time(), time.perf_counter()
-            vm = tile_vector_map(tile, t)
-            segs = len(vm.segments)
-            m = rasterize(vm, resolution) if kind == "grid" else vm
-            cells = int(np.prod(m.shape)) if kind == "grid" else 0
-            c1, w1 = time.process_time(), time.perf_counter()
-            gc.collect()
+            with MemoryProbe() as probe:
+                vm = tile_vector_map(tile, t)
+                segs = len(vm.segments)
+                m = rasterize(vm, resolution) if kind == "grid" else vm
+                cells = int(np.prod(m.shape)) if kind == "grid" else 0
+                del vm
             prep.append({"matcher": "(map)", "kind": kind, "tiles": t.tiles, "size": t.extent_m2,
-                         "cells": cells, "segments": segs, "prep_cpu_s": c1 - c0, "prep_wall_s": w1 - w0,
-                         "rss_delta_mb": rss_mb() - r0, "status": "ok"})
+                         "cells": cells, "segments": segs, "prep_cpu_s": probe.cpu_s,
+                         "prep_wall_s": probe.wall_s, "rss_delta_mb": probe.retained_mb,
+                         "peak_mb": probe.peak_mb, "status": "ok"})
             box["map"] = m
         return box["map"]
 
@@ -236,16 +286,13 @@ def success_of(est_pose: Pose, truth: Pose, thr: Thresholds = THRESHOLDS) -> tup
     return d, math.degrees(o), ok
 
 
-def prepare_timed(matcher, problem: Problem) -> tuple[float, float, float]:
-    """``matcher.prepare(problem)`` if it has one: CPU s, wall s and the retained RSS (MB)."""
-    gc.collect()
-    r0, c0, w0 = rss_mb(), time.process_time(), time.perf_counter()
+def prepare_timed(matcher, problem: Problem) -> MemoryProbe:
+    """``matcher.prepare(problem)`` if it has one, measured (:class:`MemoryProbe`)."""
     prepare = getattr(matcher, "prepare", None)
-    if prepare is not None:
-        prepare(problem)
-    c1, w1 = time.process_time(), time.perf_counter()
-    gc.collect()
-    return c1 - c0, w1 - w0, rss_mb() - r0
+    with MemoryProbe() as probe:
+        if prepare is not None:
+            prepare(problem)
+    return probe
 
 
 def run_level(lv: Level, matchers: dict[str, object], log: Callable[[str], None],
@@ -264,7 +311,7 @@ def run_level(lv: Level, matchers: dict[str, object], log: Callable[[str], None]
                "cells": int(np.prod(base.shape)) if isinstance(base, GridMap) else 0,
                "segments": len(base.segments) if isinstance(base, VectorMap) else 0}
         try:
-            cpu, wall, mem = prepare_timed(matchers[name], problems[name][0])
+            probe = prepare_timed(matchers[name], problems[name][0])
             p0 = problems[name][0]
             matchers[name].score(p0, p0.initial)  # untimed warm-up: kernels, lazy structures
             for p in problems[name][:warmup]:
@@ -272,10 +319,11 @@ def run_level(lv: Level, matchers: dict[str, object], log: Callable[[str], None]
         except Exception as exc:  # noqa: BLE001 - reported in prep.csv, the others go on
             log(f"{name} on {lv.axis}/{lv.kind}/{lv.level}: {type(exc).__name__}: {exc}")
             prep.append({**row, "prep_cpu_s": math.nan, "prep_wall_s": math.nan, "rss_delta_mb": math.nan,
-                         "status": f"error:{type(exc).__name__}"})
+                         "peak_mb": math.nan, "status": f"error:{type(exc).__name__}"})
             continue
         names.append(name)
-        prep.append({**row, "prep_cpu_s": cpu, "prep_wall_s": wall, "rss_delta_mb": mem, "status": "ok"})
+        prep.append({**row, "prep_cpu_s": probe.cpu_s, "prep_wall_s": probe.wall_s,
+                     "rss_delta_mb": probe.retained_mb, "peak_mb": probe.peak_mb, "status": "ok"})
     rows = []
     k = len(names)
     for i, s in enumerate(lv.scans):
@@ -329,7 +377,7 @@ def run_study(cfg: StudyConfig, log: Callable[[str], None] = print) -> dict:
                 if lv.axis == "area":
                     prep.append({"matcher": n, "kind": lv.kind, "tiles": lv.tiles, "size": lv.size,
                                  "cells": 0, "segments": 0, "prep_cpu_s": math.nan, "prep_wall_s": math.nan,
-                                 "rss_delta_mb": math.nan, "status": "skipped"})
+                                 "rss_delta_mb": math.nan, "peak_mb": math.nan, "status": "skipped"})
         if not active:
             continue
         c0 = time.process_time()
@@ -406,7 +454,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         limit_threads(1)
         started, load0, w0 = time.strftime("%Y-%m-%dT%H:%M:%S%z"), os.getloadavg(), time.perf_counter()
         result = run_study(cfg, lambda s: print(s, flush=True))
-        provenance = {"started": started, "wall_s": round(time.perf_counter() - w0, 1),
+        provenance = {"command": "make scaling-quick" if args.quick else "make scaling", "started": started, "wall_s": round(time.perf_counter() - w0, 1),
                       "loadavg_start": [round(x, 2) for x in load0],
                       "loadavg_end": [round(x, 2) for x in os.getloadavg()], "cores": cores,
                       "cpu": _cpu_model(), "python": platform.python_version(),

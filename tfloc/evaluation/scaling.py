@@ -26,7 +26,7 @@ SCAN_COLUMNS = ["matcher", "axis", "kind", "level", "size", "tiles", "beams", "f
 #: Columns of the preparation rows (``prep.csv``): one per (matcher, map); matcher ``(map)`` is
 #: the map itself (building it; its own arrays).
 PREP_COLUMNS = ["matcher", "kind", "tiles", "size", "cells", "segments", "prep_cpu_s",
-                "prep_wall_s", "rss_delta_mb", "status"]
+                "prep_wall_s", "rss_delta_mb", "peak_mb", "status"]
 
 
 @dataclass(frozen=True)

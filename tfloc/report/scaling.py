@@ -99,8 +99,9 @@ def prep_section(prep: pd.DataFrame, prep_slopes: pd.DataFrame) -> str:
                     cells.append("—")
                     continue
                 r = g.loc[s]
-                cells.append("skipped" if r["status"] != "ok" else
-                             f"{num(r['prep_cpu_s'], 2)} s / {num(r['rss_delta_mb'], 0)} MB")
+                cells.append(r["status"] if r["status"] != "ok" else
+                             f"{num(r['prep_cpu_s'], 2)} s / {num(r['rss_delta_mb'], 0)} MB "
+                             f"({num(r['peak_mb'], 0)})")
             ps = prep_slopes[(prep_slopes["kind"] == kind) & (prep_slopes["matcher"] == m)]
             ts = float(ps["time_slope"].iloc[0]) if len(ps) else math.nan
             ms = float(ps["memory_slope"].iloc[0]) if len(ps) else math.nan
@@ -108,9 +109,12 @@ def prep_section(prep: pd.DataFrame, prep_slopes: pd.DataFrame) -> str:
         what = (f"{int(sub['cells'].max()):,} cells at the largest size" if kind == "grid"
                 else f"{int(sub['segments'].max()):,} segments at the largest size")
         out.append(f"### Map preparation, {kind} maps ({what})\n\nCPU seconds of `prepare(problem)` / "
-                   f"resident memory it left behind (MB, RSS after minus before, after a garbage "
-                   f"collection; each matcher on its own copy of the map). `(map)`: building the map "
-                   f"itself (tiling{', rasterising at 5 cm' if kind == 'grid' else ''}).\n\n"
+                   f"resident memory it left behind (MB: RSS after minus before, each after a garbage "
+                   f"collection and `malloc_trim`; psutil) and, in brackets, its peak above the memory "
+                   f"before (MB: VmHWM, reset through `/proc/self/clear_refs`). Both count what "
+                   f"tracemalloc does not see (numba, open3d, small_gicp, Karto); each matcher "
+                   f"prepares its own copy of the map. `(map)`: building the map itself "
+                   f"(tiling{', rasterising at 5 cm' if kind == 'grid' else ''}).\n\n"
                    + table(head, body) + "\n")
     return "\n".join(out)
 
@@ -121,7 +125,7 @@ def write_readme(path: Path, levels: pd.DataFrame, slopes: pd.DataFrame, prep: p
     load0, load1 = provenance.get("loadavg_start", []), provenance.get("loadavg_end", [])
     lines = ["# Scaling study: CPU per scan against map area, beam count and initial offset", "",
              "Written by `scripts/scaling.py` (issue 26, item 3); do not edit by hand: "
-             f"{'`make scaling-quick`' if config.get('scans_per_level', 0) < 27 else '`make scaling`'} "
+             f"`{provenance.get('command', 'python scripts/scaling.py')}` "
              "regenerates it.", "",
              "**Conditions.** One process pinned to one core "
              f"({provenance.get('cores')}), every library on one thread; per-scan CPU time "
@@ -159,8 +163,12 @@ def write_readme(path: Path, levels: pd.DataFrame, slopes: pd.DataFrame, prep: p
                   f"cells: its occupancy array alone is {cells * 4 / 2**20:.0f} MB (float32)."]
         tp = big[big["matcher"] == "tf-plus"]
         if len(tp):
-            lines += [f"`tf-plus` holds {num(tp['rss_delta_mb'].iloc[0], 0)} MB more after its "
-                      f"preparation of that grid ({num(tp['prep_cpu_s'].iloc[0], 2)} s CPU)."]
+            lines += [f"**`tf-plus` on the {num(big['size'].iloc[0], 0)} m² grid at 5 cm**: its "
+                      f"preparation (the map's view: distance field, normals, wall surfaces, the "
+                      f"pooled copy, the free-space test) takes {num(tp['prep_cpu_s'].iloc[0], 2)} s "
+                      f"CPU and keeps {num(tp['rss_delta_mb'].iloc[0], 0)} MB resident (peak "
+                      f"{num(tp['peak_mb'].iloc[0], 0)} MB above the memory before it), on top of the "
+                      f"map itself."]
         lines += [""]
     if not skips.empty:
         lines += ["## Not run (budget)", "", table(["axis", "kind", "level", "matcher", "why"],
@@ -209,16 +217,18 @@ def write_figure(path: Path, levels: pd.DataFrame, slopes: pd.DataFrame, prep: p
     if not prep.empty:
         for ax, colname, ylabel in ((rest[0], "prep_cpu_s", "prepare CPU (s)"),
                                     (rest[1], "rss_delta_mb", "retained memory (MB)")):
+            floor = 1e-3 if colname == "prep_cpu_s" else 1.0
             for (m, kind), g in done.groupby(["matcher", "kind"], sort=True):
                 g = g.sort_values("size")
-                y = g[colname].clip(lower=1e-4 if colname == "prep_cpu_s" else 0.1)
+                y = g[colname].clip(lower=floor)
                 c = "k" if m == "(map)" else col.get(m, "grey")
                 ax.plot(g["size"], y, "o-" if kind == "grid" else "s--", color=c, ms=3, lw=1,
-                        label=f"{m} {kind}")
+                        label=m if kind == "grid" else None)
+            ax.set_ylim(bottom=floor * 0.8)
             ax.set(xscale="log", yscale="log", xlabel="map extent (m²)", ylabel=ylabel,
-                   title=f"{ylabel.split(' (')[0]} per map (— grid, -- vector)")
+                   title=f"{ylabel.split(' (')[0]} per map (— grid, -- vector; floor {floor:g})")
             ax.grid(True, which="both", alpha=0.3)
-            ax.legend(fontsize=5, ncol=2, loc="best")
+            ax.legend(fontsize=6, ncol=2, loc="best")
         rest = rest[2:]
     for ax in rest:
         ax.set_visible(False)
