@@ -365,6 +365,7 @@ def run_study(cfg: StudyConfig, log: Callable[[str], None] = print) -> dict:
     """Run every level of the study; returns the rows, preparation rows, skips and provenance."""
     tile = read_vector_map(ROOT / cfg.map_path if not Path(cfg.map_path).is_absolute() else cfg.map_path)
     matchers = build_matchers(cfg.matchers or available_matchers(), log)
+    gc.freeze()  # the libraries' objects: every later gc.collect (memory probes) skips them
     levels, map_prep = build_levels(cfg, tile)
     rows, prep, skips = [], [], []
     out_of_budget: dict[tuple[str, str, str], str] = {}   # (axis, kind, matcher) → why
