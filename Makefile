@@ -6,7 +6,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.tfloc-installed
 JOBS   ?= 2
 
-.PHONY: install quick bench robustness robustness-full ablation-real test test-unit timing lint clean-venv real-data fuzz chaos
+.PHONY: install quick bench robustness robustness-full scaling scaling-quick ablation-real test test-unit timing lint clean-venv real-data fuzz chaos
 
 $(STAMP): pyproject.toml
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -52,6 +52,7 @@ bench: $(STAMP)
 	$(BIN)/tfloc timing results/robustness
 	$(BIN)/tfloc report results/robustness
 	$(BIN)/tfloc robustness results/robustness
+	$(MAKE) scaling-quick
 
 ## Issue 25: every matcher on every map style of the real logs and every changed world of the
 ## simulated office (10 scans per offset group of each dataset; ~12 min on 2 quiet cores)
@@ -67,6 +68,17 @@ robustness-full: $(STAMP)
 	$(BIN)/tfloc timing results/robustness-full
 	$(BIN)/tfloc report results/robustness-full
 	$(BIN)/tfloc robustness results/robustness-full
+
+## The scaling study (issue 26): every matcher's CPU per scan against map area (300-20 000 m²,
+## vector and 5 cm grid), beam count (181-1081) and initial offset, and each map's preparation
+## time and memory → results/scaling/ (README.md, scaling.png; ~15 min CPU, one pinned core).
+scaling: $(STAMP)
+	$(BIN)/python scripts/scaling.py --out results/scaling
+
+## Its fixed subsample, part of make bench: every axis and level, 9 scans per level, 9 per
+## offset bin → results/scaling-quick/ (~3 min CPU).
+scaling-quick: $(STAMP)
+	$(BIN)/python scripts/scaling.py --quick --out results/scaling-quick
 
 ## tf-plus's per-stage ablation on the real logs, maps as built and thickened (results/tf-plus-ablation-real/; ~5 min quiet).
 ablation-real: $(STAMP)

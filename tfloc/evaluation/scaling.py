@@ -1,0 +1,93 @@
+"""How a matcher's cost grows: medians per level and log–log slopes (the scaling study).
+
+The study (``scripts/scaling.py``) times every matcher per scan while one thing grows: the map's
+area, the scanner's beam count or the initial offset. Per (matcher, axis, map kind, level) the
+median CPU ms is taken; the slope of log(median CPU) against log(level) (least squares over the
+levels, each level one point) says how the cost grows: 0 = flat, 1 = linear. A matcher *grows*
+with an axis when the slope exceeds :data:`GROWS_SLOPE` (0.2: ×16 the area costs ×1.74 or more).
+The same fit is applied to preparation CPU time and memory against map area.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+#: A slope of log cost against log size above this counts as "grows".
+GROWS_SLOPE = 0.2
+
+#: Columns of the study's per-scan rows (``scaling.csv``).
+SCAN_COLUMNS = ["matcher", "axis", "kind", "level", "size", "tiles", "beams", "fov_deg", "scan_id",
+                "offset_bin", "init_dist_m", "position", "cpu_ms", "wall_ms", "dist_err_m",
+                "orient_err_deg", "success", "status"]
+#: Columns of the preparation rows (``prep.csv``): one per (matcher, map); matcher ``(map)`` is
+#: the map itself (building it; its own arrays).
+PREP_COLUMNS = ["matcher", "kind", "tiles", "size", "cells", "segments", "prep_cpu_s",
+                "prep_wall_s", "rss_delta_mb", "peak_mb", "status"]
+
+
+@dataclass(frozen=True)
+class Slope:
+    """A least-squares line ``log y = intercept + slope · log x`` over ``n`` points."""
+
+    slope: float
+    intercept: float
+    n: int
+
+    @property
+    def grows(self) -> bool:
+        """Whether the cost grows with x (slope > :data:`GROWS_SLOPE`)."""
+        return bool(self.slope > GROWS_SLOPE)
+
+
+def fit_loglog(x: np.ndarray, y: np.ndarray) -> Slope:
+    """The least-squares slope of log(y) on log(x) over the points with finite, positive x and
+    y; NaN slope with fewer than two distinct x."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    ok = np.isfinite(x) & np.isfinite(y) & (x > 0) & (y > 0)
+    lx, ly = np.log(x[ok]), np.log(y[ok])
+    if np.unique(lx).size < 2:
+        return Slope(math.nan, math.nan, int(ok.sum()))
+    slope, intercept = np.polyfit(lx, ly, 1)
+    return Slope(float(slope), float(intercept), int(ok.sum()))
+
+
+def level_table(rows: pd.DataFrame) -> pd.DataFrame:
+    """Per (axis, kind, matcher, level): scans ``n``, ``size`` (the level's x: m², beams or
+    metres), median and p90 CPU ms, median wall ms and the success rate."""
+    keys = ["axis", "kind", "matcher", "level"]
+    g = rows.groupby(keys, sort=False)
+    out = g.agg(size=("size", "first"), n=("cpu_ms", "size"), cpu_ms_median=("cpu_ms", "median"),
+                cpu_ms_p90=("cpu_ms", lambda s: float(np.percentile(s, 90))),
+                wall_ms_median=("wall_ms", "median"), success=("success", "mean"))
+    return out.reset_index()
+
+
+def slope_table(levels: pd.DataFrame) -> pd.DataFrame:
+    """Per (axis, kind, matcher): the log–log slope of median CPU against the level's size, the
+    number of levels it spans, the cost at the first and last level and whether it grows."""
+    out = []
+    for (axis, kind, matcher), g in levels.groupby(["axis", "kind", "matcher"], sort=False):
+        g = g.sort_values("size")
+        s = fit_loglog(g["size"].to_numpy(), g["cpu_ms_median"].to_numpy())
+        out.append({"axis": axis, "kind": kind, "matcher": matcher, "slope": s.slope, "levels": s.n,
+                    "first_ms": float(g["cpu_ms_median"].iloc[0]), "last_ms": float(g["cpu_ms_median"].iloc[-1]),
+                    "first_size": float(g["size"].iloc[0]), "last_size": float(g["size"].iloc[-1]),
+                    "grows": s.grows if math.isfinite(s.slope) else None})
+    return pd.DataFrame(out)
+
+
+def prep_slope_table(prep: pd.DataFrame) -> pd.DataFrame:
+    """Per (kind, matcher): log–log slopes of preparation CPU seconds and retained memory (MB)
+    against map area, over the maps whose preparation finished."""
+    out = []
+    done = prep[prep["status"] == "ok"]
+    for (kind, matcher), g in done.groupby(["kind", "matcher"], sort=False):
+        t = fit_loglog(g["size"].to_numpy(), g["prep_cpu_s"].to_numpy())
+        m = fit_loglog(g["size"].to_numpy(), g["rss_delta_mb"].to_numpy())
+        out.append({"kind": kind, "matcher": matcher, "time_slope": t.slope, "memory_slope": m.slope,
+                    "maps": t.n})
+    return pd.DataFrame(out)

@@ -1,0 +1,238 @@
+"""The scaling study's README (tables, slopes, one sentence per matcher) and its figure.
+
+Inputs are the tables of :mod:`tfloc.evaluation.scaling` (levels, slopes, preparation rows); the
+study itself is ``scripts/scaling.py``.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from matplotlib.figure import Figure
+
+from tfloc.evaluation.scaling import GROWS_SLOPE
+
+from .figures import colours
+from .mdtable import num, table
+
+AXIS_TITLES = {("area", "vector"): "map area, vector map", ("area", "grid"): "map area, 5 cm grid",
+               ("beams", "vector"): "beam count (office, vector)",
+               ("offset", "vector"): "initial distance offset (office, vector)"}
+AXIS_X = {"area": "map extent (m²)", "beams": "beams per scan", "offset": "offset bin centre (m)"}
+
+
+def _cell(levels: pd.DataFrame, axis: str, kind: str, matcher: str, level: str) -> str:
+    g = levels[(levels["axis"] == axis) & (levels["kind"] == kind) & (levels["matcher"] == matcher)
+               & (levels["level"] == level)]
+    if g.empty:
+        return "—"
+    r = g.iloc[0]
+    return f"{num(r['cpu_ms_median'], 2)} ({100 * r['success']:.0f} %)"
+
+
+def level_section(levels: pd.DataFrame, axis: str, kind: str, slopes: pd.DataFrame) -> str:
+    """One table: a row per matcher, a column per level (median CPU ms and success), the slope."""
+    sub = levels[(levels["axis"] == axis) & (levels["kind"] == kind)]
+    if sub.empty:
+        return ""
+    order = sub.drop_duplicates("level").sort_values("size")
+    cols = list(order["level"])
+    sizes = list(order["size"])
+    n = int(sub["n"].max())
+    head = ["matcher"] + [f"{lv} ({num(s, 0)})" if axis != "offset" else lv for lv, s in
+                          zip(cols, sizes, strict=True)] + ["slope", "grows?"]
+    body = []
+    for m in sorted(sub["matcher"].unique()):
+        s = slopes[(slopes["axis"] == axis) & (slopes["kind"] == kind) & (slopes["matcher"] == m)]
+        slope = float(s["slope"].iloc[0]) if len(s) else math.nan
+        body.append([m] + [_cell(levels, axis, kind, m, lv) for lv in cols]
+                    + [num(slope, 2), _verdict(slope)])
+    title = AXIS_TITLES.get((axis, kind), f"{axis}, {kind}")
+    return (f"### CPU per scan against {title}\n\nMedian CPU ms per scan (success rate), n = {n} scans "
+            f"per cell; column heads: level ({AXIS_X[axis]}); slope of log(median CPU) against "
+            f"log({AXIS_X[axis].split(' (')[0]}).\n\n" + table(head, body) + "\n")
+
+
+def _verdict(slope: float) -> str:
+    if not math.isfinite(slope):
+        return "—"
+    return "grows" if slope > GROWS_SLOPE else "flat"
+
+
+def sentences(slopes: pd.DataFrame) -> list[str]:
+    """One plain sentence per matcher: whether its per-scan cost grows with each axis."""
+    out = []
+    for m in sorted(slopes["matcher"].unique()):
+        parts = []
+        for axis, kind, what in (("area", "vector", "a vector map's area"), ("area", "grid", "a grid map's area"),
+                                 ("beams", "vector", "the beam count"), ("offset", "vector", "the initial offset")):
+            s = slopes[(slopes["axis"] == axis) & (slopes["kind"] == kind) & (slopes["matcher"] == m)]
+            if s.empty or not math.isfinite(float(s["slope"].iloc[0])):
+                continue
+            r = s.iloc[0]
+            verb = "grows with" if r["slope"] > GROWS_SLOPE else "does not grow with"
+            parts.append(f"{verb} {what} (slope {r['slope']:.2f}; {num(r['first_ms'], 2)} → "
+                         f"{num(r['last_ms'], 2)} ms)")
+        if parts:
+            out.append(f"- **{m}**: its CPU per scan " + "; ".join(parts) + ".")
+    return out
+
+
+def prep_section(prep: pd.DataFrame, prep_slopes: pd.DataFrame) -> str:
+    """Preparation per map: CPU s and retained memory (MB) per matcher and map size, and slopes."""
+    if prep.empty:
+        return ""
+    out = []
+    for kind in prep["kind"].unique():
+        sub = prep[prep["kind"] == kind]
+        sizes = sorted(sub["size"].unique())
+        head = ["matcher"] + [f"{num(s, 0)} m²" for s in sizes] + ["time slope", "memory slope"]
+        body = []
+        for m in dict.fromkeys(sub["matcher"]):
+            g = sub[sub["matcher"] == m].set_index("size")
+            cells = []
+            for s in sizes:
+                if s not in g.index:
+                    cells.append("—")
+                    continue
+                r = g.loc[s]
+                cells.append(r["status"] if r["status"] != "ok" else
+                             f"{num(r['prep_cpu_s'], 2)} s / {num(r['rss_delta_mb'], 0)} MB "
+                             f"({num(r['peak_mb'], 0)})")
+            ps = prep_slopes[(prep_slopes["kind"] == kind) & (prep_slopes["matcher"] == m)]
+            ts = float(ps["time_slope"].iloc[0]) if len(ps) else math.nan
+            ms = float(ps["memory_slope"].iloc[0]) if len(ps) else math.nan
+            body.append([m, *cells, num(ts, 2), num(ms, 2)])
+        what = (f"{int(sub['cells'].max()):,} cells at the largest size" if kind == "grid"
+                else f"{int(sub['segments'].max()):,} segments at the largest size")
+        out.append(f"### Map preparation, {kind} maps ({what})\n\nCPU seconds of `prepare(problem)` / "
+                   f"resident memory it left behind (MB: RSS after minus before, each after a garbage "
+                   f"collection and `malloc_trim`; psutil) and, in brackets, its peak above the memory "
+                   f"before (MB: VmHWM, reset through `/proc/self/clear_refs`). Both count what "
+                   f"tracemalloc does not see (numba, open3d, small_gicp, Karto); each matcher "
+                   f"prepares its own copy of the map. `(map)`: building the map itself "
+                   f"(tiling{', rasterising at 5 cm' if kind == 'grid' else ''}).\n\n"
+                   + table(head, body) + "\n")
+    return "\n".join(out)
+
+
+def write_readme(path: Path, levels: pd.DataFrame, slopes: pd.DataFrame, prep: pd.DataFrame,
+                 prep_slopes: pd.DataFrame, skips: pd.DataFrame, config: dict, provenance: dict) -> Path:
+    """The study's README.md."""
+    load0, load1 = provenance.get("loadavg_start", []), provenance.get("loadavg_end", [])
+    lines = ["# Scaling study: CPU per scan against map area, beam count and initial offset", "",
+             "Written by `scripts/scaling.py` (issue 26, item 3); do not edit by hand: "
+             f"`{provenance.get('command', 'python scripts/scaling.py')}` "
+             "regenerates it.", "",
+             "**Conditions.** One process pinned to one core "
+             f"({provenance.get('cores')}), every library on one thread; per-scan CPU time "
+             "(`time.process_time`) of `localize` alone, matchers interleaved scan by scan (order "
+             "rotated per scan), after `prepare` and an untimed warm-up. "
+             f"Machine: {provenance.get('cpu', '?')}, Python {provenance.get('python', '?')}; "
+             f"**the machine was shared** with other jobs (load average {load0} at the start, "
+             f"{load1} at the end): CPU times are robust to that, wall times are not. Started "
+             f"{provenance.get('started', '?')}, {provenance.get('wall_s', '?')} s wall.", "",
+             "**Problems.** The office floor `" + str(config.get("map_path")) + "` tiled n × n "
+             "(tiles 0.4 m apart, each closed by its own outline); scans simulated in tile (0, 0) "
+             "(LMS200 model plus 1 cm noise, seeded), so the same scans at every map size. Initial "
+             "poses from the paper protocol's sampler, scan k in offset cell k mod 9 (0–3 m, 0–15°). "
+             "Beam axis: the same poses, 180° at 1°/0.5°/0.25° and 270° at 0.25°. Offset axis: "
+             "the protocol's distance bins. Success: ≤ 10 cm and ≤ 2°. "
+             f"Scans per level: {config.get('scans_per_level')} (area, beams), "
+             f"{config.get('scans_per_offset_bin')} per offset bin.", "",
+             f"**Verdict rule.** A slope of log(median CPU) against log(size) above {GROWS_SLOPE} = "
+             "*grows* (×16 the area → ×1.74 the cost or more). Slopes are fitted on the level medians "
+             "(least squares; the points are in the figure and in `levels.csv`).", "",
+             f"**Budgets.** A matcher whose median at a level exceeded {config.get('budget_ms'):g} ms, "
+             f"or whose preparation exceeded {config.get('prep_budget_s'):g} s CPU, was not run at the "
+             "larger levels of that axis (listed below); its slope covers the levels it ran.", "",
+             "![scaling](scaling.png)", "", "## Per matcher", "", *sentences(slopes), ""]
+    for axis, kind in (("area", "vector"), ("area", "grid"), ("beams", "vector"), ("offset", "vector")):
+        sec = level_section(levels, axis, kind, slopes)
+        if sec:
+            lines += [sec]
+    lines += ["## Map preparation (apart from the per-scan cost)", "", prep_section(prep, prep_slopes)]
+    grid = prep[(prep["kind"] == "grid") & (prep["status"] == "ok")]
+    if not grid.empty:
+        big = grid[grid["size"] == grid["size"].max()]
+        cells = int(big["cells"].max())
+        lines += [f"The largest grid ({num(big['size'].iloc[0], 0)} m² extent at 5 cm) has {cells:,} "
+                  f"cells: its occupancy array alone is {cells * 4 / 2**20:.0f} MB (float32)."]
+        tp = big[big["matcher"] == "tf-plus"]
+        if len(tp):
+            lines += [f"**`tf-plus` on the {num(big['size'].iloc[0], 0)} m² grid at 5 cm**: its "
+                      f"preparation (the map's view: distance field, normals, wall surfaces, the "
+                      f"pooled copy, the free-space test) takes {num(tp['prep_cpu_s'].iloc[0], 2)} s "
+                      f"CPU and keeps {num(tp['rss_delta_mb'].iloc[0], 0)} MB resident (peak "
+                      f"{num(tp['peak_mb'].iloc[0], 0)} MB above the memory before it), on top of the "
+                      f"map itself."]
+        lines += [""]
+    if not skips.empty:
+        lines += ["## Not run (budget)", "", table(["axis", "kind", "level", "matcher", "why"],
+                                                   skips[["axis", "kind", "level", "matcher", "why"]].values.tolist()), ""]
+    lines += ["## Files", "", "- `scaling.csv`: one row per (matcher, axis, level, scan): CPU and wall "
+              "ms, errors, success.", "- `levels.csv`: medians per level; `slopes.csv`: the fits.",
+              "- `prep.csv`: preparation per (matcher, map): CPU and wall s, retained RSS (MB).",
+              "- `study.json`: the configuration and the machine.", ""]
+    path.write_text("\n".join(lines))
+    return path
+
+
+def write_figure(path: Path, levels: pd.DataFrame, slopes: pd.DataFrame, prep: pd.DataFrame) -> Path:
+    """Log–log panels: CPU per scan against each axis (points = level medians, lines = fits), and
+    preparation time and memory against map area."""
+    panels = [k for k in AXIS_TITLES if not levels[(levels["axis"] == k[0]) & (levels["kind"] == k[1])].empty]
+    matchers = sorted(levels["matcher"].unique())
+    col = colours(matchers)
+    n = len(panels) + (2 if not prep.empty else 0)
+    ncol = 3
+    nrow = max(1, math.ceil(n / ncol))
+    fig = Figure(figsize=(5.2 * ncol, 4.0 * nrow))
+    axes = fig.subplots(nrow, ncol, squeeze=False).ravel()
+    for ax, (axis, kind) in zip(axes, panels, strict=False):
+        sub = levels[(levels["axis"] == axis) & (levels["kind"] == kind)]
+        for m in matchers:
+            g = sub[sub["matcher"] == m].sort_values("size")
+            if g.empty:
+                continue
+            ax.plot(g["size"], g["cpu_ms_median"], "o", color=col[m], ms=4)
+            s = slopes[(slopes["axis"] == axis) & (slopes["kind"] == kind) & (slopes["matcher"] == m)]
+            label = m
+            if len(s) and math.isfinite(float(s["slope"].iloc[0])) and len(g) > 1:
+                x = np.geomspace(g["size"].min(), g["size"].max(), 20)
+                b = float(s["slope"].iloc[0])
+                a = np.mean(np.log(g["cpu_ms_median"]) - b * np.log(g["size"]))
+                ax.plot(x, np.exp(a + b * np.log(x)), "-", color=col[m], lw=1)
+                label = f"{m} ({b:+.2f})"
+            ax.plot([], [], "o-", color=col[m], label=label)
+        ax.set(xscale="log", yscale="log", title=AXIS_TITLES[(axis, kind)], xlabel=AXIS_X[axis],
+               ylabel="median CPU per scan (ms)")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=6, loc="best")
+    rest = axes[len(panels):]
+    done = prep[prep["status"] == "ok"] if not prep.empty else prep
+    if not prep.empty:
+        for ax, colname, ylabel in ((rest[0], "prep_cpu_s", "prepare CPU (s)"),
+                                    (rest[1], "rss_delta_mb", "retained memory (MB)")):
+            floor = 1e-3 if colname == "prep_cpu_s" else 1.0
+            for (m, kind), g in done.groupby(["matcher", "kind"], sort=True):
+                g = g.sort_values("size")
+                y = g[colname].clip(lower=floor)
+                c = "k" if m == "(map)" else col.get(m, "grey")
+                ax.plot(g["size"], y, "o-" if kind == "grid" else "s--", color=c, ms=3, lw=1,
+                        label=m if kind == "grid" else None)
+            ax.set_ylim(bottom=floor * 0.8)
+            ax.set(xscale="log", yscale="log", xlabel="map extent (m²)", ylabel=ylabel,
+                   title=f"{ylabel.split(' (')[0]} per map (— grid, -- vector; floor {floor:g})")
+            ax.grid(True, which="both", alpha=0.3)
+            ax.legend(fontsize=6, ncol=2, loc="best")
+        rest = rest[2:]
+    for ax in rest:
+        ax.set_visible(False)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    return path
