@@ -49,6 +49,8 @@ def test_answers_and_improves_on_the_guess(name: str) -> None:
 @pytest.mark.parametrize("name", NAMES)
 def test_score_prefers_truth(name: str) -> None:
     matcher = single_scan(name)
+    if not callable(getattr(matcher, "score", None)):
+        pytest.skip("a matcher without an objective (e.g. odometry)")
     problem, true = make_problem()
     assert math.isfinite(matcher.score(problem, true))
     assert matcher.score(problem, true) < matcher.score(problem, problem.initial)
@@ -56,7 +58,7 @@ def test_score_prefers_truth(name: str) -> None:
 
 @pytest.mark.parametrize("name", NAMES)
 def test_a_global_problem_is_refused_by_a_local_matcher(name: str) -> None:
-    matcher = build(name)
+    matcher = single_scan(name)
     problem, _ = make_problem()
     glob = tfloc.Problem(problem.map, problem.laser, problem.ranges, None)
     if kind(matcher) == "local":

@@ -14,12 +14,14 @@ step's ``info["status"]`` saying so. Units: metres, radians, seconds.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
 import numpy as np
 
 from .laser import LaserSpec
 from .map import Map
+from .params import Configured
 from .pose import Pose
 from .problem import Estimate, Problem
 
@@ -93,20 +95,19 @@ def as_tracker(obj: object) -> Tracker:
     return obj if is_tracker(obj) else LocalTracker(obj)
 
 
-class DeadReckoning:
+@dataclass(frozen=True)
+class NoParameters:
+    """The configuration of a matcher that takes none."""
+
+
+class DeadReckoning(Configured):
     """``odometry``: the prediction alone, the floor of every tracking table. Run along a
     sequence (:class:`LocalTracker`) it composes the odometry from the start pose (dead
     reckoning); on a single scan it answers its initial guess unchanged. It has no objective
     (no ``score``) and takes no parameter."""
 
+    CONFIG = NoParameters
     name = "odometry"
-
-    def __init__(self, **params) -> None:
-        if params:
-            from tfloc.errors import ParameterError
-
-            raise ParameterError(f"unknown parameter(s) {', '.join(sorted(params))}; known: (none)",
-                                 tuple(sorted(params)))
 
     def localize(self, problem: Problem) -> Estimate:
         return Estimate(problem.initial, True)

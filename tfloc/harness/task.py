@@ -28,12 +28,10 @@ from tfloc.core.matcher import check_solvable
 from tfloc.core.pose import Pose, angdiff
 from tfloc.errors import InvalidProblemError
 from tfloc.evaluation.outcome import AMBIGUOUS, NO_ANSWER, Thresholds, outcome
+from tfloc.evaluation.relocalization import HYPOTHESES_KEY, hypotheses_info
 from tfloc.io.scenario import Scan
 
 from .workspace import load_dataset, load_matcher, problem_of, status_of, timed_localize, warm
-
-#: how many of a global matcher's hypotheses a row keeps (top-5 success)
-HYPOTHESES = 5
 
 
 @dataclass(frozen=True)
@@ -133,8 +131,7 @@ def run_task(task: Task) -> dict[str, Any] | list[dict[str, Any]]:
     row = base_row(task, scan)
     p = est.pose
     status = status_of(est)
-    info = est.info if not est.hypotheses else {
-        **est.info, "hypotheses": [[h.x, h.y, h.theta] for h in est.hypotheses[:HYPOTHESES]]}
+    info = est.info if not est.hypotheses else {**est.info, HYPOTHESES_KEY: hypotheses_info(est.hypotheses)}
     row.update(est_x=p.x, est_y=p.y, est_theta=p.theta, runtime_s=timed.wall_s, cpu_s=timed.cpu_s,
                converged=int(bool(est.converged)), iterations=est.iterations,
                evaluations=est.evaluations, status=status,
@@ -145,7 +142,7 @@ def run_task(task: Task) -> dict[str, Any] | list[dict[str, Any]]:
     row.update(dist_err_m=d, orient_err_rad=o)
     s_est = s_true = np.nan
     recorded = ""
-    if status == "ok" and not task.thresholds.success(d, o):
+    if status == "ok" and not task.thresholds.success(d, o) and callable(getattr(matcher, "score", None)):
         try:  # why did it fail? the matcher's own objective at its answer and at the truth
             s_est, s_true = float(matcher.score(problem, p)), float(matcher.score(problem, scan.true))
             row.update(score_est=s_est, score_true=s_true)

@@ -57,12 +57,12 @@ def problem_of(scenario: Scenario, scan: Scan, initial=...) -> Problem:
 
 def warm(matcher: Matcher, problem: Problem) -> None:
     """Untimed warm-up: ``matcher.prepare(problem)`` (map-only structures) if the matcher has one,
-    then one ``score`` at the initial pose, if there is one (kernels compiled or loaded from
+    then one ``score`` at the initial pose, if there are both (kernels compiled or loaded from
     numba's cache)."""
     prepare = getattr(matcher, "prepare", None)
     if prepare is not None:
         prepare(problem)
-    if problem.initial is not None:
+    if problem.initial is not None and callable(getattr(matcher, "score", None)):
         matcher.score(problem, problem.initial)
 
 

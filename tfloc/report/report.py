@@ -30,7 +30,7 @@ from tfloc.evaluation.summary import (
 from tfloc.harness.workspace import load_dataset
 from tfloc.io.estimates import status_kind
 from tfloc.io.rundir import RunDir, RunInfo
-from tfloc.io.scenario import SCAN_TO_SCAN, SEQUENCE
+from tfloc.io.scenario import GLOBAL, SCAN_TO_SCAN, SEQUENCE
 
 from . import figures as F
 from . import sections as S
@@ -293,6 +293,17 @@ def _tracking(run_dir: Path, df: pd.DataFrame, info: RunInfo, thr: Thresholds, w
     return tracking_section(df, scenarios, maps, run_dir, thr, figures=with_figures)
 
 
+def _relocalization(run_dir: Path, df: pd.DataFrame, info: RunInfo, thr: Thresholds) -> str:
+    """The global section of a run's global datasets (:mod:`tfloc.report.relocalization`)."""
+    from tfloc.io.maps import load_map
+
+    from .relocalization import relocalization_section
+
+    maps = {n: load_map(load_dataset(str(d))[0].map_path) for n, d in info.datasets.items()
+            if n in set(df["dataset"])}
+    return relocalization_section(df, maps, run_dir, thr)
+
+
 def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
                  with_figures: bool = True) -> ReportFiles:
     """Write report.md, summary.csv and figures/*.png into ``run_dir``; returns their paths.
@@ -301,14 +312,17 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
     df, info = load_run(run_dir)
     run = info.doc
     thr = thresholds or info.thresholds
-    seq = info.datasets_in(list(df["dataset"].unique()), SEQUENCE)
+    names = list(df["dataset"].unique())
+    seq, glob = info.datasets_in(names, SEQUENCE), info.datasets_in(names, GLOBAL)
     tracking = _tracking(run_dir, df[df["dataset"].isin(seq)], info, thr, with_figures) if seq else ""
-    if seq and df["dataset"].isin(seq).all():
+    if glob:
+        tracking = _relocalization(run_dir, df[df["dataset"].isin(glob)], info, thr) + "\n" + tracking
+    if df["dataset"].isin(seq | glob).all():
         p = prepare(df, thr)
         report = run_dir / "report.md"
         report.write_text("\n".join([header(run_dir, run, p, thr, set()), tracking]))
-        return ReportFiles(report, run_dir / "tracking.csv", ())
-    p = prepare(df[~df["dataset"].isin(seq)], thr)
+        return ReportFiles(report, run_dir / ("tracking.csv" if seq else "relocalization.csv"), ())
+    p = prepare(df[~df["dataset"].isin(seq | glob)], thr)
     s2s = info.datasets_in(list(p["dataset"].unique()), SCAN_TO_SCAN)
     summary = write_summary(summary_table(p, s2s), run_dir / "summary.csv")
     order = label_order(run, p)

@@ -1,0 +1,48 @@
+"""The report's section for global datasets (``"mode": "global"``): top-1, top-5, ambiguous,
+CPU per scan and cost against the map's free area, per dataset and matcher
+(:mod:`tfloc.evaluation.relocalization`), and ``relocalization.csv``."""
+
+from __future__ import annotations
+
+from dataclasses import asdict
+from pathlib import Path
+
+import pandas as pd
+
+from tfloc.evaluation.outcome import Thresholds
+from tfloc.evaluation.relocalization import free_area_m2, result_from_row, summarize
+
+from .mdtable import num
+from .mdtable import table as md_table
+
+
+def _pct(v: float, lo: float, hi: float) -> str:
+    return f"{100 * v:.1f} [{100 * lo:.1f}–{100 * hi:.1f}]"
+
+
+def relocalization_section(df: pd.DataFrame, maps: dict[str, object], out_dir: Path,
+                           thresholds: Thresholds) -> str:
+    """The markdown of the global section for the rows ``df`` of global datasets (``maps``:
+    dataset → its map, for the free area); writes ``out_dir/relocalization.csv``."""
+    rows = df.to_dict("records")
+    results = [r for r in (result_from_row(x, thresholds, f"{x['dataset']}/{x['scan_id']}") for x in rows) if r]
+    area = {d: free_area_m2(m) for d, m in maps.items()}
+    summary = summarize(results, area)
+    pd.DataFrame([asdict(s) for s in summary]).to_csv(Path(out_dir) / "relocalization.csv", index=False,
+                                                      float_format="%.6g")
+    invalid = df[df["status"].str.startswith("invalid:")].groupby("matcher").size()
+    table = md_table(["dataset", "matcher", "n", "top-1 % [95 % CI]", "top-5 % [95 % CI]", "ambiguous %",
+                      "no answer %", "CPU ms/scan (median)", "free area m²", "CPU ms per 100 m²"],
+                     [[s.dataset, s.matcher, s.n, _pct(s.top1, s.top1_lo, s.top1_hi),
+                       _pct(s.top5, s.top5_lo, s.top5_hi), num(100 * s.ambiguous, 1), num(100 * s.no_answer, 1),
+                       num(s.cpu_ms_median, 1), num(s.free_area_m2, 0), num(s.ms_per_100m2, 2)] for s in summary])
+    text = ["## Global localization (no initial guess)\n",
+            "Each scan is localized over the whole map. top-1 = the answer within "
+            f"{100 * thresholds.dist_m:g} cm and {thresholds.orient_deg:g}°; top-5 = any of the first five "
+            "hypotheses within them (what a robot could tell apart by moving); ambiguous = a wrong answer "
+            "the matcher's own score prefers to the truth; CPU per scan with the map's index or grids "
+            "built beforehand (their build time is reported apart).\n", table]
+    if len(invalid):
+        text.append("Local matchers given these problems got `invalid:` rows (nothing ran): "
+                    + ", ".join(f"`{m}` {n}" for m, n in invalid.items()) + ".\n")
+    return "\n".join(text)
