@@ -204,8 +204,10 @@ class AmclTracker:
         self._init_at: tuple[Pose, Pose] | None = (pose, self._odom)  # (pose, odometry) to start from
         self._inits = 0
         self.updates = 0
-        self.reproducible = _pdf_seed_counter() is not None or (
-            c.initial_sigma_xy == 0 and c.initial_sigma_theta == 0)
+        #: whether runs repeat bit for bit: not with random injection (std::random_device), nor a
+        #: spread start on a build whose seed counter we do not know
+        self.reproducible = c.recovery_alpha_slow == 0 and c.recovery_alpha_fast == 0 and (
+            _pdf_seed_counter() is not None or (c.initial_sigma_xy == 0 and c.initial_sigma_theta == 0))
 
     def reset(self, pose: Pose) -> None:
         """Start the filter again at ``pose`` (the current scan's), as Nav2 does on an initial-pose

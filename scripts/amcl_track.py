@@ -8,9 +8,9 @@ elsewhere.
   grid AMCL is given, "a clean simulated grid") or in the vector map with 1 cm range noise
   (``--scans vector``); odometry drawn from the true increments with the odometry motion model
   (Thrun et al., Probabilistic Robotics, Sec. 5.4; α1…α4 = ``--alpha``).
-* ``intel``: the SLAM-corrected Intel log in time order (910 scans, 0.67 m median between scans)
-  on ``data/maps/real-intel.yaml``; the log's odometry columns are the corrected poses, so the
-  odometry is drawn from the corrected increments with the same model.
+* ``intel``, ``csail``, ``aces``: the SLAM-corrected logs in time order on ``data/maps/real-*.yaml``
+  (Intel: 910 scans, 0.67 m median between scans); the logs' odometry columns are the corrected
+  poses, so the odometry is drawn from the corrected increments with the same model.
 
 Prints one markdown row per (sequence, tracker): scans, share within 10 cm / 2°, median position
 and heading error, CPU ms per scan (median, mean) and per filter update. Usage::
@@ -129,22 +129,27 @@ def sequences(which: list[str], scans: str, alpha: float, seed: int):
             ranges = vmap.raycast(truth, laser)
             ranges = ranges + rng.normal(0.0, 0.01, ranges.shape)
         yield f"office-1 route ({scans} scans)", vmap, laser, ranges, odometry_increments(truth, alpha, rng), truth
-    if "intel" in which:
-        from tfloc.datasets.real import INTEL_LASER, clean_ranges, front_scans
+    from tfloc.datasets import real
+
+    logs = {"intel": ("intel/intel-corrected.log.gz", real.INTEL_LASER, real.NO_RETURN_M),
+            "csail": ("mit-csail/csail-corrected.log.gz", real.CSAIL_LASER, real.NO_RETURN_M),
+            "aces": ("aces/aces-corrected.log.gz", real.ACES_LASER, real.ACES_NO_RETURN_M)}
+    for name, (path, laser, no_return) in logs.items():
+        if name not in which:
+            continue
         from tfloc.io.carmen import read_carmen
         from tfloc.io.rosmap import read_ros_map
 
-        log = read_carmen(ROOT / "data" / "real" / "intel" / "intel-corrected.log.gz")
-        recs = front_scans(log, INTEL_LASER)
+        recs = real.front_scans(read_carmen(ROOT / "data" / "real" / path), laser)
         truth = np.array([r.pose.as_array() for r in recs])
-        ranges = np.vstack([clean_ranges(r.ranges) for r in recs])
-        grid = read_ros_map(ROOT / "data" / "maps" / "real-intel.yaml")
-        yield "intel (corrected, time order)", grid, INTEL_LASER, ranges, odometry_increments(truth, alpha, rng), truth
+        ranges = np.vstack([real.clean_ranges(r.ranges, no_return) for r in recs])
+        grid = read_ros_map(ROOT / "data" / "maps" / f"real-{name}.yaml")
+        yield f"{name} (corrected, time order)", grid, laser, ranges, odometry_increments(truth, alpha, rng), truth
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("which", nargs="+", choices=("sim", "intel"))
+    ap.add_argument("which", nargs="+", choices=("sim", "intel", "csail", "aces"))
     ap.add_argument("--scans", choices=("grid", "vector"), default="grid")
     ap.add_argument("--alpha", type=float, default=0.05, help="odometry noise α1…α4 (default 0.05)")
     ap.add_argument("--seed", type=int, default=20261201)
