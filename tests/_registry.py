@@ -10,7 +10,7 @@ from importlib.metadata import entry_points
 import pytest
 
 from tfloc.core.matcher import GROUP, available_matchers, get_matcher, solves_global
-from tfloc.core.tracker import is_tracker
+from tfloc.core.tracker import has_single_scan_mode
 from tfloc.errors import LibraryMissingError
 
 NAMES = available_matchers()
@@ -36,7 +36,7 @@ def build(name: str, **params):
 def kind(matcher) -> str:
     """``tracker`` (start/step, no single-scan mode), ``global`` (answers problems without an
     initial guess) or ``local``."""
-    if is_tracker(matcher) and not callable(getattr(matcher, "localize", None)):
+    if not has_single_scan_mode(matcher):
         return "tracker"
     return "global" if solves_global(matcher) else "local"
 

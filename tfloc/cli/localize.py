@@ -25,6 +25,7 @@ from pathlib import Path
 from tqdm import tqdm
 
 from tfloc.core.matcher import check_solvable
+from tfloc.core.tracker import has_single_scan_mode
 from tfloc.errors import ConfigError, InvalidProblemError
 from tfloc.harness.config import MatcherSpec
 from tfloc.harness.fingerprint import build_matcher
@@ -82,6 +83,8 @@ def run(args: argparse.Namespace) -> int:
                             keys={k: f"--param {k}" for k in params})
     build_matcher(spec)
     matcher = load_matcher(spec.name, spec.params_json)
+    if not has_single_scan_mode(matcher):
+        raise ConfigError(f"matcher {args.matcher!r} is a tracker with no single-scan mode: use tfloc track")
     if args.map is not None:
         from tfloc.io.maps import load_map
 

@@ -28,7 +28,7 @@ from pathlib import Path
 from pebble import ProcessExpired, ProcessPool
 from tqdm import tqdm
 
-from tfloc.core.tracker import is_tracker
+from tfloc.core.tracker import has_single_scan_mode
 from tfloc.errors import ConfigError, ResultsError
 from tfloc.io.estimates import ResultWriter, done_keys, drop_rows
 from tfloc.io.rundir import RunDir
@@ -80,7 +80,7 @@ def tracker_only(spec) -> bool:
         m = load_matcher(spec.name, spec.params_json)
     except Exception:  # noqa: BLE001 - build_matchers reports it
         return False
-    return is_tracker(m) and not callable(getattr(m, "localize", None))
+    return not has_single_scan_mode(m)
 
 
 def _init_worker() -> None:
