@@ -6,7 +6,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.tfloc-installed
 JOBS   ?= 2
 
-.PHONY: install quick bench robustness robustness-full scaling scaling-quick ablation-real test test-unit timing lint clean-venv real-data fuzz chaos
+.PHONY: install quick bench global-full robustness robustness-full scaling scaling-quick ablation-real test test-unit timing lint clean-venv real-data fuzz chaos
 
 $(STAMP): pyproject.toml
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -53,6 +53,13 @@ bench: $(STAMP)
 	$(BIN)/tfloc report results/robustness
 	$(BIN)/tfloc robustness results/robustness
 	$(MAKE) scaling-quick
+	$(BIN)/tfloc bench benchmarks/global.toml --jobs $(JOBS) --regenerate
+	$(BIN)/tfloc report results/global
+
+## Global localization on every scan of the global sets (issue 24) → results/global-full/.
+global-full: $(STAMP)
+	$(BIN)/tfloc bench benchmarks/global-full.toml --jobs $(JOBS) --regenerate
+	$(BIN)/tfloc report results/global-full
 
 ## Issue 25: every matcher on every map style of the real logs and every changed world of the
 ## simulated office (10 scans per offset group of each dataset; ~12 min on 2 quiet cores)
