@@ -19,7 +19,6 @@ from __future__ import annotations
 import argparse
 import csv
 import sys
-import tomllib
 from pathlib import Path
 
 from tqdm import tqdm
@@ -27,11 +26,8 @@ from tqdm import tqdm
 from tfloc.core.matcher import check_solvable
 from tfloc.core.tracker import has_single_scan_mode
 from tfloc.errors import ConfigError, InvalidProblemError
-from tfloc.harness.config import MatcherSpec
-from tfloc.harness.fingerprint import build_matcher
 from tfloc.harness.threads import limit_threads
 from tfloc.harness.workspace import (
-    load_matcher,
     problem_of,
     status_of,
     timed_localize,
@@ -39,6 +35,8 @@ from tfloc.harness.workspace import (
     warm,
 )
 from tfloc.io.scenario import iter_scans, read_scenario
+
+from ._matcher import matcher_from_args
 
 HELP = "localize the scans of a dataset with one matcher (no scoring)"
 COLUMNS = ["scan_id", "matcher", "est_x", "est_y", "est_theta", "runtime_s", "cpu_s", "converged",
@@ -59,30 +57,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--limit", type=int, default=None, help="only the first N scans")
 
 
-def parse_params(items: list[str]) -> dict:
-    """``KEY=VALUE`` options as a dict; VALUE is read as TOML (a bare word is a string)."""
-    out = {}
-    for item in items:
-        key, eq, value = item.partition("=")
-        if not eq or not key.strip():
-            raise ConfigError(f"--param {item!r}: expected KEY=VALUE")
-        try:
-            out[key.strip()] = tomllib.loads(f"v = {value}")["v"]
-        except tomllib.TOMLDecodeError:
-            out[key.strip()] = value
-    return out
-
-
 def run(args: argparse.Namespace) -> int:
     limit_threads(1)
     scenario = read_scenario(args.dataset)
-    if ":" in args.matcher:
-        raise ConfigError(f"--matcher {args.matcher}: localize runs registered matchers only")
-    params = parse_params(args.param)
-    spec = MatcherSpec.make(args.matcher, params, where=f"--matcher {args.matcher}",
-                            keys={k: f"--param {k}" for k in params})
-    build_matcher(spec)
-    matcher = load_matcher(spec.name, spec.params_json)
+    matcher = matcher_from_args(args.matcher, args.param, "localize")
     if not has_single_scan_mode(matcher):
         raise ConfigError(f"matcher {args.matcher!r} is a tracker with no single-scan mode: use tfloc track")
     if args.map is not None:

@@ -23,7 +23,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from tfloc.errors import ConfigError, ResultsError
+from tfloc.errors import ResultsError
 
 HELP = "track a sequence dataset with one matcher (guess = last estimate ⊕ odometry)"
 COLUMNS = ["scan_id", "est_x", "est_y", "est_theta", "status", "cpu_s"]
@@ -40,25 +40,17 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from tfloc.cli.localize import parse_params
-    from tfloc.harness.config import MatcherSpec
-    from tfloc.harness.fingerprint import build_matcher
     from tfloc.harness.threads import limit_threads
     from tfloc.harness.track import check_sequence, track
-    from tfloc.harness.workspace import load_matcher
     from tfloc.io.scenario import read_scans, read_scenario
+
+    from ._matcher import matcher_from_args
 
     limit_threads(1)
     scenario = read_scenario(args.dataset)
-    if ":" in args.matcher:
-        raise ConfigError(f"--matcher {args.matcher}: track runs registered matchers only")
-    params = parse_params(args.param)
     scans = read_scans(scenario)
     check_sequence(scenario, scans)
-    spec = MatcherSpec.make(args.matcher, params, where=f"--matcher {args.matcher}",
-                            keys={k: f"--param {k}" for k in params})
-    build_matcher(spec)
-    matcher = load_matcher(spec.name, spec.params_json)
+    matcher = matcher_from_args(args.matcher, args.param, "track")
     with tqdm(total=len(scans), desc=args.matcher, unit="scan", disable=not sys.stderr.isatty()) as bar:
         rows = track(scenario, scans, matcher, progress=lambda _k: bar.update(1))
     write_track(args.out, rows)
