@@ -107,23 +107,29 @@ def raster_kernel(segs: np.ndarray, x0: float, y0: float, res: float, nx: int,
 
 
 @njit(cache=True, nogil=True)
+def raster_code(x: float, y: float, codes: np.ndarray, x0: float, y0: float, res: float,
+                segs: np.ndarray, sure: float) -> int:
+    """:func:`inside_kernel`'s answer for one point, from the cell codes of
+    :func:`raster_kernel` where the point's cell is pure (outside the raster: outside), else from
+    :func:`inside_kernel`."""
+    ny, nx = codes.shape
+    fx = math.floor((x - x0) / res)
+    fy = math.floor((y - y0) / res)
+    if not (fx >= 0.0 and fy >= 0.0 and fx < nx and fy < ny):
+        return 0                                         # beyond the rings' bounds (or NaN)
+    code = codes[int(fy), int(fx)]
+    if code >= 0:
+        return code
+    return inside_kernel(np.array([x]), np.array([y]), segs, sure)[0]
+
+
+@njit(cache=True, nogil=True)
 def raster_inside_kernel(xs: np.ndarray, ys: np.ndarray, codes: np.ndarray, x0: float, y0: float,
                          res: float, segs: np.ndarray, sure: float) -> np.ndarray:
-    """:func:`inside_kernel`'s answers, from the cell codes of :func:`raster_kernel` where the
-    point's cell is pure (outside the raster: outside), else from :func:`inside_kernel`."""
-    ny, nx = codes.shape
+    """:func:`raster_code` of every point ``(xs[i], ys[i])``."""
     out = np.empty(xs.shape[0], dtype=np.int8)
     for i in range(xs.shape[0]):
-        fx = math.floor((xs[i] - x0) / res)
-        fy = math.floor((ys[i] - y0) / res)
-        if not (fx >= 0.0 and fy >= 0.0 and fx < nx and fy < ny):
-            out[i] = 0                                   # beyond the rings' bounds (or NaN)
-            continue
-        code = codes[int(fy), int(fx)]
-        if code >= 0:
-            out[i] = code
-        else:
-            out[i] = inside_kernel(xs[i:i + 1], ys[i:i + 1], segs, sure)[0]
+        out[i] = raster_code(xs[i], ys[i], codes, x0, y0, res, segs, sure)
     return out
 
 
