@@ -215,3 +215,25 @@ def test_tf_plus_turning_function_equals_the_step_by_step_one(test_room, lms200)
     few = np.full(lms200.n_beams, np.inf)
     few[90:92] = 2.0
     assert scan_turning_function(few, lms200) is None and _turning_function(few, lms200, ShapeConfig()) is None
+
+
+def test_lattice_on_a_vector_map_equals_the_map_queries() -> None:
+    import shapely
+
+    from tfloc.io.maps import load_map
+    from tfloc.tfplus.coarse import _offsets, lattice
+    from tfloc.tfplus.view import map_view
+
+    m = load_map(ROOT / "data" / "maps" / "office-2.geojson")
+    view = map_view(m, 0.05, 0.3, 0.3)
+    rng = np.random.default_rng(8)
+    x0, y0, x1, y1 = m.bounds
+    free, area = m._free_space(0.0), m.area
+    for centre in rng.uniform((x0 - 1, y0 - 1), (x1 + 1, y1 + 1), (40, 2)):
+        for clearance in (0.1, 0.07, 0.0):
+            xy = centre[None, :] + _offsets(3.3, 0.2)
+            keep = view(xy) >= clearance
+            keep &= shapely.intersects_xy(area, xy[:, 0], xy[:, 1])
+            keep &= shapely.contains_xy(free, xy[:, 0], xy[:, 1])
+            got = lattice(m, view, centre, 3.3, 0.2, clearance)
+            assert got.tobytes() == xy[keep].tobytes()

@@ -45,14 +45,16 @@ def _maps() -> list[VectorMap]:
     return maps
 
 
+@pytest.mark.parametrize("cell", [0.1, 0.37])
 @pytest.mark.parametrize("index", range(5))
-def test_is_free_and_in_bounds_equal_shapely(index: int, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_is_free_and_in_bounds_equal_shapely(index: int, cell: float,
+                                             monkeypatch: pytest.MonkeyPatch) -> None:
     maps = _maps()
     if index >= len(maps):
         pytest.skip("map not bundled")
     m = maps[index]
     rng = np.random.default_rng(index)
-    monkeypatch.setattr(inside, "FEW", 10**9)   # the compiled test for every query
+    monkeypatch.setattr(inside, "CELL", cell)
     for clearance in (0.0, 0.1, 0.3):
         free = m._free_space(clearance)
         xy = _points(free, rng, 4000)
@@ -60,6 +62,15 @@ def test_is_free_and_in_bounds_equal_shapely(index: int, monkeypatch: pytest.Mon
         np.testing.assert_array_equal(m.is_free(xy, clearance), expect)
         np.testing.assert_array_equal(np.concatenate([m.is_free(p[None], clearance) for p in xy[:300]]),
                                       expect[:300])
+        rings = m.free_rings(clearance)
+        assert rings is not None and rings.res == cell
+        assert (rings.codes >= 0).mean() > 0.3          # most cells are answered by the raster
+        # points on the raster's cell edges and corners
+        edges = np.stack(np.meshgrid(rings.x0 + rings.res * np.arange(rings.codes.shape[1]),
+                                     rings.y0 + rings.res * np.arange(rings.codes.shape[0])),
+                         axis=-1).reshape(-1, 2)
+        np.testing.assert_array_equal(m.is_free(edges, clearance),
+                                      shapely.contains_xy(free, edges[:, 0], edges[:, 1]))
     xy = _points(m.area, rng, 4000)
     np.testing.assert_array_equal(m.in_bounds(xy), shapely.intersects_xy(m.area, xy[:, 0], xy[:, 1]))
 

@@ -1,17 +1,20 @@
 """A compiled point-in-area test that gives shapely's answers, for many single-point queries.
 
 ``shapely.contains_xy`` / ``intersects_xy`` cost a few microseconds per call whatever the number of
-points, and ``tf`` asks one point per cost evaluation (hundreds per scan); for many points at
-once shapely's indexed test is the faster and answers (more than :data:`FEW` points). :class:`Rings` holds the
+points, and ``tf`` asks one point per cost evaluation (hundreds per scan), ``tf-plus`` some 800
+lattice points per scan. :class:`Rings` holds the
 boundary segments of a valid (Multi)Polygon and answers by crossing parity, compiled; a point
 closer than :data:`SURE` metres to the boundary is *unsure* and left to shapely, so every answer is
 shapely's: away from the boundary the parity of a valid polygon's rings is the interior (the
 rounding of the crossing test is ~1e-14 m on maps of tens of metres, far below :data:`SURE`), and
-on or near the boundary, where ``contains`` and ``intersects`` differ, shapely decides.
+on or near the boundary, where ``contains`` and ``intersects`` differ, shapely decides. Most
+points are answered by one look-up in a raster of the area (:func:`raster_kernel`): a cell no
+segment comes near lies wholly on one side, the side of its centre.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,7 +23,8 @@ from numba import njit
 from shapely.geometry.base import BaseGeometry
 
 SURE = 1e-7  # metres from the boundary beyond which the compiled test decides alone
-FEW = 8      # queries of more points go to shapely (its prepared geometry is indexed)
+CELL = 0.1          # metres: the raster's cell (larger on maps of more than MAX_CELLS cells)
+MAX_CELLS = 4e6
 
 
 @njit(cache=True, nogil=True)
@@ -50,12 +54,97 @@ def inside_kernel(xs: np.ndarray, ys: np.ndarray, segs: np.ndarray, sure: float)
     return out
 
 
+@njit(cache=True, nogil=True)
+def _segment_distance(x: float, y: float, x1: float, y1: float, x2: float, y2: float) -> float:
+    """Distance (metres) of ``(x, y)`` from the segment ``(x1, y1)–(x2, y2)``."""
+    ex, ey = x2 - x1, y2 - y1
+    ll = ex * ex + ey * ey
+    u = 0.0
+    if ll > 0.0:
+        u = min(1.0, max(0.0, ((x - x1) * ex + (y - y1) * ey) / ll))
+    dx, dy = x1 + u * ex - x, y1 + u * ey - y
+    return math.sqrt(dx * dx + dy * dy)
+
+
+@njit(cache=True, nogil=True)
+def raster_kernel(segs: np.ndarray, x0: float, y0: float, res: float, nx: int,
+                  ny: int) -> np.ndarray:
+    """Per cell ``(ny, nx)`` of side ``res`` from ``(x0, y0)``: 1 wholly inside the rings
+    ``segs``, 0 wholly outside, -1 *mixed* (a segment passes within the cell's half-diagonal, plus
+    a margin, of its centre). A pure cell's side is the crossing parity at its centre, counted
+    row by row (the crossings of the row's line, sorted), as :func:`inside_kernel` counts it."""
+    codes = np.zeros((ny, nx), dtype=np.int8)
+    reach = res * math.sqrt(0.5) + 1e-9
+    for m in range(segs.shape[0]):                      # mixed cells along every segment
+        x1, y1, x2, y2 = segs[m, 0], segs[m, 1], segs[m, 2], segs[m, 3]
+        c0 = max(int(math.floor((min(x1, x2) - reach - x0) / res)) - 1, 0)
+        c1 = min(int(math.floor((max(x1, x2) + reach - x0) / res)) + 1, nx - 1)
+        r0 = max(int(math.floor((min(y1, y2) - reach - y0) / res)) - 1, 0)
+        r1 = min(int(math.floor((max(y1, y2) + reach - y0) / res)) + 1, ny - 1)
+        for r in range(r0, r1 + 1):
+            yc = y0 + (r + 0.5) * res
+            for c in range(c0, c1 + 1):
+                if _segment_distance(x0 + (c + 0.5) * res, yc, x1, y1, x2, y2) <= reach:
+                    codes[r, c] = -1
+    xs = np.empty(segs.shape[0])
+    for r in range(ny):                                  # parity of the pure cells, per row
+        y = y0 + (r + 0.5) * res
+        k = 0
+        for m in range(segs.shape[0]):
+            x1, y1, x2, y2 = segs[m, 0], segs[m, 1], segs[m, 2], segs[m, 3]
+            if (y1 > y) != (y2 > y):
+                xs[k] = x1 + (y - y1) * (x2 - x1) / (y2 - y1)
+                k += 1
+        cross = np.sort(xs[:k])
+        j = 0                                            # crossings at or left of the centre
+        for c in range(nx):
+            x = x0 + (c + 0.5) * res
+            while j < k and cross[j] <= x:
+                j += 1
+            if codes[r, c] == 0 and (k - j) % 2 == 1:    # odd count to the right: inside
+                codes[r, c] = 1
+    return codes
+
+
+@njit(cache=True, nogil=True)
+def raster_code(x: float, y: float, codes: np.ndarray, x0: float, y0: float, res: float,
+                segs: np.ndarray, sure: float) -> int:
+    """:func:`inside_kernel`'s answer for one point, from the cell codes of
+    :func:`raster_kernel` where the point's cell is pure (outside the raster: outside), else from
+    :func:`inside_kernel`."""
+    ny, nx = codes.shape
+    fx = math.floor((x - x0) / res)
+    fy = math.floor((y - y0) / res)
+    if not (fx >= 0.0 and fy >= 0.0 and fx < nx and fy < ny):
+        return 0                                         # beyond the rings' bounds (or NaN)
+    code = codes[int(fy), int(fx)]
+    if code >= 0:
+        return code
+    return inside_kernel(np.array([x]), np.array([y]), segs, sure)[0]
+
+
+@njit(cache=True, nogil=True)
+def raster_inside_kernel(xs: np.ndarray, ys: np.ndarray, codes: np.ndarray, x0: float, y0: float,
+                         res: float, segs: np.ndarray, sure: float) -> np.ndarray:
+    """:func:`raster_code` of every point ``(xs[i], ys[i])``."""
+    out = np.empty(xs.shape[0], dtype=np.int8)
+    for i in range(xs.shape[0]):
+        out[i] = raster_code(xs[i], ys[i], codes, x0, y0, res, segs, sure)
+    return out
+
+
 @dataclass(frozen=True, eq=False)
 class Rings:
-    """The boundary of a valid Polygon or MultiPolygon ``geom`` as segments ``(M, 4)``."""
+    """The boundary of a valid Polygon or MultiPolygon ``geom`` as segments ``(M, 4)``, and a
+    raster of its cells (:func:`raster_kernel`: ``codes``, cell ``res`` metres from
+    ``(x0, y0)``) that answers most queries by one look-up."""
 
     geom: BaseGeometry
     segs: np.ndarray
+    codes: np.ndarray
+    x0: float
+    y0: float
+    res: float
 
     @classmethod
     def of(cls, geom: BaseGeometry) -> Rings | None:
@@ -68,19 +157,23 @@ class Rings:
         for ring in shapely.get_parts(shapely.get_rings(shapely.get_parts(geom))):
             c = shapely.get_coordinates(ring)
             parts.append(np.hstack((c[:-1], c[1:])))
-        return cls(geom, np.ascontiguousarray(np.vstack(parts), dtype=float))
+        segs = np.ascontiguousarray(np.vstack(parts), dtype=float)
+        x_min, y_min, x_max, y_max = geom.bounds
+        res = max(CELL, math.sqrt((x_max - x_min) * (y_max - y_min) / MAX_CELLS))
+        x0, y0 = x_min - 2 * res, y_min - 2 * res       # two cells beyond the bounds
+        nx = int(math.ceil((x_max - x_min) / res)) + 4
+        ny = int(math.ceil((y_max - y_min) / res)) + 4
+        return cls(geom, segs, raster_kernel(segs, x0, y0, res, nx, ny), x0, y0, res)
 
     def contains(self, xy: np.ndarray, boundary: bool) -> np.ndarray:
         """Which ``(N, 2)`` points lie in the interior (``boundary`` False: ``contains_xy``) or in
         the interior or on the boundary (True: ``intersects_xy``)."""
         x = np.ascontiguousarray(xy[:, 0], dtype=float)
         y = np.ascontiguousarray(xy[:, 1], dtype=float)
-        test = shapely.intersects_xy if boundary else shapely.contains_xy
-        if len(x) > FEW:       # shapely's indexed test is the faster for many points
-            return test(self.geom, x, y)
-        code = inside_kernel(x, y, self.segs, SURE)
+        code = raster_inside_kernel(x, y, self.codes, self.x0, self.y0, self.res, self.segs, SURE)
         out = code == 1
         unsure = code < 0
         if unsure.any():
+            test = shapely.intersects_xy if boundary else shapely.contains_xy
             out[unsure] = test(self.geom, x[unsure], y[unsure])
         return out

@@ -116,6 +116,10 @@ class VectorMap:
         run it inside their own compiled code."""
         return self._rings(("rings", round(float(clearance), 9)), self._free_space(clearance))
 
+    def area_rings(self) -> Rings | None:
+        """The compiled test behind :meth:`in_bounds` (``None``: shapely answers)."""
+        return self._rings("area-rings", self.area)
+
     def is_free(self, xy: np.ndarray, clearance: float = 0.0) -> np.ndarray:
         """Which ``(N, 2)`` points are in free space at least ``clearance`` metres from geometry
         (shapely's ``contains_xy``; answered by the compiled :class:`~tfloc.maps.inside.Rings`,
@@ -130,11 +134,11 @@ class VectorMap:
         """Which ``(N, 2)`` points lie inside the mapped area (boundary included; shapely's
         ``intersects_xy``, answered as :meth:`is_free` is)."""
         p = np.asarray(xy, dtype=float).reshape(-1, 2)
-        area = self.area
-        shapely.prepare(area)
-        rings = self._rings("area-rings", area)
+        rings = self.area_rings()
         if rings is not None:
             return rings.contains(p, boundary=True)
+        area = self.area
+        shapely.prepare(area)
         return shapely.intersects_xy(area, p[:, 0], p[:, 1])
 
     def sample_points(self, spacing: float) -> tuple[np.ndarray, np.ndarray]:

@@ -17,8 +17,10 @@ from functools import lru_cache
 import numpy as np
 
 from tfloc.core.map import Map
+from tfloc.maps.inside import SURE
+from tfloc.maps.vector import VectorMap
 
-from .kernels import grid_scores_kernel, pose_scores_kernel, separated_kernel
+from .kernels import grid_scores_kernel, lattice_kernel, pose_scores_kernel, separated_kernel
 from .view import MapView
 
 
@@ -28,6 +30,17 @@ def lattice(map_: Map, field: MapView, centre: np.ndarray, radius: float, step: 
     at least ``clearance`` from the map's points (by the distance field: a clearance query to
     the map itself can cost more than the whole search on a map used once)."""
     xy = centre[None, :] + _offsets(float(radius), float(step))
+    if isinstance(map_, VectorMap):            # the same tests in one compiled call (the field
+        # compared in its own dtype, as numpy compares a float32 array with a Python float)
+        area, free = map_.area_rings(), map_.free_rings()
+        if area is not None and free is not None:
+            corner = field.origin
+            keep, decided = lattice_kernel(
+                xy, field.table, float(corner[0]), float(corner[1]), field.resolution,
+                field.table.dtype.type(clearance), area.codes, area.x0, area.y0, area.res, area.segs, free.codes,
+                free.x0, free.y0, free.res, free.segs, SURE)
+            if decided:
+                return xy[keep]
     keep = field(xy) >= clearance
     keep[keep] = map_.in_bounds(xy[keep])
     keep[keep] = map_.is_free(xy[keep])

@@ -13,6 +13,7 @@ from numba import njit
 
 from tfloc.maps._gridcast import _entry, _start, _step
 from tfloc.maps._raycast import _atan2
+from tfloc.maps.inside import raster_code
 
 
 @njit(cache=True, nogil=True)
@@ -371,3 +372,35 @@ def see_through_kernel(occ: np.ndarray, origin_x: float, origin_y: float, resolu
                 if not inside_grid:
                     break
     return out
+
+
+@njit(cache=True, nogil=True)
+def lattice_kernel(xy: np.ndarray, table: np.ndarray, corner_x: float, corner_y: float,
+                   resolution: float, clearance: float, area_codes: np.ndarray, area_x0: float,
+                   area_y0: float, area_res: float, area_segs: np.ndarray, free_codes: np.ndarray,
+                   free_x0: float, free_y0: float, free_res: float, free_segs: np.ndarray,
+                   sure: float) -> tuple[np.ndarray, bool]:
+    """:func:`tfloc.tfplus.coarse.lattice`'s test of the positions ``xy`` ``(N, 2)`` on a vector
+    map, in one call: the distance field (``table``, cells of ``resolution`` from the corner) at
+    least ``clearance`` (of the table's dtype), in the mapped area and in free space (:func:`tfloc.maps.inside.raster_code`
+    on the area's and the free space's rings). Returns the mask and whether every point was
+    decided (False: one lay too near a boundary for the compiled test; ask the map)."""
+    h, w = table.shape
+    flat = table.ravel()
+    keep = np.zeros(xy.shape[0], dtype=np.bool_)
+    for i in range(xy.shape[0]):
+        x, y = xy[i, 0], xy[i, 1]
+        ix = min(max(np.int64(math.floor((x - corner_x) / resolution)), 0), w - 1)
+        iy = min(max(np.int64(math.floor((y - corner_y) / resolution)), 0), h - 1)
+        if not flat[iy * w + ix] >= clearance:
+            continue
+        code = raster_code(x, y, area_codes, area_x0, area_y0, area_res, area_segs, sure)
+        if code < 0:
+            return keep, False
+        if code == 0:
+            continue
+        code = raster_code(x, y, free_codes, free_x0, free_y0, free_res, free_segs, sure)
+        if code < 0:
+            return keep, False
+        keep[i] = code == 1
+    return keep, True
