@@ -140,3 +140,15 @@ def test_study_end_to_end_on_a_tiny_configuration(tmp_path):
         assert (tmp_path / f).stat().st_size > 0, f
     readme = (tmp_path / "README.md").read_text()
     assert "**tf-plus**" in readme and "CPU per scan against map area, 5 cm grid" in readme
+
+
+def test_a_matcher_over_budget_is_not_run_at_larger_levels():
+    study = _study()
+    cfg = study.StudyConfig(areas_m2=(300.0, 1200.0, 5000.0), kinds=("vector",), axes=("area",),
+                            scans_per_level=2, matchers=("tf-plus",), budget_ms=1e-6)
+    result = study.run_study(cfg, log=lambda s: None)
+    assert set(result["rows"]["level"]) == {"1x1"}
+    skips = result["skips"]
+    assert list(skips["level"]) == ["2x2", "4x4"] and skips["why"].str.contains("> 1e-06 ms at 1x1").all()
+    prep = result["prep"]
+    assert list(prep.loc[prep["matcher"] == "tf-plus", "status"]) == ["ok", "skipped", "skipped"]
