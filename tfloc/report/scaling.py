@@ -119,8 +119,38 @@ def prep_section(prep: pd.DataFrame, prep_slopes: pd.DataFrame) -> str:
     return "\n".join(out)
 
 
-def write_readme(path: Path, levels: pd.DataFrame, slopes: pd.DataFrame, prep: pd.DataFrame,
-                 prep_slopes: pd.DataFrame, skips: pd.DataFrame, config: dict, provenance: dict) -> Path:
+def changed_outcomes(rows: pd.DataFrame) -> str:
+    """A sentence on the area axis's scans whose success differs between the smallest map and a
+    larger one (the scans are the same: only the map around them grew), with their errors."""
+    a = rows[rows["axis"] == "area"]
+    if a.empty or a["level"].nunique() < 2:
+        return ""
+    first = a.loc[a["size"] == a["size"].min()].set_index(["kind", "matcher", "scan_id"])
+    rest = a.loc[a["size"] > a["size"].min()]
+    base = first["success"].reindex(pd.MultiIndex.from_frame(rest[["kind", "matcher", "scan_id"]]))
+    flip = rest[(rest["success"].to_numpy() != base.to_numpy())]
+    if flip.empty:
+        return ("**Success across sizes.** Every matcher answered every scan the same way (success "
+                "or not) at every map size.")
+    lost = flip[flip["success"] == 0]
+    pairs = flip.groupby(["kind", "matcher"])["scan_id"].nunique()
+    return (f"**Success across sizes.** The scans are the same at every size, yet "
+            f"{int(pairs.sum())} (matcher, scan) pairs out of "
+            f"{a.groupby(['kind', 'matcher'])['scan_id'].nunique().sum()} change outcome between the "
+            f"one-tile map and a larger one ({len(lost)} rows lost, {len(flip) - len(lost)} gained; "
+            f"by matcher: {', '.join(f'{m} {k} {n}' for (k, m), n in pairs.items())}). From 2 × 2 "
+            f"tiles on, tile (0, 0) has neighbours 0.4 m behind its outline walls (a wall's "
+            f"thickness): the median distance error of the lost rows is "
+            f"{lost['dist_err_m'].median():.2f} m, i.e. a wall matched to the neighbour's parallel "
+            f"wall. This is the larger map's geometry, not the study's scans; the costs are "
+            f"compared on the same scans all the same.") if len(lost) else (
+            f"**Success across sizes.** {int(pairs.sum())} (matcher, scan) pairs change outcome "
+            f"between the one-tile map and a larger one, all gained.")
+
+
+def write_readme(path: Path, rows: pd.DataFrame, levels: pd.DataFrame, slopes: pd.DataFrame,
+                 prep: pd.DataFrame, prep_slopes: pd.DataFrame, skips: pd.DataFrame, config: dict,
+                 provenance: dict) -> Path:
     """The study's README.md."""
     load0, load1 = provenance.get("loadavg_start", []), provenance.get("loadavg_end", [])
     lines = ["# Scaling study: CPU per scan against map area, beam count and initial offset", "",
@@ -149,6 +179,7 @@ def write_readme(path: Path, levels: pd.DataFrame, slopes: pd.DataFrame, prep: p
              f"**Budgets.** A matcher whose median at a level exceeded {config.get('budget_ms'):g} ms, "
              f"or whose preparation exceeded {config.get('prep_budget_s'):g} s CPU, was not run at the "
              "larger levels of that axis (listed below); its slope covers the levels it ran.", "",
+             changed_outcomes(rows), "",
              "![scaling](scaling.png)", "", "## Per matcher", "", *sentences(slopes), ""]
     for axis, kind in (("area", "vector"), ("area", "grid"), ("beams", "vector"), ("offset", "vector")):
         sec = level_section(levels, axis, kind, slopes)
