@@ -112,6 +112,8 @@ def test_slope_table_from_levels():
     sl = slope_table(levels).set_index("matcher")
     assert sl.loc["a", "slope"] == pytest.approx(0.0, abs=1e-9) and not sl.loc["a", "grows"]
     assert sl.loc["b", "slope"] == pytest.approx(1.0) and sl.loc["b", "grows"]
+    assert sl.loc["a", "ms_per_unit"] == pytest.approx(0.0, abs=1e-9)
+    assert sl.loc["b", "ms_per_unit"] == pytest.approx(2.0, rel=1e-3)
 
 
 def test_study_end_to_end_on_a_tiny_configuration(tmp_path):

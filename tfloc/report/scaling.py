@@ -21,6 +21,9 @@ from .mdtable import num, table
 AXIS_TITLES = {("area", "vector"): "map area, vector map", ("area", "grid"): "map area, 5 cm grid",
                ("beams", "vector"): "beam count (office, vector)",
                ("offset", "vector"): "initial distance offset (office, vector)"}
+#: The linear slope's unit per axis: (label, factor applied to ms per unit of size).
+LINEAR_UNIT = {"area": ("ms per 10⁴ m²", 1e4), "beams": ("ms per 100 beams", 100.0),
+               "offset": ("ms per m", 1.0)}
 AXIS_X = {"area": "map extent (m²)", "beams": "beams per scan", "offset": "offset bin centre (m)"}
 
 
@@ -42,18 +45,21 @@ def level_section(levels: pd.DataFrame, axis: str, kind: str, slopes: pd.DataFra
     cols = list(order["level"])
     sizes = list(order["size"])
     n = int(sub["n"].max())
+    unit, factor = LINEAR_UNIT[axis]
     head = ["matcher"] + [f"{lv} ({num(s, 0)})" if axis != "offset" else lv for lv, s in
-                          zip(cols, sizes, strict=True)] + ["slope", "grows?"]
+                          zip(cols, sizes, strict=True)] + ["slope", "grows?", unit]
     body = []
     for m in sorted(sub["matcher"].unique()):
         s = slopes[(slopes["axis"] == axis) & (slopes["kind"] == kind) & (slopes["matcher"] == m)]
         slope = float(s["slope"].iloc[0]) if len(s) else math.nan
+        linear = float(s["ms_per_unit"].iloc[0]) * factor if len(s) else math.nan
         body.append([m] + [_cell(levels, axis, kind, m, lv) for lv in cols]
-                    + [num(slope, 2), _verdict(slope)])
+                    + [num(slope, 2), _verdict(slope), f"{linear:+.2f}" if math.isfinite(linear) else "—"])
     title = AXIS_TITLES.get((axis, kind), f"{axis}, {kind}")
     return (f"### CPU per scan against {title}\n\nMedian CPU ms per scan (success rate), n = {n} scans "
-            f"per cell; column heads: level ({AXIS_X[axis]}); slope of log(median CPU) against "
-            f"log({AXIS_X[axis].split(' (')[0]}).\n\n" + table(head, body) + "\n")
+            f"per table cell; column heads: level ({AXIS_X[axis]}); slope of log(median CPU) against "
+            f"log({AXIS_X[axis].split(' (')[0]}); last column: the least-squares slope of the median "
+            f"itself ({unit}), the additive part a log–log slope hides while it is small.\n\n" + table(head, body) + "\n")
 
 
 def _verdict(slope: float) -> str:
