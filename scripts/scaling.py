@@ -366,6 +366,15 @@ def run_study(cfg: StudyConfig, log: Callable[[str], None] = print) -> dict:
     tile = read_vector_map(ROOT / cfg.map_path if not Path(cfg.map_path).is_absolute() else cfg.map_path)
     matchers = build_matchers(cfg.matchers or available_matchers(), log)
     gc.freeze()  # the libraries' objects: every later gc.collect (memory probes) skips them
+    try:
+        return _run_levels(cfg, tile, matchers, log)
+    finally:
+        gc.unfreeze()
+
+
+def _run_levels(cfg: StudyConfig, tile: VectorMap, matchers: dict[str, object],
+                log: Callable[[str], None]) -> dict:
+    """:func:`run_study`'s loop over the levels, with the budgets."""
     levels, map_prep = build_levels(cfg, tile)
     rows, prep, skips = [], [], []
     out_of_budget: dict[tuple[str, str, str], str] = {}   # (axis, kind, matcher) → why
@@ -478,6 +487,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         result = run_study(cfg, lambda s: print(s, flush=True))
         provenance = {"command": "make scaling-quick" if args.quick else "make scaling",
                       "started": started, "wall_s": round(time.perf_counter() - w0, 1),
+                      "cpu_s": round(time.process_time(), 1),
                       "loadavg_start": [round(x, 2) for x in load0],
                       "loadavg_end": [round(x, 2) for x in os.getloadavg()], "cores": cores,
                       "cpu": _cpu_model(), "python": platform.python_version(),

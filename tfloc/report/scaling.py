@@ -170,7 +170,8 @@ def write_readme(path: Path, rows: pd.DataFrame, levels: pd.DataFrame, slopes: p
              f"Machine: {provenance.get('cpu', '?')}, Python {provenance.get('python', '?')}; "
              f"**the machine was shared** with other jobs (load average {load0} at the start, "
              f"{load1} at the end): CPU times are robust to that, wall times are not. Started "
-             f"{provenance.get('started', '?')}, {provenance.get('wall_s', '?')} s wall.", "",
+             f"{provenance.get('started', '?')}, {provenance.get('wall_s', '?')} s wall"
+             + (f", {provenance['cpu_s']} s CPU in all." if "cpu_s" in provenance else "."), "",
              "**Problems.** The office floor `" + str(config.get("map_path")) + "` tiled n × n "
              "(tiles 0.4 m apart, each closed by its own outline); scans simulated in tile (0, 0) "
              "(LMS200 model plus 1 cm noise, seeded), so the same scans at every map size. Initial "
