@@ -159,3 +159,9 @@ def test_a_matcher_over_budget_is_not_run_at_larger_levels():
     assert list(skips["level"]) == ["2x2", "4x4"] and skips["why"].str.contains("> 1e-06 ms at 1x1").all()
     prep = result["prep"]
     assert list(prep.loc[prep["matcher"] == "tf-plus", "status"]) == ["ok", "skipped", "skipped"]
+
+
+def test_tiling_needs_a_closed_tile():
+    bare = VectorMap.from_segments(np.array([[0.0, 0.0, 5.0, 0.0]]))
+    with pytest.raises(ConfigError, match="outline or a region"):
+        tile_vector_map(bare, Tiling(2, 2, 6.0, 1.0))
