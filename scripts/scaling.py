@@ -59,7 +59,7 @@ from tfloc.datasets.noise import NoiseModel
 from tfloc.datasets.protocol import strata
 from tfloc.datasets.synthetic import sample_pose_pair
 from tfloc.datasets.tiling import Tiling, tile_vector_map, tiling_for_area
-from tfloc.errors import LibraryMissingError, TflocError
+from tfloc.errors import ConfigError, LibraryMissingError, TflocError
 from tfloc.evaluation.outcome import Thresholds
 from tfloc.evaluation.scaling import (
     PREP_COLUMNS,
@@ -366,6 +366,15 @@ def run_study(cfg: StudyConfig, log: Callable[[str], None] = print) -> dict:
     tile = read_vector_map(ROOT / cfg.map_path if not Path(cfg.map_path).is_absolute() else cfg.map_path)
     matchers = build_matchers(cfg.matchers or available_matchers(), log)
     gc.freeze()  # the libraries' objects: every later gc.collect (memory probes) skips them
+    try:
+        return _run_levels(cfg, tile, matchers, log)
+    finally:
+        gc.unfreeze()
+
+
+def _run_levels(cfg: StudyConfig, tile: VectorMap, matchers: dict[str, object],
+                log: Callable[[str], None]) -> dict:
+    """:func:`run_study`'s loop over the levels, with the budgets."""
     levels, map_prep = build_levels(cfg, tile)
     rows, prep, skips = [], [], []
     out_of_budget: dict[tuple[str, str, str], str] = {}   # (axis, kind, matcher) → why
@@ -419,19 +428,34 @@ def pin_one_core() -> list[int]:
 
 
 def write_results(out: Path, result: dict, cfg: StudyConfig, provenance: dict) -> None:
-    """Every output file of the study into ``out``."""
+    """The study's raw rows (``scaling.csv``, ``prep.csv``, ``skips.csv``, ``study.json``) into
+    ``out``, then everything derived from them (:func:`render`)."""
     out.mkdir(parents=True, exist_ok=True)
-    rows, prep = result["rows"], result["prep"]
-    rows.to_csv(out / "scaling.csv", index=False, float_format="%.6g")
-    prep.to_csv(out / "prep.csv", index=False, float_format="%.6g")
+    result["rows"].to_csv(out / "scaling.csv", index=False, float_format="%.6g")
+    result["prep"].to_csv(out / "prep.csv", index=False, float_format="%.6g")
+    result["skips"].to_csv(out / "skips.csv", index=False, float_format="%.6g")
+    (out / "study.json").write_text(json.dumps({"config": asdict(cfg), **provenance}, indent=1) + "\n")
+    render(out)
+
+
+def render(out: Path) -> None:
+    """``levels.csv``, ``slopes.csv``, ``scaling.png`` and ``README.md`` from the raw files in
+    ``out`` (so the tables and text can be redrawn without measuring again)."""
+    try:
+        rows = pd.read_csv(out / "scaling.csv")
+        prep = pd.read_csv(out / "prep.csv")
+        skips = pd.read_csv(out / "skips.csv")
+        doc = json.loads((out / "study.json").read_text())
+    except (OSError, ValueError) as exc:
+        raise ConfigError(f"{out}: cannot read the study's raw files ({exc}); run the study first") from None
     levels = level_table(rows)
     slopes = slope_table(levels)
     levels.to_csv(out / "levels.csv", index=False, float_format="%.6g")
     slopes.to_csv(out / "slopes.csv", index=False, float_format="%.4g")
-    (out / "study.json").write_text(json.dumps({"config": asdict(cfg), **provenance}, indent=1) + "\n")
     write_figure(out / "scaling.png", levels, slopes, prep)
-    write_readme(out / "README.md", levels, slopes, prep, prep_slope_table(prep), result["skips"],
-                 asdict(cfg), provenance)
+    config = doc.pop("config", {})
+    write_readme(out / "README.md", rows, levels, slopes, prep, prep_slope_table(prep), skips, config,
+                 doc)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -441,6 +465,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--matchers", nargs="*", default=None, help="matcher names (default: all registered)")
     ap.add_argument("--axes", nargs="*", default=None, choices=("area", "beams", "offset"))
     ap.add_argument("--scans", type=int, default=None, help="scans per level (area and beam axes)")
+    ap.add_argument("--render", action="store_true",
+                    help="only redraw the tables, figure and README from the raw files in --out")
     args = ap.parse_args(argv)
     cfg = StudyConfig.quick() if args.quick else StudyConfig()
     if args.matchers:
@@ -451,11 +477,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         cfg = replace(cfg, scans_per_level=args.scans)
     out = args.out or ROOT / "results" / ("scaling-quick" if args.quick else "scaling")
     try:
+        if args.render:
+            render(out)
+            print(f"wrote {out}/README.md")
+            return 0
         cores = pin_one_core()
         limit_threads(1)
         started, load0, w0 = time.strftime("%Y-%m-%dT%H:%M:%S%z"), os.getloadavg(), time.perf_counter()
         result = run_study(cfg, lambda s: print(s, flush=True))
-        provenance = {"command": "make scaling-quick" if args.quick else "make scaling", "started": started, "wall_s": round(time.perf_counter() - w0, 1),
+        provenance = {"command": "make scaling-quick" if args.quick else "make scaling",
+                      "started": started, "wall_s": round(time.perf_counter() - w0, 1),
+                      "cpu_s": round(time.process_time(), 1),
                       "loadavg_start": [round(x, 2) for x in load0],
                       "loadavg_end": [round(x, 2) for x in os.getloadavg()], "cores": cores,
                       "cpu": _cpu_model(), "python": platform.python_version(),

@@ -112,13 +112,15 @@ def test_slope_table_from_levels():
     sl = slope_table(levels).set_index("matcher")
     assert sl.loc["a", "slope"] == pytest.approx(0.0, abs=1e-9) and not sl.loc["a", "grows"]
     assert sl.loc["b", "slope"] == pytest.approx(1.0) and sl.loc["b", "grows"]
+    assert sl.loc["a", "ms_per_unit"] == pytest.approx(0.0, abs=1e-9)
+    assert sl.loc["b", "ms_per_unit"] == pytest.approx(2.0, rel=1e-3)
 
 
 def test_study_end_to_end_on_a_tiny_configuration(tmp_path):
     study = _study()
     cfg = study.StudyConfig(areas_m2=(300.0, 1200.0), kinds=("vector", "grid"),
                             lasers=((180.0, 1.0), (180.0, 0.5)), resolution_m=0.1, scans_per_level=2,
-                            scans_per_offset_bin=2, matchers=("tf-plus", "o3d-icp"), warmup=1)
+                            scans_per_offset_bin=2, matchers=("tf-plus", "cv-corners"), warmup=1)
     result = study.run_study(cfg, log=lambda s: None)
     rows, prep = result["rows"], result["prep"]
     # every (axis, kind, level) × matcher × scan once
@@ -131,12 +133,35 @@ def test_study_end_to_end_on_a_tiny_configuration(tmp_path):
     assert sorted(rows.loc[rows["axis"] == "beams", "beams"].unique()) == [181, 361]
     assert (rows["cpu_ms"] > 0).all() and rows["success"].isin([0, 1]).all()
     # preparation: the map itself and each matcher, for each area level and kind
-    assert set(prep["matcher"]) == {"(map)", "tf-plus", "o3d-icp"}
+    assert set(prep["matcher"]) == {"(map)", "tf-plus", "cv-corners"}
     assert len(prep) == 3 * 2 * 2 and (prep["status"] == "ok").all()
     grid = prep[(prep["kind"] == "grid") & (prep["matcher"] == "(map)")].sort_values("size")
     assert grid["cells"].iloc[1] > 3.5 * grid["cells"].iloc[0]
     study.write_results(tmp_path, result, cfg, {"cores": [1], "cpu": "test"})
-    for f in ("scaling.csv", "prep.csv", "levels.csv", "slopes.csv", "README.md", "scaling.png", "study.json"):
+    for f in ("scaling.csv", "prep.csv", "skips.csv", "levels.csv", "slopes.csv", "README.md", "scaling.png",
+              "study.json"):
         assert (tmp_path / f).stat().st_size > 0, f
     readme = (tmp_path / "README.md").read_text()
     assert "**tf-plus**" in readme and "CPU per scan against map area, 5 cm grid" in readme
+    # the tables and README are redrawn from the raw files alone, the same
+    (tmp_path / "README.md").unlink()
+    study.render(tmp_path)
+    assert (tmp_path / "README.md").read_text() == readme
+
+
+def test_a_matcher_over_budget_is_not_run_at_larger_levels():
+    study = _study()
+    cfg = study.StudyConfig(areas_m2=(300.0, 1200.0, 5000.0), kinds=("vector",), axes=("area",),
+                            scans_per_level=2, matchers=("tf-plus",), budget_ms=1e-6)
+    result = study.run_study(cfg, log=lambda s: None)
+    assert set(result["rows"]["level"]) == {"1x1"}
+    skips = result["skips"]
+    assert list(skips["level"]) == ["2x2", "4x4"] and skips["why"].str.contains("> 1e-06 ms at 1x1").all()
+    prep = result["prep"]
+    assert list(prep.loc[prep["matcher"] == "tf-plus", "status"]) == ["ok", "skipped", "skipped"]
+
+
+def test_tiling_needs_a_closed_tile():
+    bare = VectorMap.from_segments(np.array([[0.0, 0.0, 5.0, 0.0]]))
+    with pytest.raises(ConfigError, match="outline or a region"):
+        tile_vector_map(bare, Tiling(2, 2, 6.0, 1.0))

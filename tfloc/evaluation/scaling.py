@@ -55,6 +55,17 @@ def fit_loglog(x: np.ndarray, y: np.ndarray) -> Slope:
     return Slope(float(slope), float(intercept), int(ok.sum()))
 
 
+def fit_linear(x: np.ndarray, y: np.ndarray) -> float:
+    """The least-squares slope of y on x (y's unit per x's unit): an additive cost that a log–log
+    slope hides while it is small next to the rest (e.g. ms per m² of map); NaN with fewer than
+    two distinct finite x."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    ok = np.isfinite(x) & np.isfinite(y)
+    if np.unique(x[ok]).size < 2:
+        return math.nan
+    return float(np.polyfit(x[ok], y[ok], 1)[0])
+
+
 def level_table(rows: pd.DataFrame) -> pd.DataFrame:
     """Per (axis, kind, matcher, level): scans ``n``, ``size`` (the level's x: m², beams or
     metres), median and p90 CPU ms, median wall ms and the success rate."""
@@ -68,12 +79,14 @@ def level_table(rows: pd.DataFrame) -> pd.DataFrame:
 
 def slope_table(levels: pd.DataFrame) -> pd.DataFrame:
     """Per (axis, kind, matcher): the log–log slope of median CPU against the level's size, the
-    number of levels it spans, the cost at the first and last level and whether it grows."""
+    linear slope (ms per unit of size), the number of levels it spans, the cost at the first and
+    last level and whether it grows."""
     out = []
     for (axis, kind, matcher), g in levels.groupby(["axis", "kind", "matcher"], sort=False):
         g = g.sort_values("size")
         s = fit_loglog(g["size"].to_numpy(), g["cpu_ms_median"].to_numpy())
         out.append({"axis": axis, "kind": kind, "matcher": matcher, "slope": s.slope, "levels": s.n,
+                    "ms_per_unit": fit_linear(g["size"].to_numpy(), g["cpu_ms_median"].to_numpy()),
                     "first_ms": float(g["cpu_ms_median"].iloc[0]), "last_ms": float(g["cpu_ms_median"].iloc[-1]),
                     "first_size": float(g["size"].iloc[0]), "last_size": float(g["size"].iloc[-1]),
                     "grows": s.grows if math.isfinite(s.slope) else None})

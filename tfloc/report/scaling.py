@@ -21,6 +21,9 @@ from .mdtable import num, table
 AXIS_TITLES = {("area", "vector"): "map area, vector map", ("area", "grid"): "map area, 5 cm grid",
                ("beams", "vector"): "beam count (office, vector)",
                ("offset", "vector"): "initial distance offset (office, vector)"}
+#: The linear slope's unit per axis: (label, factor applied to ms per unit of size).
+LINEAR_UNIT = {"area": ("ms per 10⁴ m²", 1e4), "beams": ("ms per 100 beams", 100.0),
+               "offset": ("ms per m", 1.0)}
 AXIS_X = {"area": "map extent (m²)", "beams": "beams per scan", "offset": "offset bin centre (m)"}
 
 
@@ -42,18 +45,21 @@ def level_section(levels: pd.DataFrame, axis: str, kind: str, slopes: pd.DataFra
     cols = list(order["level"])
     sizes = list(order["size"])
     n = int(sub["n"].max())
+    unit, factor = LINEAR_UNIT[axis]
     head = ["matcher"] + [f"{lv} ({num(s, 0)})" if axis != "offset" else lv for lv, s in
-                          zip(cols, sizes, strict=True)] + ["slope", "grows?"]
+                          zip(cols, sizes, strict=True)] + ["slope", "grows?", unit]
     body = []
     for m in sorted(sub["matcher"].unique()):
         s = slopes[(slopes["axis"] == axis) & (slopes["kind"] == kind) & (slopes["matcher"] == m)]
         slope = float(s["slope"].iloc[0]) if len(s) else math.nan
+        linear = float(s["ms_per_unit"].iloc[0]) * factor if len(s) else math.nan
         body.append([m] + [_cell(levels, axis, kind, m, lv) for lv in cols]
-                    + [num(slope, 2), _verdict(slope)])
+                    + [num(slope, 2), _verdict(slope), f"{linear:+.2f}" if math.isfinite(linear) else "—"])
     title = AXIS_TITLES.get((axis, kind), f"{axis}, {kind}")
     return (f"### CPU per scan against {title}\n\nMedian CPU ms per scan (success rate), n = {n} scans "
-            f"per cell; column heads: level ({AXIS_X[axis]}); slope of log(median CPU) against "
-            f"log({AXIS_X[axis].split(' (')[0]}).\n\n" + table(head, body) + "\n")
+            f"per table cell; column heads: level ({AXIS_X[axis]}); slope of log(median CPU) against "
+            f"log({AXIS_X[axis].split(' (')[0]}); last column: the least-squares slope of the median "
+            f"itself ({unit}), the additive part a log–log slope hides while it is small.\n\n" + table(head, body) + "\n")
 
 
 def _verdict(slope: float) -> str:
@@ -119,8 +125,38 @@ def prep_section(prep: pd.DataFrame, prep_slopes: pd.DataFrame) -> str:
     return "\n".join(out)
 
 
-def write_readme(path: Path, levels: pd.DataFrame, slopes: pd.DataFrame, prep: pd.DataFrame,
-                 prep_slopes: pd.DataFrame, skips: pd.DataFrame, config: dict, provenance: dict) -> Path:
+def changed_outcomes(rows: pd.DataFrame) -> str:
+    """A sentence on the area axis's scans whose success differs between the smallest map and a
+    larger one (the scans are the same: only the map around them grew), with their errors."""
+    a = rows[rows["axis"] == "area"]
+    if a.empty or a["level"].nunique() < 2:
+        return ""
+    first = a.loc[a["size"] == a["size"].min()].set_index(["kind", "matcher", "scan_id"])
+    rest = a.loc[a["size"] > a["size"].min()]
+    base = first["success"].reindex(pd.MultiIndex.from_frame(rest[["kind", "matcher", "scan_id"]]))
+    flip = rest[(rest["success"].to_numpy() != base.to_numpy())]
+    if flip.empty:
+        return ("**Success across sizes.** Every matcher answered every scan the same way (success "
+                "or not) at every map size.")
+    lost = flip[flip["success"] == 0]
+    pairs = flip.groupby(["kind", "matcher"])["scan_id"].nunique()
+    return (f"**Success across sizes.** The scans are the same at every size, yet "
+            f"{int(pairs.sum())} (matcher, scan) pairs out of "
+            f"{a.groupby(['kind', 'matcher'])['scan_id'].nunique().sum()} change outcome between the "
+            f"one-tile map and a larger one ({len(lost)} rows lost, {len(flip) - len(lost)} gained; "
+            f"by matcher: {', '.join(f'{m} {k} {n}' for (k, m), n in pairs.items())}). From 2 × 2 "
+            f"tiles on, tile (0, 0) has neighbours 0.4 m behind its outline walls (a wall's "
+            f"thickness): the median distance error of the lost rows is "
+            f"{lost['dist_err_m'].median():.2f} m, i.e. a wall matched to the neighbour's parallel "
+            f"wall. This is the larger map's geometry, not the study's scans; the costs are "
+            f"compared on the same scans all the same.") if len(lost) else (
+            f"**Success across sizes.** {int(pairs.sum())} (matcher, scan) pairs change outcome "
+            f"between the one-tile map and a larger one, all gained.")
+
+
+def write_readme(path: Path, rows: pd.DataFrame, levels: pd.DataFrame, slopes: pd.DataFrame,
+                 prep: pd.DataFrame, prep_slopes: pd.DataFrame, skips: pd.DataFrame, config: dict,
+                 provenance: dict) -> Path:
     """The study's README.md."""
     load0, load1 = provenance.get("loadavg_start", []), provenance.get("loadavg_end", [])
     lines = ["# Scaling study: CPU per scan against map area, beam count and initial offset", "",
@@ -134,7 +170,8 @@ def write_readme(path: Path, levels: pd.DataFrame, slopes: pd.DataFrame, prep: p
              f"Machine: {provenance.get('cpu', '?')}, Python {provenance.get('python', '?')}; "
              f"**the machine was shared** with other jobs (load average {load0} at the start, "
              f"{load1} at the end): CPU times are robust to that, wall times are not. Started "
-             f"{provenance.get('started', '?')}, {provenance.get('wall_s', '?')} s wall.", "",
+             f"{provenance.get('started', '?')}, {provenance.get('wall_s', '?')} s wall"
+             + (f", {provenance['cpu_s']} s CPU in all." if "cpu_s" in provenance else "."), "",
              "**Problems.** The office floor `" + str(config.get("map_path")) + "` tiled n × n "
              "(tiles 0.4 m apart, each closed by its own outline); scans simulated in tile (0, 0) "
              "(LMS200 model plus 1 cm noise, seeded), so the same scans at every map size. Initial "
@@ -149,6 +186,7 @@ def write_readme(path: Path, levels: pd.DataFrame, slopes: pd.DataFrame, prep: p
              f"**Budgets.** A matcher whose median at a level exceeded {config.get('budget_ms'):g} ms, "
              f"or whose preparation exceeded {config.get('prep_budget_s'):g} s CPU, was not run at the "
              "larger levels of that axis (listed below); its slope covers the levels it ran.", "",
+             changed_outcomes(rows), "",
              "![scaling](scaling.png)", "", "## Per matcher", "", *sentences(slopes), ""]
     for axis, kind in (("area", "vector"), ("area", "grid"), ("beams", "vector"), ("offset", "vector")):
         sec = level_section(levels, axis, kind, slopes)
