@@ -15,6 +15,12 @@ translation ``δtrans`` and a second rotation ``δrot2`` (Eq. 5.33–5.35). The 
 noisy increments composed from the start. A motion shorter than :data:`MIN_TRANS_M` is a turn in
 place: ``δrot1`` = 0 (its heading would be undefined), as AMCL does.
 
+Odometry is integrated at its own rate, not at the laser's: :func:`densify` cuts a trajectory
+into steps of at most :data:`ODOM_STEP_M` and :data:`ODOM_STEP_RAD` (a 10 Hz odometry at 1 m/s
+and 30°/s), and the noise is drawn on those steps, so that the odometry's error per metre does
+not depend on how far apart the scans are (the model's variance grows with the square of a step:
+drawn once per 1 m scan gap it would be ten times that of ten 0.1 m steps).
+
 Wheel slip (:class:`Slip`) is a separate, labelled perturbation: at a few scans the robot moved
 by 0.3–1 m more than the wheels say (it slid or was pushed), a jump the odometry does not see.
 Units: metres, radians.
@@ -32,6 +38,8 @@ from tfloc.errors import ConfigError
 
 #: a motion shorter than this (metres) is a turn in place: δrot1 = 0
 MIN_TRANS_M = 0.01
+#: the longest odometry step (metres, radians): a 10 Hz odometry at 1 m/s and 30°/s
+ODOM_STEP_M, ODOM_STEP_RAD = 0.1, math.radians(3.0)
 ORIGIN = Pose()
 
 
@@ -129,3 +137,25 @@ def draw_odometry(true_poses: np.ndarray, noise: OdometryNoise, rng: np.random.G
                 inc = Pose(inc.x - dist * math.cos(ang), inc.y - dist * math.sin(ang), inc.theta)
         odom.append(odom[-1].compose(inc))
     return np.array([p.as_array() for p in odom]), slipped
+
+
+def densify(poses: np.ndarray, step_m: float = ODOM_STEP_M,
+            step_rad: float = ODOM_STEP_RAD) -> tuple[np.ndarray, np.ndarray]:
+    """The trajectory ``poses`` ``(N, 3)`` with every gap cut into equal steps of at most
+    ``step_m`` and ``step_rad`` (x, y and the unwrapped heading interpolated linearly); returns
+    the dense poses and the index of each original pose in them."""
+    P = np.asarray(poses, dtype=float)
+    out, idx = [P[:1]], [0]
+    for a, b in zip(P[:-1], P[1:], strict=True):
+        dth = float(wrap_angle(b[2] - a[2]))
+        n = max(1, math.ceil(math.hypot(b[0] - a[0], b[1] - a[1]) / step_m - 1e-9),
+                math.ceil(abs(dth) / step_rad - 1e-9))
+        f = np.arange(1, n + 1)[:, None] / n
+        seg = np.column_stack([a[0] + f[:, 0] * (b[0] - a[0]), a[1] + f[:, 0] * (b[1] - a[1]),
+                               a[2] + f[:, 0] * dth])
+        seg[-1] = b
+        out.append(seg)
+        idx.append(idx[-1] + n)
+    dense = np.vstack(out)
+    dense[:, 2] = wrap_angle(dense[:, 2])
+    return dense, np.array(idx)
