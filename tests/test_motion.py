@@ -94,6 +94,17 @@ def test_densify_keeps_the_poses_and_bounds_the_steps():
     turns = np.abs(np.angle(np.exp(1j * np.diff(dense[:, 2]))))
     assert steps.max() <= 0.1 + 1e-9 and turns.max() <= math.radians(3) + 1e-9
     assert at[1] == 10 and at[2] - at[1] == math.ceil(1.2 / math.radians(3))
+    # every step is a turn in place or a straight drive (forwards or backwards)
+    for a, b in zip(dense[:-1], dense[1:], strict=True):
+        d = Pose.from_array(a).between(Pose.from_array(b))
+        assert abs(d.y) < 1e-6 or abs(d.theta) < 1e-9 or np.hypot(d.x, d.y) < 1e-9 or b is dense[-1]
+
+
+def test_backward_steps_are_as_noisy_as_forward_ones():
+    noise = OdometryNoise(0.1, 0.05, 0.1, 0.05)
+    fwd = sample_increments(Pose(0.1, 0.0, 0.0), noise, np.random.default_rng(2), 20000)
+    bwd = sample_increments(Pose(-0.1, 0.0, 0.0), noise, np.random.default_rng(2), 20000)
+    np.testing.assert_allclose(np.std(fwd, axis=0), np.std(bwd, axis=0), rtol=0.05)
 
 
 def test_scan_rate_does_not_change_the_odometry():

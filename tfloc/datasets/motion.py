@@ -10,7 +10,10 @@ translation ``δtrans`` and a second rotation ``δrot2`` (Eq. 5.33–5.35). The 
 * ``δrot2``: α1·δrot2² + α2·δtrans²
 
 (α1: rotation from rotation, α2: rotation from translation, α3: translation from translation,
-α4: translation from rotation; the model AMCL's ``diff`` odometry uses). Here it draws the
+α4: translation from rotation; the model AMCL's ``diff`` odometry uses). As in AMCL (Nav2's
+``DifferentialMotionModel``), the rotations enter the variances as ``min(|δrot|, π − |δrot|)``,
+so that driving backwards is as noisy as driving forwards (the book's formula would count a
+backward step as a half turn). Here it draws the
 *odometry* a robot would have measured from its *true* increments: the raw odometry pose is the
 noisy increments composed from the start. A motion shorter than :data:`MIN_TRANS_M` is a turn in
 place: ``δrot1`` = 0 (its heading would be undefined), as AMCL does.
@@ -103,11 +106,17 @@ def sample_parts(delta: Pose, noise: OdometryNoise, rng: np.random.Generator, n:
     ``delta``, ``(n, 3)``. Draws 3·n normals in a fixed order (reproducible)."""
     a1, a2, a3, a4 = noise.alphas
     rot1, trans, rot2 = decompose(delta)
+    r1, r2 = _turn(rot1), _turn(rot2)
     z = rng.standard_normal((n, 3))
     return np.column_stack([
-        rot1 - z[:, 0] * math.sqrt(a1 * rot1 ** 2 + a2 * trans ** 2),
-        trans - z[:, 1] * math.sqrt(a3 * trans ** 2 + a4 * (rot1 ** 2 + rot2 ** 2)),
-        rot2 - z[:, 2] * math.sqrt(a1 * rot2 ** 2 + a2 * trans ** 2)])
+        rot1 - z[:, 0] * math.sqrt(a1 * r1 ** 2 + a2 * trans ** 2),
+        trans - z[:, 1] * math.sqrt(a3 * trans ** 2 + a4 * (r1 ** 2 + r2 ** 2)),
+        rot2 - z[:, 2] * math.sqrt(a1 * r2 ** 2 + a2 * trans ** 2)])
+
+
+def _turn(rot: float) -> float:
+    """The rotation as the noise sees it: forward and backward alike (AMCL)."""
+    return min(abs(rot), math.pi - abs(rot))
 
 
 def sample_increments(delta: Pose, noise: OdometryNoise, rng: np.random.Generator,
@@ -141,21 +150,34 @@ def draw_odometry(true_poses: np.ndarray, noise: OdometryNoise, rng: np.random.G
 
 def densify(poses: np.ndarray, step_m: float = ODOM_STEP_M,
             step_rad: float = ODOM_STEP_RAD) -> tuple[np.ndarray, np.ndarray]:
-    """The trajectory ``poses`` ``(N, 3)`` with every gap cut into equal steps of at most
-    ``step_m`` and ``step_rad`` (x, y and the unwrapped heading interpolated linearly); returns
-    the dense poses and the index of each original pose in them."""
+    """The trajectory ``poses`` ``(N, 3)`` with every gap driven as a differential-drive robot
+    does it in the model's terms: turn in place by ``δrot1``, drive straight ``δtrans``, turn by
+    ``δrot2`` (a gap whose motion points backwards is driven backwards, as AMCL reads it), each
+    cut into equal steps of at most ``step_m`` and ``step_rad``. Returns the dense poses and the
+    index of each original pose in them."""
     P = np.asarray(poses, dtype=float)
     out, idx = [P[:1]], [0]
     for a, b in zip(P[:-1], P[1:], strict=True):
-        dth = float(wrap_angle(b[2] - a[2]))
-        n = max(1, math.ceil(math.hypot(b[0] - a[0], b[1] - a[1]) / step_m - 1e-9),
-                math.ceil(abs(dth) / step_rad - 1e-9))
-        f = np.arange(1, n + 1)[:, None] / n
-        seg = np.column_stack([a[0] + f[:, 0] * (b[0] - a[0]), a[1] + f[:, 0] * (b[1] - a[1]),
-                               a[2] + f[:, 0] * dth])
+        d = Pose.from_array(a).between(Pose.from_array(b))
+        rot1, trans, rot2 = decompose(d)
+        if abs(rot1) > math.pi / 2:  # backwards
+            rot1, trans = float(wrap_angle(rot1 + math.pi)), -trans
+            rot2 = float(wrap_angle(d.theta - rot1))
+        x, y, th = (float(v) for v in a)
+        pts: list[tuple[float, float, float]] = []
+        n = math.ceil(abs(rot1) / step_rad - 1e-9)
+        pts += [(x, y, th + f * rot1) for f in np.arange(1, n + 1) / max(n, 1)]
+        th += rot1
+        n = math.ceil(abs(trans) / step_m - 1e-9)
+        c, s_ = math.cos(th), math.sin(th)
+        pts += [(x + f * trans * c, y + f * trans * s_, th) for f in np.arange(1, n + 1) / max(n, 1)]
+        x, y = x + trans * c, y + trans * s_
+        n = math.ceil(abs(rot2) / step_rad - 1e-9)
+        pts += [(x, y, th + f * rot2) for f in np.arange(1, n + 1) / max(n, 1)]
+        seg = np.array(pts or [tuple(b)], dtype=float)
         seg[-1] = b
         out.append(seg)
-        idx.append(idx[-1] + n)
+        idx.append(idx[-1] + len(seg))
     dense = np.vstack(out)
     dense[:, 2] = wrap_angle(dense[:, 2])
     return dense, np.array(idx)
