@@ -82,3 +82,45 @@ def test_reproducible_and_checked():
         OdometryNoise(-0.1, 0, 0, 0)
     with pytest.raises(ConfigError):
         Slip(prob=1.5)
+
+
+def test_densify_keeps_the_poses_and_bounds_the_steps():
+    from tfloc.datasets.motion import densify
+
+    P = np.array([[0, 0, 0], [1.0, 0, 0], [1.0, 0, 1.2], [1.0, 0.05, 1.25], [3.0, 2.0, -3.0]])
+    dense, at = densify(P, 0.1, math.radians(3))
+    np.testing.assert_allclose(dense[at], np.column_stack([P[:, :2], np.angle(np.exp(1j * P[:, 2]))]))
+    steps = np.hypot(*np.diff(dense[:, :2], axis=0).T)
+    turns = np.abs(np.angle(np.exp(1j * np.diff(dense[:, 2]))))
+    assert steps.max() <= 0.1 + 1e-9 and turns.max() <= math.radians(3) + 1e-9
+    assert at[1] == 10 and at[2] - at[1] == math.ceil(1.2 / math.radians(3))
+    # every step is a turn in place or a straight drive (forwards or backwards)
+    for a, b in zip(dense[:-1], dense[1:], strict=True):
+        d = Pose.from_array(a).between(Pose.from_array(b))
+        assert abs(d.y) < 1e-6 or abs(d.theta) < 1e-9 or np.hypot(d.x, d.y) < 1e-9 or b is dense[-1]
+
+
+def test_backward_steps_are_as_noisy_as_forward_ones():
+    noise = OdometryNoise(0.1, 0.05, 0.1, 0.05)
+    fwd = sample_increments(Pose(0.1, 0.0, 0.0), noise, np.random.default_rng(2), 20000)
+    bwd = sample_increments(Pose(-0.1, 0.0, 0.0), noise, np.random.default_rng(2), 20000)
+    np.testing.assert_allclose(np.std(fwd, axis=0), np.std(bwd, axis=0), rtol=0.05)
+
+
+def test_scan_rate_does_not_change_the_odometry():
+    """The 1 Hz sequence's odometry is the 10 Hz trajectory's, sampled (odometry has its own
+    rate): over a 1 s gap its increment error is that of ten 0.1 m steps, not one 1 m step."""
+    from pathlib import Path
+
+    from tfloc.io.scenario import read_scans, read_scenario
+
+    root = Path(__file__).resolve().parents[1] / "data" / "scenarios"
+    err = {}
+    for name in ("seq-rate-1hz-b", "seq-easy-b"):
+        s = read_scans(read_scenario(root / name))
+        if name == "seq-easy-b":
+            s = s[::10]
+        e = [a.odom.between(b.odom).distance_to(a.true.between(b.true)) for a, b in zip(s[:-1], s[1:], strict=True)]
+        err[name] = float(np.median(e))
+    # the same order of magnitude (different draws); one 1 m step at α = 0.05 would give ~3× more
+    assert 0.5 < err["seq-rate-1hz-b"] / err["seq-easy-b"] < 2.0

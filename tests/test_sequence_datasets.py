@@ -138,3 +138,19 @@ def test_people_are_in_the_scans_not_in_the_map(tmp_path):
             short.append(int(((ideal - got) > 0.1).sum()))
     assert short[0] > 50 and short[1] == 0
     assert not math.isnan(short[0])
+
+
+def test_real_sequences_regenerate_bit_for_bit(tmp_path):
+    """`tfloc real-data`'s sequences: the committed bytes; truth = the corrected poses in order."""
+    from tfloc.datasets.real_sequences import build_sequences
+
+    build_sequences(ROOT / "data" / "real", tmp_path)
+    for key in ("intel", "csail", "aces"):
+        rel = Path("scenarios") / f"real-{key}-sequence"
+        assert (tmp_path / rel / "scans.csv").read_bytes() == (ROOT / "data" / rel / "scans.csv").read_bytes()
+        a, b = (json.loads(p.read_text()) for p in (tmp_path / rel / "scenario.json",
+                                                      ROOT / "data" / rel / "scenario.json"))
+        a.pop("map"), b.pop("map")
+        assert a == b
+    scans = read_scans(read_scenario(ROOT / "data" / "scenarios" / "real-aces-sequence"))
+    assert len(scans) == 440 and scans[0].initial == scans[0].true

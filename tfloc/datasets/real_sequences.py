@@ -9,7 +9,9 @@ the FLASER ``odom_*`` fields equal the corrected pose on every line, and dead re
 ODOM messages stays within 0.3 m of the corrected end pose after 320–500 m (raw wheel odometry
 drifts by metres). So the odometry is drawn from the corrected increments with the odometry
 motion model (:mod:`tfloc.datasets.motion`), all α = :data:`ALPHA` (the simulated sequences'
-``low`` level), seeded per log.
+``low`` level), on the corrected trajectory cut into odometry steps of at most 0.1 m and 3°
+(:func:`~tfloc.datasets.motion.densify`: odometry runs at its own rate, not at the laser's),
+seeded per log.
 
 **Stamps.** The logs' ``ipc_timestamp`` where it increases strictly along the file (ACES);
 Intel (4 steps backwards) and CSAIL (corrected stamps spread over a constant 10 000 s with 404
@@ -26,7 +28,7 @@ from tfloc.core.pose import Pose
 from tfloc.io.carmen import read_carmen
 from tfloc.io.scenario import SEQUENCE, Scan, write_scenario
 
-from .motion import OdometryNoise, draw_odometry
+from .motion import OdometryNoise, densify, draw_odometry
 from .real import (
     ACES_LASER,
     ACES_NO_RETURN_M,
@@ -54,7 +56,8 @@ def sequence_scans(log_path: Path, laser, no_return: float, rng: np.random.Gener
     t = np.array([s.timestamp for s in recs])
     own = bool(np.all(np.diff(t) > 0))
     stamps = t if own else np.arange(len(recs), dtype=float)
-    odom, _ = draw_odometry(P, noise, rng)
+    dense, at = densify(P)
+    odom = draw_odometry(dense, noise, rng)[0][at]
     rows = [Scan(f"s{k:04d}", "real", clean_ranges(r.ranges, no_return),
                  Pose.from_array(P[0]) if k == 0 else None, Pose.from_array(P[k]),
                  stamp=float(stamps[k]), odom=Pose.from_array(odom[k]))
@@ -84,7 +87,7 @@ def build_sequences(real: Path, out: Path, seed: int = SEQ_SEED) -> list[Path]:
                 "truth), start = the first corrected pose, map = the scan-to-map dataset's grid. "
                 "The log has no raw odometry (data/real/PROVENANCE.md): odom_* is drawn from the "
                 "corrected increments by the odometry motion model (Probabilistic Robotics Table "
-                f"5.6), alphas {ALPHA:g}/{ALPHA:g}/{ALPHA:g}/{ALPHA:g}, seed {seed} child "
+                "5.6) on steps of at most 0.1 m and 3 deg (odometry at its own rate), alphas {ALPHA:g}/{ALPHA:g}/{ALPHA:g}/{ALPHA:g}, seed {seed} child "
                 f"{int(ss.spawn_key[-1])}. "
                 + ("stamp = the log's ipc_timestamp." if own else
                    "stamp = the scan's index in seconds (the log's stamps do not increase).")),

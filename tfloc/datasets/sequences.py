@@ -3,7 +3,9 @@
 Each dataset is one route (:mod:`tfloc.datasets.routes`) driven at 1 m/s with turns in place at
 30°/s, scanned at ``rate_hz`` by the simulated LMS200 (the paper protocol's noise model,
 :class:`~tfloc.datasets.noise.NoiseModel`), with raw odometry drawn from the true increments by
-the odometry motion model (:mod:`tfloc.datasets.motion`). The **condition** of a dataset is a
+the odometry motion model (:mod:`tfloc.datasets.motion`) on the 10 Hz trajectory whatever
+the scan rate (odometry runs at its own rate: a lower scan rate means larger gaps between
+scans, not worse odometry). The **condition** of a dataset is a
 label in ``scenario.json`` (``"condition": {"name", "rate_hz", "odom_noise", "slip", "people"}``)
 and names what makes a robot lose track:
 
@@ -44,6 +46,9 @@ from .routes import ROUTES, Motion, drive, plan_route
 SEQ_SEED = 20261201
 LOW, HIGH = OdometryNoise(0.05, 0.05, 0.05, 0.05), OdometryNoise(0.2, 0.2, 0.2, 0.2)
 QUICK_SCANS = 100
+#: the odometry's rate (Hz): the true trajectory is sampled at this rate, the scans every
+#: ``ODOM_RATE_HZ / rate_hz``-th sample
+ODOM_RATE_HZ = 10.0
 
 
 @dataclass(frozen=True)
@@ -155,12 +160,14 @@ def discs_ranges(pose: np.ndarray, laser: LaserSpec, centres: np.ndarray, radius
 def simulate(m: VectorMap, verts: np.ndarray, cond: Condition, spec: SimSpec,
              ss: np.random.SeedSequence, limit: int | None = None) -> tuple[list[Scan], dict]:
     """The scans of one sequence (ids ``k00000``…, group = the condition's name) and a summary."""
-    stamps, true = drive(verts, spec.motion, cond.rate_hz)
-    if limit is not None:
-        stamps, true = stamps[:limit], true[:limit]
+    stamps, fine = drive(verts, spec.motion, ODOM_RATE_HZ)
     odom_ss, scan_ss, people_ss = ss.spawn(3)
-    odom, slipped = draw_odometry(true, cond.noise, np.random.default_rng(odom_ss),
+    odom, slipped = draw_odometry(fine, cond.noise, np.random.default_rng(odom_ss),
                                   spec.slip if cond.slip else None)
+    stride = int(round(ODOM_RATE_HZ / cond.rate_hz))
+    at = np.arange(0, len(fine), stride)[:limit]
+    stamps, true, odom = stamps[at], fine[at], odom[at]
+    slipped = np.array([slipped[a + 1:b + 1].any() for a, b in zip(at[:-1], at[1:], strict=True)])
     ideal = m.raycast(true, spec.laser)
     if cond.people:
         phase = np.random.default_rng(people_ss).random(spec.people.n)
