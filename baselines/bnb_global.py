@@ -24,8 +24,10 @@ written, with compiled kernels (:mod:`tfloc.baselines._bnb_kernels`). Choices an
   its bound does not exceed the threshold: ``min_score`` = 0.6 (Cartographer's
   ``global_localization_min_score``; its ``min_score`` for local constraints is 0.55) until
   ``hypotheses`` = 5 distinct answers (> ``distinct_m`` = 0.5 m or > ``distinct_deg`` = 10°
-  apart) are held, then the fifth one's score, so the top-5 are exact too (with 1 hypothesis
-  this is Cartographer's search).
+  apart) are held, then the fifth one's score: a subtree whose bound does not beat five held
+  answers cannot hold a sixth (with 1 hypothesis this is Cartographer's search; with 5 the
+  list is exact unless one new answer displaces two held ones at once, after which subtrees
+  already cut at the higher threshold are not revisited).
 * **Refinement**: as Cartographer's constraint builder does after the branch and bound, each
   hypothesis is refined by a least-squares fit on the bilinearly interpolated probability grid
   (Cartographer's Ceres scan matcher: occupied-space residuals ``w/√N·(1 − p)`` with

@@ -83,3 +83,18 @@ def test_a_local_matcher_gets_an_invalid_problem_not_a_crash() -> None:
     with pytest.raises(InvalidProblemError, match="solves local problems only"):
         check_solvable(get_matcher("csm-corr"), problem)
     check_solvable(get_matcher("bnb-global"), problem)
+
+
+def test_real_global_sets_regenerate_bit_for_bit(tmp_path) -> None:
+    import json
+
+    from tfloc.datasets.global_sets import build_global_real
+
+    (tmp_path / "maps").mkdir()
+    for key in ("intel", "csail", "aces"):
+        for ext in ("yaml", "pgm"):
+            shutil.copy(ROOT / "data" / "maps" / f"real-{key}.{ext}", tmp_path / "maps")
+    for d in build_global_real(ROOT / "data" / "real", tmp_path):
+        assert (d / "scans.csv").read_bytes() == (SCEN / d.name / "scans.csv").read_bytes(), d.name
+        mine, bundled = (json.loads((p / "scenario.json").read_text()) for p in (d, SCEN / d.name))
+        assert mine == bundled, d.name  # the map path too: maps/ sits where it does in data/

@@ -111,3 +111,15 @@ def test_free_area_of_the_test_room(test_room) -> None:
     a = free_area_m2(test_room)
     assert 70.0 < a < 74.0
     assert free_area_m2(test_room, clearance=0.3) < a
+
+
+def test_summarize_rows_names_the_line_of_a_bad_row() -> None:
+    from tfloc.evaluation.relocalization import summarize_rows
+
+    good = [(2, _row(NEAR, [NEAR])), (3, _row(None, status="invalid:no guess"))]
+    (s,) = summarize_rows(good, T)
+    assert s.n == 1 and s.top1 == 1.0
+    bad = _row(NEAR)
+    bad["info"] = '{"hypotheses": [[1, 2]]}'
+    with pytest.raises(ResultsError, match=r"run/estimates.csv:9: info 'hypotheses'\[0\]"):
+        summarize_rows([*good, (9, bad)], T, path="run/estimates.csv")

@@ -175,6 +175,15 @@ def summarize(results: Iterable[ScanResult],
     return out
 
 
+def summarize_rows(rows: Iterable[tuple[int, Mapping[str, Any]]], thresholds: Thresholds,
+                   free_area: Mapping[str, float] | None = None, path: str = "estimates.csv") -> list[GlobalSummary]:
+    """:func:`summarize` of ``estimates.csv`` rows ``(line, row)`` (as
+    :func:`tfloc.io.estimates.read_rows` gives them); rows without truth or ``invalid:`` are left
+    out; a malformed ``info`` raises :class:`ResultsError` naming ``path:line``."""
+    scored = (result_from_row(row, thresholds, f"{path}:{line}") for line, row in rows)
+    return summarize((r for r in scored if r is not None), free_area)
+
+
 def free_area_m2(map_: Any, clearance: float = 0.0, step: float = 0.1) -> float:
     """The free area (m²) of a map (any :class:`~tfloc.core.map.Map`): the share of a ``step``-metre
     lattice over its bounds that ``is_free`` (with ``clearance``), times the bounds' area."""
