@@ -46,7 +46,10 @@ class TfGlobalConfig:
     """Parameters of ``tf-global`` (metres, radians).
 
     Attributes:
-        places: index places resolved by ``tf-plus`` per scan.
+        places: index places resolved by ``tf-plus`` per scan, at least; ...
+        place_density: ... and at least this many per m² of the map's free area (a map twice
+            the size holds about twice the places that look alike; 0.04/m² gives the 12 places
+            chosen on the development offices, 270–300 m²).
         place_separation: index entries within this distance ...
         place_heading_separation: ... and this heading of a better one are the same place.
         hypotheses: ranked answers returned (``Estimate.hypotheses``; the harness scores 5).
@@ -63,11 +66,12 @@ class TfGlobalConfig:
 
     RULES: ClassVar[dict] = {
         ">= 1": ("places", "hypotheses"),
-        ">= 0": ("place_separation", "place_heading_separation", "hypothesis_separation",
+        ">= 0": ("place_density", "place_separation", "place_heading_separation", "hypothesis_separation",
                  "hypothesis_heading_separation"),
         ("tf-plus", "global"): ("local",)}
 
     places: int = 12
+    place_density: float = 0.04
     place_separation: float = 0.75
     place_heading_separation: float = math.radians(30.0)
     hypotheses: int = 5
@@ -133,7 +137,8 @@ class TurningFunctionGlobalMatcher:
                 "status": "no-answer", "reason": f"{len(points)} returns (< {cfg.resolver.min_returns})"})
         idx = self.index(problem)
         sig = scan_signature(problem.ranges, problem.laser, cfg.index.signature)
-        entries, sig_dist = idx.query(sig, cfg.places, cfg.place_separation, cfg.place_heading_separation)
+        count = max(cfg.places, int(round(cfg.place_density * idx.free_area_m2)))
+        entries, sig_dist = idx.query(sig, count, cfg.place_separation, cfg.place_heading_separation)
         poses, costs, evaluations = [], [], 0
         for e in entries:
             guess = dataclasses.replace(problem, initial=Pose.from_array(idx.poses[e]))
