@@ -180,3 +180,19 @@ def test_recovery_parameters_are_checked() -> None:
 
     with pytest.raises(ParameterError, match="lost_after must be >= 1"):
         RecoveringTracker(None, None, lost_after=0)
+
+
+def test_a_map_without_free_lattice_positions_gets_no_answer(test_room, lms200, tmp_path) -> None:
+    m = get_matcher("tf-global", cache_dir=str(tmp_path), index={"clearance": 20.0})
+    problem = tfloc.Problem(test_room, lms200, test_room.raycast(Pose(3, 3.5, 0), lms200), None)
+    m.prepare(problem)
+    est = m.localize(problem)
+    assert est.info["status"] == "no-answer" and not est.converged
+
+
+def test_a_local_problem_can_be_searched_globally(test_room, lms200, tmp_path) -> None:
+    m = get_matcher("tf-global", cache_dir=str(tmp_path), local="global")
+    true = Pose(3.0, 3.5, 0.3)
+    far_guess = Pose(8.5, 1.0, -2.0)                         # a wrong guess is ignored
+    est = m.localize(tfloc.Problem(test_room, lms200, test_room.raycast(true, lms200), far_guess))
+    assert est.info["mode"] == "global" and est.pose.distance_to(true) <= 0.10

@@ -95,6 +95,8 @@ class PlaceIndex:
         radians of it. Looks at ``candidates × count`` nearest entries. Returns entry indices
         (best first) and their signature distances."""
         k = int(min(len(self.poses), max(count, candidates * count)))
+        if k == 0:
+            return np.zeros(0, dtype=np.int64), np.zeros(0)
         dist, idx = self.tree.query(signature, k=k)
         dist, idx = np.atleast_1d(dist), np.atleast_1d(idx)
         keep: list[int] = []

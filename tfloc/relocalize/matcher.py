@@ -120,9 +120,10 @@ class TurningFunctionGlobalMatcher:
         """Build or load the place index and tf-plus's map view (map-only work, untimed by the
         harness)."""
         idx = self.index(problem)
-        at = dataclasses.replace(problem, initial=Pose.from_array(idx.poses[0]))
-        self.resolver.prepare(at)
-        self.resolver.score(at, at.initial)     # the cost's kernels compiled or loaded
+        if len(idx.poses):
+            at = dataclasses.replace(problem, initial=Pose.from_array(idx.poses[0]))
+            self.resolver.prepare(at)
+            self.resolver.score(at, at.initial)     # the cost's kernels compiled or loaded
         if problem.initial is not None and self.config.local == "tf-plus":
             self.local.prepare(problem)
 
@@ -136,6 +137,9 @@ class TurningFunctionGlobalMatcher:
             return Estimate(Pose(math.nan, math.nan, math.nan), False, 0, 0, {
                 "status": "no-answer", "reason": f"{len(points)} returns (< {cfg.resolver.min_returns})"})
         idx = self.index(problem)
+        if len(idx.poses) == 0:
+            return Estimate(Pose(math.nan, math.nan, math.nan), False, 0, 0, {
+                "status": "no-answer", "reason": "the map has no free lattice position to index"})
         sig = scan_signature(problem.ranges, problem.laser, cfg.index.signature)
         count = max(cfg.places, int(round(cfg.place_density * idx.free_area_m2)))
         entries, sig_dist = idx.query(sig, count, cfg.place_separation, cfg.place_heading_separation)
