@@ -161,6 +161,7 @@ def test_a_kidnapped_tracker_notices_by_its_score_and_relocalizes(matcher, test_
     path = [Pose(2.0, 3.0 + 0.2 * k, 1.2) for k in range(4)]           # walking up the room
     path += [Pose(8.6, 2.0 + 0.2 * k, 2.5) for k in range(5)]          # carried off, turned
     step = Pose(0.2 * math.cos(0.37), 0.2 * math.sin(0.37), 0.0)      # what the wheels say
+    tracker.prepare(tfloc.Problem(test_room, lms200, test_room.raycast(path[0], lms200), path[0]))
     tracker.start(test_room, lms200, path[0])
     rng = np.random.default_rng(3)
     right, relocs = [], []
