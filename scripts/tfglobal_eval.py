@@ -28,6 +28,7 @@ from tfloc.core.pose import Pose, angdiff
 from tfloc.core.problem import Problem
 from tfloc.datasets.noise import NoiseModel
 from tfloc.datasets.synthetic import sample_free_pose
+from tfloc.evaluation.stats import wilson
 from tfloc.harness.threads import limit_threads
 from tfloc.io.maps import load_map
 from tfloc.io.scenario import iter_scans, read_scenario
@@ -110,7 +111,9 @@ def run(which: str, **params) -> dict:
     out = {}
     for name in [*dict.fromkeys(r["set"] for r in rows), "all"]:
         rs = [r for r in rows if name in ("all", r["set"])]
-        out[name] = {"n": len(rs), "top1": round(np.mean([r["top1"] for r in rs]), 3),
+        k1 = sum(r["top1"] for r in rs)
+        out[name] = {"n": len(rs), "top1": round(k1 / len(rs), 3),
+                     "top1_ci95": [round(v, 3) for v in wilson(k1, len(rs))],
                      "top5": round(np.mean([r["top5"] for r in rs]), 3),
                      "ambiguous": int(sum(r["ambiguous"] for r in rs)),
                      "cpu_ms_median": round(float(np.median([r["cpu_ms"] for r in rs])), 1),

@@ -161,6 +161,7 @@ def test_a_kidnapped_tracker_notices_by_its_score_and_relocalizes(matcher, test_
     path = [Pose(2.0, 3.0 + 0.2 * k, 1.2) for k in range(4)]           # walking up the room
     path += [Pose(8.6, 2.0 + 0.2 * k, 2.5) for k in range(5)]          # carried off, turned
     step = Pose(0.2 * math.cos(0.37), 0.2 * math.sin(0.37), 0.0)      # what the wheels say
+    tracker.prepare(tfloc.Problem(test_room, lms200, test_room.raycast(path[0], lms200), path[0]))
     tracker.start(test_room, lms200, path[0])
     rng = np.random.default_rng(3)
     right, relocs = [], []
@@ -180,3 +181,44 @@ def test_recovery_parameters_are_checked() -> None:
 
     with pytest.raises(ParameterError, match="lost_after must be >= 1"):
         RecoveringTracker(None, None, lost_after=0)
+
+
+def test_a_map_without_free_lattice_positions_gets_no_answer(test_room, lms200, tmp_path) -> None:
+    m = get_matcher("tf-global", cache_dir=str(tmp_path), index={"clearance": 20.0})
+    problem = tfloc.Problem(test_room, lms200, test_room.raycast(Pose(3, 3.5, 0), lms200), None)
+    m.prepare(problem)
+    est = m.localize(problem)
+    assert est.info["status"] == "no-answer" and not est.converged
+
+
+def test_a_local_problem_can_be_searched_globally(test_room, lms200, tmp_path) -> None:
+    m = get_matcher("tf-global", cache_dir=str(tmp_path), local="global")
+    true = Pose(3.0, 3.5, 0.3)
+    far_guess = Pose(8.5, 1.0, -2.0)                         # a wrong guess is ignored
+    est = m.localize(tfloc.Problem(test_room, lms200, test_room.raycast(true, lms200), far_guess))
+    assert est.info["mode"] == "global" and est.pose.distance_to(true) <= 0.10
+
+
+def test_tfloc_index_builds_then_loads_the_index_of_a_dataset(test_room, lms200, tmp_path, capsys) -> None:
+    from tfloc.cli import main
+    from tfloc.io.scenario import Scan, write_scenario
+
+    ranges = test_room.raycast(Pose(3.0, 3.5, 0.3), lms200)
+    data = write_scenario(tmp_path / "room-global", "room-global", _room_path(), lms200,
+                          [Scan("g0", "global", ranges, None, None)], mode="global")
+    args = ["index", "--dataset", str(data), "--param", f"cache_dir='{tmp_path / 'idx'}'",
+            "--param", "index.headings=4"]
+    assert main(args) == 0
+    assert "built" in capsys.readouterr().out
+    assert len(list((tmp_path / "idx").glob("*.npz"))) == 1
+    assert main(args) == 0
+    assert "loaded" in capsys.readouterr().out
+    assert main([*args, "--param", "index.step=-1"]) == 2
+    assert "--param index.step: matcher 'tf-global': index.step must be > 0" in capsys.readouterr().err
+
+
+def test_tf_global_resolves_place_by_place_too(test_room, lms200, tmp_path) -> None:
+    m = get_matcher("tf-global", cache_dir=str(tmp_path), resolve="per-place", places=6)
+    true = Pose(8.6, 2.0, 2.5)
+    est = m.localize(tfloc.Problem(test_room, lms200, test_room.raycast(true, lms200), None))
+    assert est.pose.distance_to(true) <= 0.10 and abs(angdiff(est.pose.theta, true.theta)) <= 0.035

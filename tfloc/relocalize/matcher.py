@@ -7,10 +7,12 @@ index resolved by ``tf-plus``.
 2. **Query**: the real scan's signature (:mod:`tfloc.relocalize.signature`: heading-invariant,
    from the turning function's edge directions and turning angles, and the ranges) → the
    ``places`` nearest distinct index entries.
-3. **Resolve** each place with ``tf-plus`` (:class:`~tfloc.tfplus.matcher.TurningFunctionPlusMatcher`
-   configured by ``resolver``): the place's pose is its initial guess, so its turning-function
-   heading seeds, heading sweep, coarse grid (over ``resolver.search_radius`` around the place)
-   and point-to-line refinement run as in a local problem.
+3. **Resolve** the places with ``tf-plus``'s stages, configured by ``resolver``: each place's
+   pose is the guess of its turning-function heading seeds, heading sweep and coarse grid (over
+   ``resolver.search_radius`` around the place); the coarse candidates of all places compete
+   and the best ``refined`` go through one point-to-line refinement
+   (:mod:`tfloc.relocalize.resolve`, ``resolve="batched"``), or ``tf-plus``'s whole
+   ``localize`` runs from each place (``resolve="per-place"``: twice the CPU, measured).
 4. **Rank** the resolved poses by ``tf-plus``'s selection cost (:mod:`tfloc.tfplus.cost`); the
    answer is the lowest, ``hypotheses`` the best distinct ones (best first).
 
@@ -34,6 +36,7 @@ from tfloc.core.problem import Estimate, Problem
 from tfloc.tfplus.matcher import TfPlusConfig, TurningFunctionPlusMatcher
 
 from .index import IndexConfig, PlaceIndex, place_index
+from .resolve import resolve_places
 from .signature import scan_signature
 
 #: tf-plus as a resolver of one place: its search covers the place's lattice cell and more (0.35 m
@@ -46,12 +49,19 @@ class TfGlobalConfig:
     """Parameters of ``tf-global`` (metres, radians).
 
     Attributes:
-        places: index places resolved by ``tf-plus`` per scan.
+        places: index places resolved by ``tf-plus`` per scan, at least; ...
+        place_density: ... and at least this many per m² of the map's free area (a map twice
+            the size holds about twice the places that look alike; 0.08/m² gives the 24 places
+            chosen on the development offices, 270–300 m²).
         place_separation: index entries within this distance ...
         place_heading_separation: ... and this heading of a better one are the same place.
         hypotheses: ranked answers returned (``Estimate.hypotheses``; the harness scores 5).
         hypothesis_separation: hypotheses are at least this far apart ...
         hypothesis_heading_separation: ... or this far apart in heading.
+        resolve: ``"per-place"`` (tf-plus's ``localize`` from each place) or ``"batched"`` (its
+            stages, the coarse candidates of all places competing for one refinement of the
+            best ``refined``: :mod:`tfloc.relocalize.resolve`).
+        refined: see ``resolve``.
         local: a problem with an initial guess: ``"tf-plus"`` (tf-plus from the guess, with the
             ``local_resolver``'s defaults: the local matcher) or ``"global"`` (the guess ignored).
         cache_dir: where the index is stored on disk ("" = ``$TFLOC_INDEX_CACHE`` or
@@ -62,17 +72,21 @@ class TfGlobalConfig:
     """
 
     RULES: ClassVar[dict] = {
-        ">= 1": ("places", "hypotheses"),
-        ">= 0": ("place_separation", "place_heading_separation", "hypothesis_separation",
+        ">= 1": ("places", "hypotheses", "refined"),
+        ("per-place", "batched"): ("resolve",),
+        ">= 0": ("place_density", "place_separation", "place_heading_separation", "hypothesis_separation",
                  "hypothesis_heading_separation"),
         ("tf-plus", "global"): ("local",)}
 
-    places: int = 12
+    places: int = 24
+    place_density: float = 0.08
     place_separation: float = 0.75
     place_heading_separation: float = math.radians(30.0)
     hypotheses: int = 5
     hypothesis_separation: float = 0.3
     hypothesis_heading_separation: float = math.radians(10.0)
+    resolve: str = "batched"
+    refined: int = 16
     local: str = "tf-plus"
     cache_dir: str = ""
     disk_cache: bool = True
@@ -116,9 +130,10 @@ class TurningFunctionGlobalMatcher:
         """Build or load the place index and tf-plus's map view (map-only work, untimed by the
         harness)."""
         idx = self.index(problem)
-        at = dataclasses.replace(problem, initial=Pose.from_array(idx.poses[0]))
-        self.resolver.prepare(at)
-        self.resolver.score(at, at.initial)     # the cost's kernels compiled or loaded
+        if len(idx.poses):
+            at = dataclasses.replace(problem, initial=Pose.from_array(idx.poses[0]))
+            self.resolver.prepare(at)
+            self.resolver.score(at, at.initial)     # the cost's kernels compiled or loaded
         if problem.initial is not None and self.config.local == "tf-plus":
             self.local.prepare(problem)
 
@@ -132,8 +147,16 @@ class TurningFunctionGlobalMatcher:
             return Estimate(Pose(math.nan, math.nan, math.nan), False, 0, 0, {
                 "status": "no-answer", "reason": f"{len(points)} returns (< {cfg.resolver.min_returns})"})
         idx = self.index(problem)
+        if len(idx.poses) == 0:
+            return Estimate(Pose(math.nan, math.nan, math.nan), False, 0, 0, {
+                "status": "no-answer", "reason": "the map has no free lattice position to index"})
         sig = scan_signature(problem.ranges, problem.laser, cfg.index.signature)
-        entries, sig_dist = idx.query(sig, cfg.places, cfg.place_separation, cfg.place_heading_separation)
+        count = max(cfg.places, int(round(cfg.place_density * idx.free_area_m2)))
+        entries, sig_dist = idx.query(sig, count, cfg.place_separation, cfg.place_heading_separation)
+        if cfg.resolve == "batched":
+            ranked, cost, evaluations = resolve_places(problem, idx.poses[entries], cfg.resolver,
+                                                       cfg.refined)
+            return self._answer(ranked, cost, len(entries), evaluations, sig_dist)
         poses, costs, evaluations = [], [], 0
         for e in entries:
             guess = dataclasses.replace(problem, initial=Pose.from_array(idx.poses[e]))
@@ -146,15 +169,22 @@ class TurningFunctionGlobalMatcher:
         if not poses:
             return Estimate(Pose(math.nan, math.nan, math.nan), False, 1, evaluations,
                             {"status": "no-answer", "reason": "no place resolved"})
-        order = np.argsort(np.asarray(costs), kind="stable")
-        ranked = np.asarray(poses)[order]
+        return self._answer(np.asarray(poses), np.asarray(costs), len(entries), evaluations, sig_dist)
+
+    def _answer(self, poses: np.ndarray, costs: np.ndarray, places: int, evaluations: int,
+                sig_dist: np.ndarray) -> Estimate:
+        """The estimate: resolved ``poses`` ranked by their selection ``costs``, the best
+        distinct ones as hypotheses."""
+        cfg = self.config
+        order = np.argsort(costs, kind="stable")
+        ranked = poses[order]
         keep = distinct(ranked, cfg.hypotheses, cfg.hypothesis_separation,
                         cfg.hypothesis_heading_separation)
         hyps = tuple(Pose.from_array(ranked[k]) for k in keep)
-        info = {"status": "ok", "mode": "global", "places": len(entries),
+        info = {"status": "ok", "mode": "global", "places": places,
                 "cost": float(costs[order[0]]), "costs": [float(costs[order[k]]) for k in keep],
                 "signature_distance": float(sig_dist[0]) if len(sig_dist) else math.nan}
-        return Estimate(hyps[0], True, len(entries), evaluations, info, hyps)
+        return Estimate(hyps[0], True, places, evaluations, info, hyps)
 
     def score(self, problem: Problem, pose: Pose | None) -> float:
         """``tf-plus``'s selection objective at ``pose`` (the root mean square of the truncated

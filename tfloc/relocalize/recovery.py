@@ -56,6 +56,14 @@ class RecoveringTracker:
         self.pose: Pose | None = None
         self.bad = 0
 
+    def prepare(self, problem: Problem) -> None:
+        """Map-only work of both matchers (``tf-global``'s place index), untimed: call it before
+        the sequence, else the first relocalization builds the index inside a timed step."""
+        for m in (self.local, self.global_):
+            prepare = getattr(m, "prepare", None)
+            if prepare is not None and (problem.initial is not None or m is self.global_):
+                prepare(problem)
+
     def start(self, map: Map, laser: LaserSpec, pose: Pose) -> None:
         self._map, self._laser, self.pose, self.bad = map, laser, pose, 0
 
