@@ -71,7 +71,7 @@ def ok(a: Pose, b: Pose, d: float = 0.10, o: float = math.radians(2.0)) -> bool:
     return a.distance_to(b) <= d and abs(angdiff(a.theta, b.theta)) <= o
 
 
-def recall(which: str, ks=(1, 3, 5, 8, 12, 16, 24), step: float = 0.35, headings: int = 16,
+def recall(which: str, ks=(1, 3, 5, 8, 12, 16, 24, 42, 70), step: float = 0.35, headings: int = 16,
            **sig) -> dict:
     """Place recall@k: an entry among the k nearest distinct places within 0.5 m and 25° of the
     truth (what tf-plus's resolver can reach from it)."""

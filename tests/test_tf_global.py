@@ -222,3 +222,24 @@ def test_tf_global_resolves_place_by_place_too(test_room, lms200, tmp_path) -> N
     true = Pose(8.6, 2.0, 2.5)
     est = m.localize(tfloc.Problem(test_room, lms200, test_room.raycast(true, lms200), None))
     assert est.pose.distance_to(true) <= 0.10 and abs(angdiff(est.pose.theta, true.theta)) <= 0.035
+
+
+def test_an_unwritable_cache_still_gives_the_index(test_room, lms200, tmp_path) -> None:
+    blocker = tmp_path / "file"
+    blocker.write_text("not a directory")
+    idx = load_or_build(test_room, lms200, SMALL, blocker / "index")
+    assert not idx.loaded and len(idx.poses) > 0
+
+
+def test_a_grid_map_is_keyed_by_its_cells() -> None:
+    from tfloc.maps.grid import GridMap
+
+    occ = np.zeros((40, 60), dtype=np.float32)
+    occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = 1.0
+    a = GridMap(occ, 0.1, (0.0, 0.0))
+    moved = occ.copy()
+    moved[20, 30] = 1.0
+    assert map_digest(GridMap(occ.copy(), 0.1, (0.0, 0.0))) == map_digest(a)
+    assert map_digest(GridMap(moved, 0.1, (0.0, 0.0))) != map_digest(a)
+    assert map_digest(GridMap(occ, 0.1, (0.5, 0.0))) != map_digest(a)
+    assert map_digest(GridMap(occ, 0.05, (0.0, 0.0))) != map_digest(a)

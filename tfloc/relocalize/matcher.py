@@ -62,8 +62,8 @@ class TfGlobalConfig:
             stages, the coarse candidates of all places competing for one refinement of the
             best ``refined``: :mod:`tfloc.relocalize.resolve`).
         refined: see ``resolve``.
-        local: a problem with an initial guess: ``"tf-plus"`` (tf-plus from the guess, with the
-            ``local_resolver``'s defaults: the local matcher) or ``"global"`` (the guess ignored).
+        local: a problem with an initial guess: ``"tf-plus"`` (``tf-plus`` with its own defaults
+            from the guess: the local matcher) or ``"global"`` (the guess ignored).
         cache_dir: where the index is stored on disk ("" = ``$TFLOC_INDEX_CACHE`` or
             ``~/.cache/tfloc/index``).
         disk_cache: store and read the index on disk (else build it once per process).
@@ -110,7 +110,8 @@ def distinct(poses: np.ndarray, count: int, separation: float, heading_separatio
 
 
 class TurningFunctionGlobalMatcher:
-    """``tf-global``: turning-function place index → ``tf-plus`` per place → selection cost."""
+    """``tf-global``: turning-function place index → ``tf-plus``'s stages per place → its
+    selection cost."""
 
     name = "tf-global"
     CONFIG = TfGlobalConfig

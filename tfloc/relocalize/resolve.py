@@ -8,6 +8,10 @@ same field and points for every place, so the scores compare), and only the best
 (at least ``separation`` apart) go through one batched refinement
 (:mod:`tfloc.tfplus.refine`) and the selection cost (:mod:`tfloc.tfplus.cost`). Per-place
 ``localize`` refines ``candidates`` poses of every place, in one call per place.
+
+``tf-plus``'s switches apply (``tf_seed``, ``heading_sweep``, ``grid``, ``refine``,
+``refine_to``, ``beam_check``) except ``select="tf"``, which ranks as ``"residual"`` here, and
+its tie-break towards the guess (a place is no prior).
 """
 
 from __future__ import annotations
@@ -40,7 +44,8 @@ def resolve_places(problem: Problem, places: np.ndarray, cfg: TfPlusConfig,
     for place in places:
         guess = dataclasses.replace(problem, initial=Pose.from_array(place))
         heads, _ = heading_seeds(guess, cfg)
-        positions = lattice(m, field, place[:2], cfg.search_radius, cfg.grid_step, cfg.clearance)
+        positions = (lattice(m, field, place[:2], cfg.search_radius, cfg.grid_step, cfg.clearance)
+                     if cfg.grid else np.empty((0, 2)))
         if len(positions) == 0:
             positions = place[None, :2]
         poses, s = search(coarse, points, positions, heads, stride, cfg.shortlist)
@@ -50,11 +55,11 @@ def resolve_places(problem: Problem, places: np.ndarray, cfg: TfPlusConfig,
         evaluations += len(positions) * len(heads) + len(poses)
     poses = best_candidates(np.concatenate(cands), np.concatenate(scores), refined, cfg.separation)
     to = cfg.refine_to if cfg.refine_to != "auto" else ("field" if isinstance(m, GridMap) else "virtual")
-    if to == "field":
+    if cfg.refine and to == "field":
         poses = refine_to_field(field, points, poses, cfg.refinement)
-    else:
+    elif cfg.refine:
         poses = refine(m, problem.laser, points, poses, cfg.refinement)
-    evaluations += len(poses) * cfg.refinement.iterations
+    evaluations += len(poses) * cfg.refinement.iterations * cfg.refine
     cost = scan_cost(m, problem.laser, problem.ranges, poses, cfg.refinement.window,
                      cfg.refinement.inlier_distance, cfg.beam_check,
                      field if cfg.select != "virtual" else None)
