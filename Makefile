@@ -53,11 +53,15 @@ bench: $(STAMP)
 	$(BIN)/tfloc report results/robustness
 	$(BIN)/tfloc robustness results/robustness
 	$(MAKE) scaling-quick
+	for d in global-office-1 global-office-2 global-office-3 real-intel-global real-csail-global real-aces-global; do \
+		$(BIN)/tfloc index --dataset data/scenarios/$$d || exit 1; done
 	$(BIN)/tfloc bench benchmarks/global.toml --jobs $(JOBS) --regenerate
 	$(BIN)/tfloc report results/global
 
 ## Global localization on every scan of the global sets (issue 24) → results/global-full/.
 global-full: $(STAMP)
+	for d in global-office-1 global-office-2 global-office-3 real-intel-global real-csail-global real-aces-global; do \
+		$(BIN)/tfloc index --dataset data/scenarios/$$d || exit 1; done
 	$(BIN)/tfloc bench benchmarks/global-full.toml --jobs $(JOBS) --regenerate
 	$(BIN)/tfloc report results/global-full
 
