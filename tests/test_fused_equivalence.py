@@ -226,6 +226,7 @@ def test_lattice_on_a_vector_map_equals_the_map_queries() -> None:
 
     m = load_map(ROOT / "data" / "maps" / "office-2.geojson")
     view = map_view(m, 0.05, 0.3, 0.3)
+    assert m.area_rings(build=True) is not None and m.free_rings(build=True) is not None
     rng = np.random.default_rng(8)
     x0, y0, x1, y1 = m.bounds
     free, area = m._free_space(0.0), m.area
