@@ -1,15 +1,16 @@
-"""A compiled point-in-area test that gives shapely's answers, for many single-point queries.
+"""A compiled point-in-area test that gives shapely's answers, for maps queried many times.
 
 ``shapely.contains_xy`` / ``intersects_xy`` cost a few microseconds per call whatever the number of
 points, and ``tf`` asks one point per cost evaluation (hundreds per scan), ``tf-plus`` some 800
-lattice points per scan. :class:`Rings` holds the
-boundary segments of a valid (Multi)Polygon and answers by crossing parity, compiled; a point
-closer than :data:`SURE` metres to the boundary is *unsure* and left to shapely, so every answer is
-shapely's: away from the boundary the parity of a valid polygon's rings is the interior (the
-rounding of the crossing test is ~1e-14 m on maps of tens of metres, far below :data:`SURE`), and
-on or near the boundary, where ``contains`` and ``intersects`` differ, shapely decides. Most
-points are answered by one look-up in a raster of the area (:func:`raster_kernel`): a cell no
-segment comes near lies wholly on one side, the side of its centre.
+lattice points per scan. :class:`Rings` holds the boundary segments of a valid (Multi)Polygon
+and a raster of its cells (:func:`raster_kernel`): a cell that no segment comes near lies wholly
+on one side, the side of its centre, and answers by one look-up; in the other cells the crossing
+parity is counted, compiled; a point closer than :data:`SURE` metres to the boundary is *unsure*
+and left to shapely. So every answer is shapely's: away from the boundary the parity of a valid
+polygon's rings is the interior (the rounding of the crossing test is ~1e-14 m on maps of tens
+of metres, far below :data:`SURE`), and on or near the boundary, where ``contains`` and
+``intersects`` differ, shapely decides. Building the raster costs more than a few shapely calls,
+so :class:`~tfloc.maps.vector.VectorMap` builds it only when a matcher asks.
 """
 
 from __future__ import annotations
@@ -22,8 +23,8 @@ import shapely
 from numba import njit
 from shapely.geometry.base import BaseGeometry
 
-SURE = 1e-7  # metres from the boundary beyond which the compiled test decides alone
-CELL = 0.1          # metres: the raster's cell (larger on maps of more than MAX_CELLS cells)
+SURE = 1e-7      # metres from the boundary beyond which the compiled test decides alone
+CELL = 0.1       # metres: the raster's cell (larger on maps of more than MAX_CELLS cells)
 MAX_CELLS = 4e6
 
 
