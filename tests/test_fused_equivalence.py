@@ -226,6 +226,7 @@ def test_lattice_on_a_vector_map_equals_the_map_queries() -> None:
 
     m = load_map(ROOT / "data" / "maps" / "office-2.geojson")
     view = map_view(m, 0.05, 0.3, 0.3)
+    assert m.area_rings(build=True) is not None and m.free_rings(build=True) is not None
     rng = np.random.default_rng(8)
     x0, y0, x1, y1 = m.bounds
     free, area = m._free_space(0.0), m.area
@@ -237,3 +238,30 @@ def test_lattice_on_a_vector_map_equals_the_map_queries() -> None:
             keep &= shapely.contains_xy(free, xy[:, 0], xy[:, 1])
             got = lattice(m, view, centre, 3.3, 0.2, clearance)
             assert got.tobytes() == xy[keep].tobytes()
+
+
+def test_compiled_tf_search_gives_up_to_python_near_boundaries(
+        test_room, lms200, monkeypatch: pytest.MonkeyPatch) -> None:
+    """With the compiled free test unsure within 0.5 m of the free space's boundary, the compiled
+    search gives up where its simplex comes near a wall (and Function1 asks shapely): the
+    answers stay the Python ones."""
+    from tfloc.core.matcher import get_matcher
+    from tfloc.core.problem import Problem
+    from tfloc.paper import matcher as paper_matcher
+
+    m = get_matcher("tf")
+    monkeypatch.setattr(paper_matcher, "SURE", 0.5)
+    ranges = noisy_scan(test_room, lms200, TRUE)
+    x0, y0, _, _ = test_room.bounds
+    gave_up = 0
+    for guess in (Pose(x0 + 0.3, TRUE.y, TRUE.theta), Pose(TRUE.x, y0 + 0.3, TRUE.theta + 0.1)):
+        problem = Problem(test_room, lms200, ranges, guess)
+        cost = paper_matcher._Cost(problem, m.config, paper_matcher.scan_turning_function(
+            problem.ranges, problem.laser, m.config.shape))
+        gave_up += m._search_compiled(problem, cost) is None
+        fast = m.localize(problem)
+        monkeypatch.setattr(paper_matcher, "_FUSED", False)
+        slow = m.localize(problem)
+        monkeypatch.setattr(paper_matcher, "_FUSED", True)
+        assert (fast.pose, fast.evaluations, fast.info) == (slow.pose, slow.evaluations, slow.info)
+    assert gave_up > 0

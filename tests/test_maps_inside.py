@@ -55,7 +55,10 @@ def test_is_free_and_in_bounds_equal_shapely(index: int, cell: float,
     m = maps[index]
     rng = np.random.default_rng(index)
     monkeypatch.setattr(inside, "CELL", cell)
+    assert m.free_rings(0.0) is None and m.area_rings() is None   # built only when asked
+    m.area_rings(build=True)
     for clearance in (0.0, 0.1, 0.3):
+        m.free_rings(clearance, build=True)
         free = m._free_space(clearance)
         xy = _points(free, rng, 4000)
         expect = shapely.contains_xy(free, xy[:, 0], xy[:, 1])
@@ -64,7 +67,7 @@ def test_is_free_and_in_bounds_equal_shapely(index: int, cell: float,
                                       expect[:300])
         rings = m.free_rings(clearance)
         assert rings is not None and rings.res == cell
-        assert (rings.codes >= 0).mean() > 0.3          # most cells are answered by the raster
+        assert (rings.codes >= 0).mean() > 0.25         # most cells are answered by the raster
         # points on the raster's cell edges and corners
         edges = np.stack(np.meshgrid(rings.x0 + rings.res * np.arange(rings.codes.shape[1]),
                                      rings.y0 + rings.res * np.arange(rings.codes.shape[0])),

@@ -1,15 +1,16 @@
-"""A compiled point-in-area test that gives shapely's answers, for many single-point queries.
+"""A compiled point-in-area test that gives shapely's answers, for maps queried many times.
 
 ``shapely.contains_xy`` / ``intersects_xy`` cost a few microseconds per call whatever the number of
 points, and ``tf`` asks one point per cost evaluation (hundreds per scan), ``tf-plus`` some 800
-lattice points per scan. :class:`Rings` holds the
-boundary segments of a valid (Multi)Polygon and answers by crossing parity, compiled; a point
-closer than :data:`SURE` metres to the boundary is *unsure* and left to shapely, so every answer is
-shapely's: away from the boundary the parity of a valid polygon's rings is the interior (the
-rounding of the crossing test is ~1e-14 m on maps of tens of metres, far below :data:`SURE`), and
-on or near the boundary, where ``contains`` and ``intersects`` differ, shapely decides. Most
-points are answered by one look-up in a raster of the area (:func:`raster_kernel`): a cell no
-segment comes near lies wholly on one side, the side of its centre.
+lattice points per scan. :class:`Rings` holds the boundary segments of a valid (Multi)Polygon
+and a raster of its cells (:func:`raster_kernel`): a cell that no segment comes near lies wholly
+on one side, the side of its centre, and answers by one look-up; in the other cells the crossing
+parity is counted, compiled; a point closer than :data:`SURE` metres to the boundary is *unsure*
+and left to shapely. So every answer is shapely's: away from the boundary the parity of a valid
+polygon's rings is the interior (the rounding of the crossing test is ~1e-14 m on maps of tens
+of metres, far below :data:`SURE`), and on or near the boundary, where ``contains`` and
+``intersects`` differ, shapely decides. Building the raster costs more than a few shapely calls,
+so :class:`~tfloc.maps.vector.VectorMap` builds it only when a matcher asks.
 """
 
 from __future__ import annotations
@@ -22,8 +23,8 @@ import shapely
 from numba import njit
 from shapely.geometry.base import BaseGeometry
 
-SURE = 1e-7  # metres from the boundary beyond which the compiled test decides alone
-CELL = 0.1          # metres: the raster's cell (larger on maps of more than MAX_CELLS cells)
+SURE = 1e-7      # metres from the boundary beyond which the compiled test decides alone
+CELL = 0.1       # metres: the raster's cell (larger on maps of more than MAX_CELLS cells)
 MAX_CELLS = 4e6
 
 
@@ -55,37 +56,39 @@ def inside_kernel(xs: np.ndarray, ys: np.ndarray, segs: np.ndarray, sure: float)
 
 
 @njit(cache=True, nogil=True)
-def _segment_distance(x: float, y: float, x1: float, y1: float, x2: float, y2: float) -> float:
-    """Distance (metres) of ``(x, y)`` from the segment ``(x1, y1)–(x2, y2)``."""
-    ex, ey = x2 - x1, y2 - y1
-    ll = ex * ex + ey * ey
-    u = 0.0
-    if ll > 0.0:
-        u = min(1.0, max(0.0, ((x - x1) * ex + (y - y1) * ey) / ll))
-    dx, dy = x1 + u * ex - x, y1 + u * ey - y
-    return math.sqrt(dx * dx + dy * dy)
-
-
-@njit(cache=True, nogil=True)
 def raster_kernel(segs: np.ndarray, x0: float, y0: float, res: float, nx: int,
                   ny: int) -> np.ndarray:
     """Per cell ``(ny, nx)`` of side ``res`` from ``(x0, y0)``: 1 wholly inside the rings
-    ``segs``, 0 wholly outside, -1 *mixed* (a segment passes within the cell's half-diagonal, plus
-    a margin, of its centre). A pure cell's side is the crossing parity at its centre, counted
+    ``segs``, 0 wholly outside, -1 *mixed* (every cell whose centre a segment passes within the
+    cell's half-diagonal, plus a margin, and a few neighbours: found row by row along each
+    segment, so the cost grows with the segments' length, not their bounding boxes). A pure cell's side is the crossing parity at its centre, counted
     row by row (the crossings of the row's line, sorted), as :func:`inside_kernel` counts it."""
     codes = np.zeros((ny, nx), dtype=np.int8)
     reach = res * math.sqrt(0.5) + 1e-9
     for m in range(segs.shape[0]):                      # mixed cells along every segment
         x1, y1, x2, y2 = segs[m, 0], segs[m, 1], segs[m, 2], segs[m, 3]
-        c0 = max(int(math.floor((min(x1, x2) - reach - x0) / res)) - 1, 0)
-        c1 = min(int(math.floor((max(x1, x2) + reach - x0) / res)) + 1, nx - 1)
+        ex, ey = x2 - x1, y2 - y1
         r0 = max(int(math.floor((min(y1, y2) - reach - y0) / res)) - 1, 0)
         r1 = min(int(math.floor((max(y1, y2) + reach - y0) / res)) + 1, ny - 1)
         for r in range(r0, r1 + 1):
+            # the part of the segment within ``reach`` of the row's centre line (in y), widened
+            # by ``reach``: a superset of the row's cells it comes near (marking more
+            # cells mixed than needed only sends more points to the exact test)
             yc = y0 + (r + 0.5) * res
+            if ey == 0.0:
+                if abs(y1 - yc) > reach:
+                    continue
+                lo, hi = 0.0, 1.0
+            else:
+                ta, tb = (yc - reach - y1) / ey, (yc + reach - y1) / ey
+                lo, hi = max(0.0, min(ta, tb)), min(1.0, max(ta, tb))
+                if lo > hi:
+                    continue
+            xa, xb = x1 + lo * ex, x1 + hi * ex
+            c0 = max(int(math.floor((min(xa, xb) - reach - x0) / res)), 0)   # (half a cell
+            c1 = min(int(math.floor((max(xa, xb) + reach - x0) / res)), nx - 1)  # to spare)
             for c in range(c0, c1 + 1):
-                if _segment_distance(x0 + (c + 0.5) * res, yc, x1, y1, x2, y2) <= reach:
-                    codes[r, c] = -1
+                codes[r, c] = -1
     xs = np.empty(segs.shape[0])
     for r in range(ny):                                  # parity of the pure cells, per row
         y = y0 + (r + 0.5) * res

@@ -105,25 +105,30 @@ class VectorMap:
             self._free_cache[key] = free
         return self._free_cache[key]
 
-    def _rings(self, key: object, geom: BaseGeometry) -> Rings | None:
-        """The compiled point-in-area test of ``geom`` (:mod:`tfloc.maps.inside`), made once."""
+    def _rings(self, key: object, geom: BaseGeometry, build: bool) -> Rings | None:
+        """The compiled point-in-area test of ``geom`` (:mod:`tfloc.maps.inside`): made when asked
+        to ``build`` it (once), else ``None`` until then (the queries then go to shapely). It pays
+        only for a map queried many times (its raster costs more than a few shapely calls), so
+        a matcher builds it in ``prepare`` or for its own many queries, never a map used once."""
         if key not in self._free_cache:
+            if not build:
+                return None
             self._free_cache[key] = Rings.of(geom)
         return self._free_cache[key]
 
-    def free_rings(self, clearance: float = 0.0) -> Rings | None:
-        """The compiled test behind :meth:`is_free` (``None``: shapely answers), for callers that
-        run it inside their own compiled code."""
-        return self._rings(("rings", round(float(clearance), 9)), self._free_space(clearance))
+    def free_rings(self, clearance: float = 0.0, build: bool = False) -> Rings | None:
+        """The compiled test behind :meth:`is_free` (``None``: not built, or shapely answers),
+        for callers that run it inside their own compiled code; ``build`` makes it."""
+        return self._rings(("rings", round(float(clearance), 9)), self._free_space(clearance), build)
 
-    def area_rings(self) -> Rings | None:
-        """The compiled test behind :meth:`in_bounds` (``None``: shapely answers)."""
-        return self._rings("area-rings", self.area)
+    def area_rings(self, build: bool = False) -> Rings | None:
+        """The compiled test behind :meth:`in_bounds` (see :meth:`free_rings`)."""
+        return self._rings("area-rings", self.area, build)
 
     def is_free(self, xy: np.ndarray, clearance: float = 0.0) -> np.ndarray:
         """Which ``(N, 2)`` points are in free space at least ``clearance`` metres from geometry
-        (shapely's ``contains_xy``; answered by the compiled :class:`~tfloc.maps.inside.Rings`,
-        which defers to shapely near the boundary)."""
+        (shapely's ``contains_xy``; answered by the compiled :class:`~tfloc.maps.inside.Rings`
+        once built, which defers to shapely near the boundary)."""
         p = np.asarray(xy, dtype=float).reshape(-1, 2)
         rings = self.free_rings(clearance)
         if rings is not None:

@@ -16,7 +16,7 @@ from numba import njit
 
 from tfloc.core.laser import _returns_to_points
 from tfloc.maps._raycast import raycast_segments
-from tfloc.maps.inside import inside_kernel
+from tfloc.maps.inside import raster_code
 
 from .corners import _shortstraw
 from .turning import TWO_PI, _match, _match_l1, _turning
@@ -77,22 +77,24 @@ def scan_errors(scans: np.ndarray, directions: np.ndarray, max_range: float, spa
 
 
 @njit(cache=True, nogil=True)
-def function1_kernel(x: float, y: float, theta_v: float, offsets: np.ndarray, rings: np.ndarray,
+def function1_kernel(x: float, y: float, theta_v: float, offsets: np.ndarray, rings: tuple,
                      sure: float, rel_angles: np.ndarray, segs: np.ndarray, directions: np.ndarray,
                      max_range: float, spacing: float, window: int, t: float,
                      line_threshold: float, close_through_origin: bool, along_path: bool,
                      l1: bool, real_breaks: np.ndarray, real_angles: np.ndarray,
                      penalty: float) -> tuple[int, float, float, float]:
     """Alg. 5's Function1 at ``(x, y)`` on a vector map (segments ``segs``), in one call: whether
-    the position is free (:func:`tfloc.maps.inside.inside_kernel` on the free space's ``rings``;
-    ``sure`` < 0 skips the test, the caller having made it), the virtual scans of the headings
+    the position is free (:func:`tfloc.maps.inside.raster_code` on the free space's ``rings`` =
+    ``(codes, x0, y0, res, segments)`` of :class:`~tfloc.maps.inside.Rings`; ``sure`` < 0 skips
+    the test, the caller having made it), the virtual scans of the headings
     ``theta_v + offsets`` (:func:`tfloc.maps._raycast.raycast_segments`), their Err and rotation
     offsets (:func:`scan_errors`) and the best of them (the first lowest Err, as ``np.argmin``).
 
     Returns ``(code, Err, heading, rotation)``: code 1 answered, 0 not free (the rest unset),
     -1 too near the free space's boundary to say (ask shapely, then call again with ``sure`` < 0)."""
     if sure >= 0.0:
-        code = inside_kernel(np.array([x]), np.array([y]), rings, sure)[0]
+        codes, x0, y0, res, ring_segs = rings
+        code = raster_code(x, y, codes, x0, y0, res, ring_segs, sure)
         if code != 1:
             return np.int64(code), penalty, theta_v + offsets[0], 0.0
     n = offsets.shape[0]

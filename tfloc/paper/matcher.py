@@ -185,10 +185,10 @@ class _Cost:
         self._vector = None
         m = self.problem.map
         if _FUSED and isinstance(m, VectorMap):   # Function1 in one compiled call
-            rings = m.free_rings()
-            self._vector = (self._offsets, np.zeros((0, 4)) if rings is None else rings.segs,
-                            -1.0 if rings is None else SURE, np.asarray(laser.angles, dtype=float),
-                            m.segments)
+            r = m.free_rings(build=True)            # hundreds of free tests per scan
+            if r is not None:                       # (else shapely's geometry: the Python path)
+                self._vector = (self._offsets, (r.codes, r.x0, r.y0, r.res, r.segs), SURE,
+                                np.asarray(laser.angles, dtype=float), m.segments)
 
     def _function1_vector(self, x: float, y: float, theta_v: float) -> tuple[float, float, float]:
         """:meth:`function1`'s evaluation on a vector map: one compiled call

@@ -57,6 +57,7 @@ from tfloc.core.params import Configured
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
 from tfloc.maps.grid import GridMap
+from tfloc.maps.vector import VectorMap
 from tfloc.paper.kernels import scan_turning
 from tfloc.paper.shape import ShapeConfig, scan_turning_function
 from tfloc.paper.turning import TurningFunction, match
@@ -238,10 +239,14 @@ class TurningFunctionPlusMatcher(Configured):
     CONFIG = TfPlusConfig
 
     def prepare(self, problem: Problem) -> None:
-        """Build the map's view, its pooled copy and the free-space test (once per map; untimed
-        by the harness)."""
+        """Build the map's view, its pooled copy and the free-space tests (once per map; untimed
+        by the harness, once per dataset: a scan-to-scan dataset's per-scan maps never build
+        the free-space tests, which pay only on a map queried many times)."""
         _field(problem.map, self.config)
         _coarse_field(problem.map, self.config)
+        if isinstance(problem.map, VectorMap):   # the lattice's compiled free tests
+            problem.map.area_rings(build=True)
+            problem.map.free_rings(build=True)
         xy = problem.initial.xy[None, :]
         problem.map.in_bounds(xy)
         problem.map.is_free(xy)
