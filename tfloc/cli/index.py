@@ -24,7 +24,7 @@ from tfloc.harness.threads import limit_threads
 from tfloc.io.scenario import iter_scans, map_for, read_scenario
 from tfloc.relocalize.index import default_cache_dir
 
-from .localize import parse_params
+from ._matcher import parse_params
 
 HELP = "build or load tf-global's place index of a dataset's map (before a run)"
 
