@@ -55,6 +55,7 @@ def test_false_relocalization_is_a_jump_away_from_a_correct_pose() -> None:
     pred[7] = est[6]
     ks = score_kidnaps(est, true, pred, [])
     assert ks.false_relocalizations == (4,)
+    assert score_kidnaps(est, true, pred, [4]).false_relocalizations == ()   # the kidnap scan itself
     small = est.copy()
     small[4] = true[4] + (0.8, 0.0, 0.0)  # 0.8 m: not a relocalization jump
     assert false_relocalizations(small, pred, np.ones(n, bool) & ~np.isin(np.arange(n), [4, 5, 6])) == []

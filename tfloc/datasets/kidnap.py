@@ -11,7 +11,7 @@ from where it was), drawn through the same odometry motion model as every other 
 scan at the new pose) and their sizes (``"kidnap_events"``: jump in metres, turn in degrees), so
 that metrics find them without a tracker ever reading the truth; ``"set"`` is ``kidnap`` (the
 evaluation sequences) or ``kidnap-dev`` (the development sequence the recovery rule was chosen on,
-``docs/tf-global.md``). Each dataset draws from its own child of :data:`KIDNAP_SEED`, so the
+``docs/kidnap.md``). Each dataset draws from its own child of :data:`KIDNAP_SEED`, so the
 bundle is reproducible bit for bit and no other dataset's bytes depend on it. Units: metres,
 radians, seconds.
 """

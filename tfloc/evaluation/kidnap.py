@@ -12,7 +12,8 @@ within the success thresholds (:class:`~tfloc.evaluation.outcome.Thresholds`, de
   event or the end. An event is **recovered within** ``n`` scans when that count is ≤ ``n``.
 * **false relocalization**: a scan whose estimate lies more than :data:`JUMP_M` from its
   prediction although the previous estimate was correct, and is not correct itself (a jump away
-  from a correct pose). A jump onto the truth is not one.
+  from a correct pose). A jump onto the truth is not one, nor is a jump at a kidnap scan (the
+  previous estimate was right for where the robot was, not for where it is).
 """
 
 from __future__ import annotations
@@ -78,14 +79,15 @@ def scans_to_relocalize(ok: np.ndarray, events: Sequence[int], hold: int = HOLD)
 
 
 def false_relocalizations(est: np.ndarray, pred: np.ndarray, ok: np.ndarray,
-                          jump_m: float = JUMP_M) -> list[int]:
-    """Scans whose estimate jumped more than ``jump_m`` from its prediction away from a correct
-    previous estimate to an incorrect one (module notes)."""
+                          events: Sequence[int] = (), jump_m: float = JUMP_M) -> list[int]:
+    """Scans (other than the kidnap scans ``events``) whose estimate jumped more than ``jump_m``
+    from its prediction away from a correct previous estimate to an incorrect one (module notes)."""
     est, pred = np.asarray(est, float).reshape(-1, 3), np.asarray(pred, float).reshape(-1, 3)
     jump = np.hypot(est[:, 0] - pred[:, 0], est[:, 1] - pred[:, 1])
     jump = np.where(np.isfinite(jump), jump, 0.0)
     hit = np.zeros(len(est), dtype=bool)
     hit[1:] = (jump[1:] > jump_m) & ok[:-1] & ~ok[1:]
+    hit[[int(e) for e in events if 0 <= int(e) < len(hit)]] = False
     return [int(k) for k in np.flatnonzero(hit)]
 
 
@@ -95,7 +97,7 @@ def score_kidnaps(est: np.ndarray, true: np.ndarray, pred: np.ndarray, events: S
     ok = correct(est, true, thresholds)
     return KidnapScore(tuple(sorted(int(e) for e in events)),
                        tuple(scans_to_relocalize(ok, events)),
-                       tuple(false_relocalizations(est, pred, ok)))
+                       tuple(false_relocalizations(est, pred, ok, events)))
 
 
 def median_scans(values: Sequence[int | None]) -> float:
