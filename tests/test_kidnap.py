@@ -139,3 +139,26 @@ def test_report_kidnap_table(tmp_path) -> None:
     ev = pd.read_csv(tmp_path / "kidnap.csv")
     assert len(ev) == 2 * n and set(ev["kidnap_scan"]) == set(sc.extra["kidnaps"])
     assert json.loads((SCEN / name / "scenario.json").read_text())["kidnaps"] == sc.extra["kidnaps"]
+
+
+# -- the recovering tracker --------------------------------------------------------------------
+def test_tf_plus_recover_finds_itself_after_a_kidnap_and_tf_plus_does_not() -> None:
+    """The development sequence's first kidnap (scan 99): tf-plus-recover, which never reads the
+    truth, is correct again within 20 scans without a false jump; tf-plus alone stays lost."""
+    from tfloc.core.matcher import get_matcher
+    from tfloc.harness.track import track
+
+    sc = read_scenario(SCEN / "seq-kidnap-dev")
+    scans = read_scans(sc)[:130]
+    event = [s.scan_id for s in scans].index(sc.extra["kidnaps"][0])
+
+    def scored(name: str):
+        df = pd.DataFrame(track(sc, scans, get_matcher(name)))
+        pose = lambda p: df[[f"{p}_x", f"{p}_y", f"{p}_theta"]].to_numpy(float)  # noqa: E731
+        return score_kidnaps(pose("est"), pose("true"), pose("init"), [event]), df
+
+    ks, df = scored("tf-plus-recover")
+    assert ks.recovered_within(20) == 1 and ks.false_relocalizations == ()
+    info = df["info"].map(json.loads)
+    assert not any(info[:event].map(lambda i: i["lost"]))          # no global call while tracking
+    assert scored("tf-plus")[0].recovered_within(20) == 0
