@@ -48,6 +48,10 @@ bench: $(STAMP)
 	$(BIN)/tfloc report results/tf-plus-ablation
 	$(BIN)/tfloc bench benchmarks/sequences.toml --jobs $(JOBS) --regenerate
 	$(BIN)/tfloc report results/sequences
+	$(BIN)/tfloc bench benchmarks/kidnap.toml --jobs $(JOBS) --regenerate
+	$(BIN)/tfloc report results/kidnap
+	$(BIN)/tfloc bench benchmarks/kidnap-controls.toml --jobs $(JOBS) --regenerate
+	$(BIN)/tfloc report results/kidnap-controls
 	$(BIN)/tfloc bench benchmarks/robustness.toml --jobs $(JOBS) --regenerate
 	$(BIN)/tfloc timing results/robustness
 	$(BIN)/tfloc report results/robustness

@@ -109,7 +109,8 @@ def test_bad_parameters_are_named(matcher, key, value, message) -> None:
     assert err.value.names and err.value.names[0].split(".")[0] == key
 
 
-def test_bad_parameter_values_are_refused_at_construction(problem) -> None:
+def test_bad_parameter_values_are_refused_at_construction(problem, tmp_path, monkeypatch) -> None:
+    monkeypatch.chdir(tmp_path)  # a relative cache_dir ("no-such-choice") is created here
     tally = Tally("matcher parameters")
     for matcher, name, value in CASES:
         def build_and_localize(matcher=matcher, name=name, value=value):

@@ -3,7 +3,8 @@
 Writes OUT/maps/office-{1,2,3}.geojson (rooms only, furnished, crowded),
 OUT/scenarios/{office-pool,detail-1,detail-2,detail-3}, the simulated sequences
 OUT/scenarios/seq-* (a robot driving routes through the three floors with odometry, under
-labelled conditions: tfloc.datasets.sequences) and the changed-world datasets
+labelled conditions: tfloc.datasets.sequences; the kidnapped sequences OUT/scenarios/seq-kidnap-*:
+tfloc.datasets.kidnap) and the changed-world datasets
 OUT/scenarios/changed-{clutter-0,clutter-10,clutter-25,furniture-gone} (the furnished office's
 map, scans with unmapped people and boxes or without the furniture; tfloc.datasets.changed_world),
 and the global-localization datasets OUT/scenarios/global-office-{1,2,3} (evaluation) and
@@ -56,6 +57,9 @@ def run(args: argparse.Namespace) -> int:
         from tfloc.datasets.sequences import SimSpec, generate_sequences
 
         generate_sequences(args.out, SimSpec(noise=spec.noise), log=print)
+        from tfloc.datasets.kidnap import generate_kidnap_sequences
+
+        generate_kidnap_sequences(args.out, SimSpec(noise=spec.noise), log=print)
     generate_changed_world(args.out, spec, log=print)
     generate_global_offices(args.out, args.global_seed, args.global_scans, noise=spec.noise, log=print)
     return 0

@@ -21,6 +21,9 @@ from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
 from tfloc.core.tracker import PREDICTED
+from tfloc.tfplus.matcher import TfPlusConfig, TurningFunctionPlusMatcher
+
+from .matcher import TfGlobalConfig, TurningFunctionGlobalMatcher
 
 
 @dataclass(frozen=True)
@@ -93,3 +96,48 @@ class RecoveringTracker:
         return Estimate(est.pose, est.converged, est.iterations, est.evaluations,
                         {**est.info, "score": score, "lost": lost, "relocalized": relocalized},
                         est.hypotheses)
+
+
+@dataclass(frozen=True)
+class TfPlusRecoverConfig:
+    """Parameters of ``tf-plus-recover``: the recovery rule (:class:`RecoveryConfig`'s fields,
+    metres of tf-plus's score), ``tf-plus``'s (``local``) and ``tf-global``'s (``relocalizer``)."""
+
+    RULES: ClassVar[dict] = RecoveryConfig.RULES
+
+    lost_score: float = 0.02
+    lost_after: int = 2
+    accept_score: float = 0.02
+    local: TfPlusConfig = TfPlusConfig()
+    relocalizer: TfGlobalConfig = TfGlobalConfig()
+
+
+class TfPlusRecoverTracker(RecoveringTracker):
+    """``tf-plus-recover``: ``tf-plus`` tracking, ``tf-global`` when lost (module notes), the
+    registered tracker. Its rule's values were chosen on the development sequence
+    ``seq-kidnap-dev`` (``docs/kidnap.md``). A tracker only: no single-scan ``localize``."""
+
+    name = "tf-plus-recover"
+    CONFIG = TfPlusRecoverConfig
+
+    def __init__(self, config: TfPlusRecoverConfig | None = None, **overrides) -> None:
+        cfg = resolve_params(TfPlusRecoverConfig, config, overrides)
+        super().__init__(TurningFunctionPlusMatcher(cfg.local), TurningFunctionGlobalMatcher(cfg.relocalizer),
+                         RecoveryConfig(cfg.lost_score, cfg.lost_after, cfg.accept_score))
+        self.name, self.config = "tf-plus-recover", cfg   # (the rule's fields are its own)
+
+    def start(self, map: Map, laser: LaserSpec, pose: Pose) -> None:
+        """Begin at ``pose``. The map-only work (``tf-global``'s place index, ``tf-plus``'s map
+        view and compiled kernels) is done here, before the harness times any step, on a scan
+        ray-cast in the map from ``pose`` (the start the tracker is given; never the truth)."""
+        super().start(map, laser, pose)
+        ranges = map.raycast(pose, laser)
+        self.prepare(Problem(map, laser, ranges, pose))
+        self.prepare(Problem(map, laser, ranges, None))
+        warm = Problem(map, laser, ranges, pose)
+        self.local.score(warm, pose)
+        self.local.localize(warm)
+
+    def reset(self, pose: Pose) -> None:
+        """Put the estimate at ``pose`` (the loop's prediction after a step raised)."""
+        self.pose = pose

@@ -10,7 +10,9 @@ sequences (where the set has several), losses, recoveries and unrecovered losses
 sequences, the longest lost stretch, APE translation RMSE pooled over scans (cm), RPE per metre
 (mean over sequences, cm/m) and the median CPU ms per scan. Definitions:
 :mod:`tfloc.evaluation.trajectory`. Figures: each sequence's trajectories drawn on the map per
-matcher, and the distance error over distance travelled.
+matcher, and the distance error over distance travelled. Sets whose sequences have kidnap events
+(``scenario.json`` ``"kidnaps"``) get a kidnap table too (:func:`kidnap_tables`;
+:mod:`tfloc.evaluation.kidnap`), their events one row each in ``kidnap.csv``.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from tfloc.core.tracker import DeadReckoning
+from tfloc.evaluation.kidnap import WITHIN, median_scans, score_kidnaps
 from tfloc.evaluation.outcome import Thresholds
 from tfloc.evaluation.trajectory import LOST_DIST_M, errors, path_length, pooled_share, score_rows
 from tfloc.io.scenario import Scenario
@@ -87,6 +90,54 @@ def tracking_tables(s: pd.DataFrame) -> str:
         parts.append(f"**{cond}** ({len(seqs)} sequence{'s' * (len(seqs) != 1)}: "
                      f"{', '.join(seqs['dataset'])}; {int(seqs['n_truth'].sum())} scans, "
                      f"{seqs['distance_m'].sum():.0f} m)\n\n" + condition_table(g))
+    return "\n".join(parts)
+
+
+def kidnap_events(df: pd.DataFrame, datasets: dict[str, Scenario],
+                  thresholds: Thresholds = DEFAULT) -> pd.DataFrame:
+    """One row per (kidnapped dataset, matcher, event): its set, the kidnap scan, scans to
+    relocalize (NaN = never) and, on each (dataset, matcher)'s first event row, its false
+    relocalizations and tracked share."""
+    out = []
+    for (ds, m), g in df.groupby(["dataset", "matcher"], sort=False):
+        sc = datasets.get(ds)
+        kid = (sc.extra.get("kidnaps") or []) if sc is not None else []
+        if not kid:
+            continue
+        pos = {str(sid): i for i, sid in enumerate(g["scan_id"].astype(str))}
+        events = [pos[k] for k in map(str, kid) if k in pos]
+        ks = score_kidnaps(_poses(g, "est"), _poses(g, "true"), _poses(g, "init"), events, thresholds)
+        tracked = score_rows(g, thresholds).tracked
+        for i, (e, n) in enumerate(zip(ks.events, ks.scans_to_relocalize, strict=True)):
+            out.append({"dataset": ds, "matcher": m, "set": condition_of(sc, g),
+                        "kidnap_scan": str(g["scan_id"].iloc[e]),
+                        "scans_to_relocalize": math.nan if n is None else n,
+                        "false_relocalizations": len(ks.false_relocalizations) if i == 0 else 0,
+                        "tracked": tracked if i == 0 else math.nan})
+    return pd.DataFrame(out)
+
+
+def kidnap_tables(ev: pd.DataFrame) -> str:
+    """One markdown table per kidnapped set (rows of :func:`kidnap_events`): per matcher the
+    events, those relocalized within 20 scans, the median scans to relocalize ("never" counted
+    as infinitely many), false relocalizations and the tracked share (pooled over sequences)."""
+    parts = []
+    for cond, g in ev.groupby("set", sort=True):
+        rows = []
+        for m in _order(g["matcher"]):
+            h = g[g["matcher"] == m]
+            n = [None if math.isnan(v) else int(v) for v in h["scans_to_relocalize"]]
+            ok = sum(v is not None and v <= WITHIN for v in n)
+            med = median_scans(n)
+            rows.append([m, len(n), f"{ok}/{len(n)}", "never" if math.isinf(med) else num(med, 0),
+                         int(h["false_relocalizations"].sum()),
+                         num(100 * float(h["tracked"].dropna().mean()), 1)])
+        seqs = g.drop_duplicates("dataset")["dataset"]
+        parts.append(f"**{cond}: kidnap events** ({len(seqs)} sequence{'s' * (len(seqs) != 1)}: "
+                     f"{', '.join(seqs)})\n\n" + table(
+                         ["matcher", "events", f"relocalized within {WITHIN} scans",
+                          "median scans to relocalize", "false relocalizations",
+                          "tracked % (mean over sequences)"], rows))
     return "\n".join(parts)
 
 
@@ -170,6 +221,14 @@ def tracking_section(df: pd.DataFrame, datasets: dict[str, Scenario], maps: dict
             "goes above 0.5 m or 10°; a recovery = back within the thresholds by itself; APE/RPE by "
             "evo with no alignment (map frame); `odometry` = dead reckoning, the floor.\n",
             tracking_tables(s)]
+    ev = kidnap_events(df, datasets, thresholds)
+    if len(ev):
+        ev.to_csv(Path(out_dir) / "kidnap.csv", index=False, float_format="%.6g")
+        text += ["\nKidnap events (the robot moved 5–20 m and turned, unseen by the odometry): "
+                 "relocalized = the first scan after the event within the thresholds that stays "
+                 "there for 3 scans (never: not before the next event or the end); a false "
+                 "relocalization = the estimate jumps > 1 m from its prediction, away from a "
+                 "correct pose to a wrong one. Per event: `kidnap.csv`.\n", kidnap_tables(ev)]
     if figures:
         fig_dir = Path(out_dir) / "figures" / "tracking"
         for ds, g in df.groupby("dataset", sort=False):
