@@ -81,7 +81,7 @@ def row(dataset: str, label: str, scan: Scan, pred: Pose, est: Pose, status: str
                **_pose_fields("true", scan.true), **_pose_fields("init", pred),
                **_pose_fields("est", est), runtime_s=wall_s, cpu_s=cpu_s, status=status)
     if estimate is not None:
-        out.update(converged=estimate.converged, iterations=estimate.iterations,
+        out.update(converged=int(bool(estimate.converged)), iterations=estimate.iterations,
                    evaluations=estimate.evaluations)
     out["info"] = json.dumps(info or {}, default=str, sort_keys=True)
     return out
