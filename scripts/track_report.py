@@ -2,7 +2,7 @@
 
   .venv/bin/python scripts/track_report.py results/tracking [--no-figures]
 
-Reads OUT/estimates.csv, scores every (sequence, matcher) with tfloc.evaluation.trajectory and
+Reads OUT/estimates.csv (or OUT/estimates.csv.gz), scores every (sequence, matcher) with tfloc.evaluation.trajectory and
 writes OUT/tracking.md (tfloc.report.tracking: one table per sequence set) and
 OUT/figures/tracking/*.png, plus OUT/scores.csv (one row per sequence and matcher).
 """
@@ -27,7 +27,10 @@ def main() -> int:
     from tfloc.io.scenario import read_scenario
     from tfloc.report.tracking import sequence_scores, tracking_section
 
-    df = pd.read_csv(args.run / "estimates.csv", keep_default_na=False, dtype=str)
+    path = args.run / "estimates.csv"
+    if not path.exists():
+        path = path.with_suffix(".csv.gz")
+    df = pd.read_csv(path, keep_default_na=False, dtype=str)
     ds = {n: read_scenario(args.scenarios / n) for n in df["dataset"].unique()}
     maps = {} if args.no_figures else {n: load_map(s.map_path) for n, s in ds.items()}
     text = tracking_section(df, ds, maps, args.run, figures=not args.no_figures)

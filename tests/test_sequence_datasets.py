@@ -104,7 +104,7 @@ def test_bundle_design():
     assert len(long) >= 5
     g = json.loads((ROOT / "data/scenarios/seq-rate-1hz-b/scenario.json").read_text())["generator"]
     assert g["max_step_m"] == pytest.approx(1.0, abs=0.01) and g["max_turn_deg"] == pytest.approx(30.0, abs=0.1)
-    assert set(CONDITIONS) == {"easy", "rate-2hz", "rate-1hz", "odom-high", "slip", "people"}
+    assert set(CONDITIONS) == {"easy", "rate-2hz", "rate-1hz", "odom-high", "slip", "people", "combined"}
 
 
 def test_bundled_sequences_regenerate_bit_for_bit(tmp_path):

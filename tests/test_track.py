@@ -123,3 +123,16 @@ def test_run_sequence_is_one_task(tmp_path):
     ref = dead_reckoning(read_scenario(root), read_scans(read_scenario(root)))
     pose = lambda r: (r["est_x"], r["est_y"], r["est_theta"])  # noqa: E731
     assert [pose(r) for r in odo] == [pose(r) for r in ref]
+
+
+def test_rows_are_read_back_by_the_results_reader(tmp_path):
+    from tfloc.io.estimates import read_estimates
+
+    sc = read_scenario(_copy(tmp_path / "a", 6))
+    rows = track(sc, read_scans(sc), Shift())
+    with (tmp_path / "estimates.csv").open("w", newline="") as fh:
+        w = csv.DictWriter(fh, COLUMNS)
+        w.writeheader()
+        w.writerows(rows)
+    df = read_estimates(tmp_path)
+    assert len(df) == 6 and set(df["status"]) <= {"ok", "failed", "error:RuntimeError: boom"}
