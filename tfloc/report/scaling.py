@@ -243,6 +243,17 @@ def write_readme(path: Path, rows: pd.DataFrame, levels: pd.DataFrame, slopes: p
     return path
 
 
+def _plain_ticks(ax) -> None:
+    """Tick labels as plain numbers (2, 5, 10, 20) on log axes, not 2 × 10⁰."""
+    from matplotlib.ticker import FuncFormatter, LogLocator
+
+    fmt = FuncFormatter(lambda v, _: f"{v:g}")
+    for axis in (ax.xaxis, ax.yaxis):
+        axis.set_major_formatter(fmt)
+        axis.set_minor_locator(LogLocator(subs=(2.0, 5.0)))
+        axis.set_minor_formatter(fmt)
+
+
 def write_figure(path: Path, levels: pd.DataFrame, slopes: pd.DataFrame, prep: pd.DataFrame) -> Path:
     """Log–log panels: CPU per scan against each axis (points = level medians, lines = fits), and
     preparation time and memory against map area."""
@@ -272,6 +283,7 @@ def write_figure(path: Path, levels: pd.DataFrame, slopes: pd.DataFrame, prep: p
             ax.plot([], [], "o-", color=col[m], label=label)
         ax.set(xscale="log", yscale="log", title=AXIS_TITLES[(axis, kind)], xlabel=AXIS_X[axis],
                ylabel="median CPU per scan (ms)")
+        _plain_ticks(ax)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=6, loc="best")
     rest = axes[len(panels):]
