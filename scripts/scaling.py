@@ -22,7 +22,8 @@ Measurement: one process pinned to one core, every library on one thread
 wall time, and the process's resident memory after it minus before it, psutil RSS after a
 garbage collection: numba's and open3d's allocations included, unlike tracemalloc), then an
 untimed warm-up (``score`` and ``localize`` on the first scan). Per-scan CPU time
-(``time.process_time``) of ``localize`` alone, matchers interleaved scan by scan (the order
+(``time.process_time``: user + system) of ``localize`` alone, its system part apart
+(``getrusage``: mostly the kernel handing out fresh pages for large temporary arrays), matchers interleaved scan by scan (the order
 rotated by one per scan). Success = ≤ 10 cm and ≤ 2° (:class:`tfloc.evaluation.outcome.Thresholds`).
 
 Bounds: a matcher whose median CPU at a level exceeds ``budget_ms``, or whose preparation
@@ -42,6 +43,7 @@ import json
 import math
 import os
 import platform
+import resource
 import sys
 import time
 from collections.abc import Callable, Sequence
@@ -330,6 +332,7 @@ def run_level(lv: Level, matchers: dict[str, object], log: Callable[[str], None]
         for pos in range(k):
             name = names[(i + pos) % k]
             problem = problems[name][i]
+            u0 = resource.getrusage(resource.RUSAGE_SELF).ru_stime
             w0, c0 = time.perf_counter(), time.process_time()
             try:
                 est = matchers[name].localize(problem)
@@ -337,13 +340,15 @@ def run_level(lv: Level, matchers: dict[str, object], log: Callable[[str], None]
             except Exception as exc:  # noqa: BLE001 - a raising matcher is a result, not a crash
                 est, status = None, f"error:{type(exc).__name__}: {exc}"[:200]
             cpu, wall = time.process_time() - c0, time.perf_counter() - w0
+            sys_s = resource.getrusage(resource.RUSAGE_SELF).ru_stime - u0
             d, o, ok = success_of(est.pose, s.truth) if est is not None else (math.nan, math.nan, False)
             ok = ok and status == "ok"
             rows.append({"matcher": name, "axis": lv.axis, "kind": lv.kind, "level": lv.level,
                          "size": lv.size, "tiles": lv.tiles, "beams": lv.laser.n_beams,
                          "fov_deg": round(math.degrees(lv.laser.fov), 6), "scan_id": s.scan_id,
                          "offset_bin": s.offset_bin, "init_dist_m": s.initial.distance_to(s.truth),
-                         "position": pos, "cpu_ms": 1000.0 * cpu, "wall_ms": 1000.0 * wall,
+                         "position": pos, "cpu_ms": 1000.0 * cpu, "sys_ms": 1000.0 * sys_s,
+                         "wall_ms": 1000.0 * wall,
                          "dist_err_m": d, "orient_err_deg": o, "success": int(ok), "status": status})
     del maps, problems
     gc.collect()

@@ -132,6 +132,7 @@ def test_study_end_to_end_on_a_tiny_configuration(tmp_path):
     assert ids.nunique() == 1
     assert sorted(rows.loc[rows["axis"] == "beams", "beams"].unique()) == [181, 361]
     assert (rows["cpu_ms"] > 0).all() and rows["success"].isin([0, 1]).all()
+    assert (rows["sys_ms"] >= 0).all() and rows["sys_ms"].sum() <= rows["cpu_ms"].sum() * 1.05 + 20
     # preparation: the map itself and each matcher, for each area level and kind
     assert set(prep["matcher"]) == {"(map)", "tf-plus", "cv-corners"}
     assert len(prep) == 3 * 2 * 2 and (prep["status"] == "ok").all()

@@ -21,7 +21,7 @@ GROWS_SLOPE = 0.2
 
 #: Columns of the study's per-scan rows (``scaling.csv``).
 SCAN_COLUMNS = ["matcher", "axis", "kind", "level", "size", "tiles", "beams", "fov_deg", "scan_id",
-                "offset_bin", "init_dist_m", "position", "cpu_ms", "wall_ms", "dist_err_m",
+                "offset_bin", "init_dist_m", "position", "cpu_ms", "sys_ms", "wall_ms", "dist_err_m",
                 "orient_err_deg", "success", "status"]
 #: Columns of the preparation rows (``prep.csv``): one per (matcher, map); matcher ``(map)`` is
 #: the map itself (building it; its own arrays).
@@ -68,13 +68,18 @@ def fit_linear(x: np.ndarray, y: np.ndarray) -> float:
 
 def level_table(rows: pd.DataFrame) -> pd.DataFrame:
     """Per (axis, kind, matcher, level): scans ``n``, ``size`` (the level's x: m², beams or
-    metres), median and p90 CPU ms, median wall ms and the success rate."""
+    metres), median and p90 CPU ms, median wall ms, the success rate and (when the rows have
+    ``sys_ms``) the share of system time in the level's CPU time."""
     keys = ["axis", "kind", "matcher", "level"]
     g = rows.groupby(keys, sort=False)
     out = g.agg(size=("size", "first"), n=("cpu_ms", "size"), cpu_ms_median=("cpu_ms", "median"),
                 cpu_ms_p90=("cpu_ms", lambda s: float(np.percentile(s, 90))),
-                wall_ms_median=("wall_ms", "median"), success=("success", "mean"))
-    return out.reset_index()
+                wall_ms_median=("wall_ms", "median"), success=("success", "mean"),
+                **({"sys_share": ("sys_ms", "sum")} if "sys_ms" in rows else {}))
+    out = out.reset_index()
+    if "sys_share" in out:  # system CPU over all CPU of the level's calls
+        out["sys_share"] /= g["cpu_ms"].sum().to_numpy()
+    return out
 
 
 def slope_table(levels: pd.DataFrame) -> pd.DataFrame:

@@ -125,6 +125,30 @@ def prep_section(prep: pd.DataFrame, prep_slopes: pd.DataFrame) -> str:
     return "\n".join(out)
 
 
+#: A matcher whose system time exceeds this share of its CPU time at some level is named.
+SYS_SHARE_NOTE = 0.2
+
+
+def system_time_note(levels: pd.DataFrame) -> str:
+    """A sentence naming the matchers whose CPU time is largely system time at some level (the
+    kernel zeroing fresh pages of large temporaries: it varies with the allocator's state and the
+    machine's load more than user time does)."""
+    if "sys_share" not in levels:
+        return ""
+    hi = levels[levels["sys_share"] > SYS_SHARE_NOTE]
+    if hi.empty:
+        return (f"**System time.** No matcher spent more than {100 * SYS_SHARE_NOTE:.0f} % of its "
+                f"CPU time in the kernel at any level.")
+    worst = hi.sort_values("sys_share", ascending=False).drop_duplicates("matcher")
+    items = ", ".join(f"{r.matcher} {100 * r.sys_share:.0f} % ({r.axis} {r.kind} {r.level})"
+                      for r in worst.itertuples())
+    return (f"**System time.** CPU time is user plus system time. Matchers with more than "
+            f"{100 * SYS_SHARE_NOTE:.0f} % system time at some level (the largest share): {items}. "
+            f"System time here is mostly the kernel handing out fresh pages for large temporary "
+            f"arrays; it depends on the allocator's state and the machine's load, so these medians "
+            f"vary more between runs than the others (`levels.csv`: `sys_share`).")
+
+
 def changed_outcomes(rows: pd.DataFrame) -> str:
     """A sentence on the area axis's scans whose success differs between the smallest map and a
     larger one (the scans are the same: only the map around them grew), with their errors."""
@@ -186,7 +210,7 @@ def write_readme(path: Path, rows: pd.DataFrame, levels: pd.DataFrame, slopes: p
              f"**Budgets.** A matcher whose median at a level exceeded {config.get('budget_ms'):g} ms, "
              f"or whose preparation exceeded {config.get('prep_budget_s'):g} s CPU, was not run at the "
              "larger levels of that axis (listed below); its slope covers the levels it ran.", "",
-             changed_outcomes(rows), "",
+             changed_outcomes(rows), "", system_time_note(levels), "",
              "![scaling](scaling.png)", "", "## Per matcher", "", *sentences(slopes), ""]
     for axis, kind in (("area", "vector"), ("area", "grid"), ("beams", "vector"), ("offset", "vector")):
         sec = level_section(levels, axis, kind, slopes)
@@ -219,6 +243,17 @@ def write_readme(path: Path, rows: pd.DataFrame, levels: pd.DataFrame, slopes: p
     return path
 
 
+def _plain_ticks(ax) -> None:
+    """Tick labels as plain numbers (2, 5, 10, 20) on log axes, not 2 × 10⁰."""
+    from matplotlib.ticker import FuncFormatter, LogLocator
+
+    fmt = FuncFormatter(lambda v, _: f"{v:g}")
+    for axis in (ax.xaxis, ax.yaxis):
+        axis.set_major_formatter(fmt)
+        axis.set_minor_locator(LogLocator(subs=(2.0, 5.0)))
+        axis.set_minor_formatter(fmt)
+
+
 def write_figure(path: Path, levels: pd.DataFrame, slopes: pd.DataFrame, prep: pd.DataFrame) -> Path:
     """Log–log panels: CPU per scan against each axis (points = level medians, lines = fits), and
     preparation time and memory against map area."""
@@ -248,6 +283,7 @@ def write_figure(path: Path, levels: pd.DataFrame, slopes: pd.DataFrame, prep: p
             ax.plot([], [], "o-", color=col[m], label=label)
         ax.set(xscale="log", yscale="log", title=AXIS_TITLES[(axis, kind)], xlabel=AXIS_X[axis],
                ylabel="median CPU per scan (ms)")
+        _plain_ticks(ax)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=6, loc="best")
     rest = axes[len(panels):]
