@@ -41,4 +41,5 @@ def test_matcher_runs_on_a_grid_map(name: str) -> None:
     problem = Problem(grid, laser, ranges, Pose(truth.x + 0.12, truth.y - 0.09, truth.theta + np.radians(3)))
     est = matcher.localize(problem)
     assert est.pose.is_finite()
-    assert np.isfinite(matcher.score(problem, est.pose))
+    if callable(getattr(matcher, "score", None)):  # odometry has no objective
+        assert np.isfinite(matcher.score(problem, est.pose))

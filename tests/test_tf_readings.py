@@ -137,6 +137,7 @@ def test_keep_best_returns_the_lowest_err_pose_not_the_last(test_room, lms200, m
     """A scripted outer loop: simplex ends at three positions whose Err is 0.5, 0.2, 0.4."""
     ends = iter([np.array([1.0, 1.0]), np.array([2.0, 2.0]), np.array([3.0, 3.0])])
     errs = {1.0: 0.5, 2.0: 0.2, 3.0: 0.4}
+    monkeypatch.setattr(tfloc.paper.matcher, "_FUSED", False)  # the Python driver (the compiled one runs the same steps)
     monkeypatch.setattr(tfloc.paper.matcher, "simplex", lambda cost, pose, size, rng: (next(ends), 1))
     monkeypatch.setattr(tfloc.paper.matcher._Cost, "function1",
                         lambda self, xy, th: (errs.get(float(xy[0]), 0.9), th, 0.0))
