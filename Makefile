@@ -6,7 +6,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.tfloc-installed
 JOBS   ?= 2
 
-.PHONY: install quick bench global-full robustness robustness-full scaling scaling-quick ablation-real test test-unit timing lint clean-venv real-data fuzz chaos
+.PHONY: install quick bench global-full global-offices robustness robustness-full scaling scaling-quick ablation-real test test-unit timing lint clean-venv real-data fuzz chaos
 
 $(STAMP): pyproject.toml
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -68,6 +68,11 @@ global-full: $(STAMP)
 		$(BIN)/tfloc index --dataset data/scenarios/$$d || exit 1; done
 	$(BIN)/tfloc bench benchmarks/global-full.toml --jobs $(JOBS) --regenerate
 	$(BIN)/tfloc report results/global-full
+
+## tf-global against bnb-global on every scan of the three office global sets → results/global-offices/.
+global-offices: $(STAMP)
+	$(BIN)/tfloc bench benchmarks/global-offices.toml --jobs $(JOBS) --regenerate
+	$(BIN)/tfloc report results/global-offices
 
 ## Issue 25: every matcher on every map style of the real logs and every changed world of the
 ## simulated office (10 scans per offset group of each dataset; ~12 min on 2 quiet cores)
