@@ -105,6 +105,13 @@ def _insert(hk, hx, hy, hs, count, k, x, y, s, n_rot, dist_cells, rot_steps):
 
 
 @njit(cache=True, nogil=True)
+def _candidates(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Room for ``n`` candidates: rotation index, x and y (cells), score (sum of cell values)."""
+    return (np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64),
+            np.empty(n, dtype=np.float64))
+
+
+@njit(cache=True, nogil=True)
 def branch_and_bound(grids: np.ndarray, pad: int, offsets: np.ndarray, x_min: int, x_max: int,
                      y_min: int, y_max: int, min_sum: float, n_best: int, dist_cells: float,
                      rot_steps: int):
@@ -127,10 +134,7 @@ def branch_and_bound(grids: np.ndarray, pad: int, offsets: np.ndarray, x_min: in
     ny = (y_max - y_min + top) // top
     n_top = n_rot * nx * ny
     # the coarsest level, scored and sorted (ascending: pushed so the best is popped first)
-    ck = np.empty(n_top, dtype=np.int64)
-    cx = np.empty(n_top, dtype=np.int64)
-    cy = np.empty(n_top, dtype=np.int64)
-    cs = np.empty(n_top, dtype=np.float64)
+    ck, cx, cy, cs = _candidates(n_top)
     n = 0
     for k in range(n_rot):
         for ix in range(nx):
@@ -158,10 +162,7 @@ def branch_and_bound(grids: np.ndarray, pad: int, offsets: np.ndarray, x_min: in
     hy = np.zeros(n_best, dtype=np.int64)
     hs = np.zeros(n_best, dtype=np.float64)
     count = 0
-    child_k = np.empty(4, dtype=np.int64)
-    child_x = np.empty(4, dtype=np.int64)
-    child_y = np.empty(4, dtype=np.int64)
-    child_s = np.empty(4, dtype=np.float64)
+    child_k, child_x, child_y, child_s = _candidates(4)
     while sp > 0:
         sp -= 1
         k, x, y, h, s = sk[sp], sx[sp], sy[sp], sh[sp], ss[sp]

@@ -83,31 +83,31 @@ class Config:
         ("differential", "omni"): ("robot_model_type",),
     }
 
-    min_particles: int = 500
-    max_particles: int = 2000
-    recovery_alpha_slow: float = 0.0
-    recovery_alpha_fast: float = 0.0
-    alpha1: float = 0.2
-    alpha2: float = 0.2
-    alpha3: float = 0.2
-    alpha4: float = 0.2
-    alpha5: float = 0.2
-    robot_model_type: str = "differential"
-    laser_model_type: str = "beam"
-    max_beams: int = 60
-    z_hit: float = 0.5
-    z_short: float = 0.05
-    z_max: float = 0.05
-    z_rand: float = 0.5
-    sigma_hit: float = 0.2
-    lambda_short: float = 0.1
-    laser_max_range: float = 100.0
-    laser_min_range: float = -1.0
-    update_min_d: float = 0.25
-    update_min_a: float = 0.2
-    initial_sigma_xy: float = 0.0
-    initial_sigma_theta: float = 0.0
-    seed: int = 0
+    min_particles: int = 500  #: KLD sampling's fewest particles
+    max_particles: int = 2000  #: KLD sampling's most particles
+    recovery_alpha_slow: float = 0.0  #: slow average's decay for random particles (0: off)
+    recovery_alpha_fast: float = 0.0  #: fast average's decay for random particles (0: off)
+    alpha1: float = 0.2  #: odometry noise: rotation from rotation
+    alpha2: float = 0.2  #: odometry noise: rotation from translation
+    alpha3: float = 0.2  #: odometry noise: translation from translation
+    alpha4: float = 0.2  #: odometry noise: translation from rotation
+    alpha5: float = 0.2  #: odometry noise: strafe (omni model only)
+    robot_model_type: str = "differential"  #: motion model, differential or omni
+    laser_model_type: str = "beam"  #: sensor model: only beam (the wheel's one)
+    max_beams: int = 60  #: beams used per update
+    z_hit: float = 0.5  #: beam model: weight of the hit part
+    z_short: float = 0.05  #: beam model: weight of the short part
+    z_max: float = 0.05  #: beam model: weight of the max-range part
+    z_rand: float = 0.5  #: beam model: weight of the random part
+    sigma_hit: float = 0.2  #: beam model: sd of the hit part (metres)
+    lambda_short: float = 0.1  #: beam model: decay of the short part (1/m)
+    laser_max_range: float = 100.0  #: range cap (metres; ≤ 0: the laser's)
+    laser_min_range: float = -1.0  #: ranges below are dropped (metres; < 0: none)
+    update_min_d: float = 0.25  #: update after moving this far along x or y (metres)
+    update_min_a: float = 0.2  #: ... or turning this far (radians)
+    initial_sigma_xy: float = 0.0  #: sd of the initial particles in x and y (metres)
+    initial_sigma_theta: float = 0.0  #: sd of their heading (radians)
+    seed: int = 0  #: seed of the filter's random numbers
 
 
 #: Builds of the wheel whose pf_pdf seed counter we know: sha256 of ``_amcl_impl*.so`` →

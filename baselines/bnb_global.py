@@ -86,23 +86,23 @@ class Config:
         "[0, 1]": ("min_score",),
         ">= 1": ("branch_and_bound_depth", "hypotheses", "refine_max_evals", "voxel_min_num_points")}
 
-    resolution: float = 0.05
-    sigma: float = 0.05
-    branch_and_bound_depth: int = 7
-    min_score: float = 0.6
-    hypotheses: int = 5
-    distinct_m: float = 0.5
-    distinct_deg: float = 10.0
-    linear_search_window: float = 7.0
-    angular_search_window_deg: float = 30.0
-    refine: bool = True
-    occupied_space_weight: float = 20.0
-    translation_weight: float = 10.0
-    rotation_weight: float = 1.0
-    refine_max_evals: int = 50
-    voxel_filter: bool = True
-    voxel_max_length: float = 0.9
-    voxel_min_num_points: int = 100
+    resolution: float = 0.05  #: cell size of the probability grid (metres)
+    sigma: float = 0.05  #: blur of the grid's walls, p = 0.1 + 0.8·exp(−d²/2σ²) (metres)
+    branch_and_bound_depth: int = 7  #: levels of precomputed grids
+    min_score: float = 0.6  #: score an answer must exceed (mean probability, 0–1)
+    hypotheses: int = 5  #: distinct answers kept, best first
+    distinct_m: float = 0.5  #: answers closer than this are one answer (metres) ...
+    distinct_deg: float = 10.0  #: ... and closer than this in heading (degrees)
+    linear_search_window: float = 7.0  #: local problems: ± this about the guess (metres)
+    angular_search_window_deg: float = 30.0  #: local problems: ± this about the guess (degrees)
+    refine: bool = True  #: least-squares refinement of each hypothesis
+    occupied_space_weight: float = 20.0  #: refinement: occupied-space weight w (w/√N)
+    translation_weight: float = 10.0  #: refinement: weight toward the search's x, y (1/m)
+    rotation_weight: float = 1.0  #: refinement: weight toward its heading (1/rad)
+    refine_max_evals: int = 50  #: refinement: least_squares' max_nfev
+    voxel_filter: bool = True  #: thin the scan by the adaptive voxel filter first
+    voxel_max_length: float = 0.9  #: the filter's coarsest voxel edge (metres)
+    voxel_min_num_points: int = 100  #: the filter keeps at least this many returns
 
 
 @dataclass(frozen=True, eq=False)

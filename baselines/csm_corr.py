@@ -58,17 +58,17 @@ class Config:
         ">= 0": ("window_xy", "window_theta_deg", "min_mean_likelihood"),
         ">= 1": ("xy_step_cells", "block", "expand_batch", "refine_max_evals")}
 
-    resolution: float = 0.02
-    sigma: float = 0.10
-    window_xy: float = 3.5
-    window_theta_deg: float = 20.0
-    rot_step_deg: float = 1.0
-    xy_step_cells: int = 2
-    block: int = 8
-    expand_batch: int = 8
-    refine_scale: float = 0.05
-    refine_max_evals: int = 200
-    min_mean_likelihood: float = 0.3
+    resolution: float = 0.02  #: cell size of the likelihood field (metres)
+    sigma: float = 0.10  #: σ of the likelihood exp(−d²/2σ²) (metres)
+    window_xy: float = 3.5  #: search ± this in x and in y about the guess (metres)
+    window_theta_deg: float = 20.0  #: search ± this in heading (degrees)
+    rot_step_deg: float = 1.0  #: heading step of the search (degrees)
+    xy_step_cells: int = 2  #: translation step of the search (cells)
+    block: int = 8  #: translation steps per side of a low-resolution block
+    expand_batch: int = 8  #: blocks expanded per vectorised round
+    refine_scale: float = 0.05  #: Cauchy loss scale of the refinement (metres)
+    refine_max_evals: int = 200  #: refinement: least_squares' max_nfev
+    min_mean_likelihood: float = 0.3  #: converged needs this mean likelihood per beam (0–1)
 
 
 @dataclass(frozen=True)

@@ -66,16 +66,16 @@ class Config:
         "finite": ("layers",),
         _TYPES: ("registration_type",)}
 
-    registration_type: str = "GICP"
-    layers: tuple[float, ...] = (-0.05, 0.0, 0.05)
-    gates: tuple[float, ...] = (2.0, 1.0, 0.5, 0.2, 0.1)
-    map_spacing: float = 0.05
-    num_neighbors: int = 10
-    max_iterations: int = 20
-    rotation_epsilon_rad: float = math.radians(0.1)
-    translation_epsilon: float = 1e-3
-    num_threads: int = 1
-    min_inlier_fraction: float = 0.5
+    registration_type: str = "GICP"  #: small_gicp's registration type (GICP, ICP or PLANE_ICP)
+    layers: tuple[float, ...] = (-0.05, 0.0, 0.05)  #: z of the stacked point layers (metres)
+    gates: tuple[float, ...] = (2.0, 1.0, 0.5, 0.2, 0.1)  #: correspondence gate per stage (metres)
+    map_spacing: float = 0.05  #: sampling of the map's geometry (metres)
+    num_neighbors: int = 10  #: neighbours per point of its covariance
+    max_iterations: int = 20  #: small_gicp's iterations per stage
+    rotation_epsilon_rad: float = math.radians(0.1)  #: small_gicp's rotation tolerance (rad)
+    translation_epsilon: float = 1e-3  #: small_gicp's convergence on the translation (metres)
+    num_threads: int = 1  #: small_gicp's threads
+    min_inlier_fraction: float = 0.5  #: converged needs this share of points within the last gate
 
 
 @dataclass(frozen=True, eq=False)

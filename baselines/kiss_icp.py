@@ -69,15 +69,15 @@ class Config:
         ">= 1": ("max_points_per_voxel", "max_num_iterations", "max_num_threads"),
         "[0, 1]": ("min_inlier_fraction",)}
 
-    voxel_sizes: tuple[float, ...] = (2.0, 1.0, 0.3, 0.1)
-    gate_factor: float = 3.0
-    kernel_factor: float = 1.0
-    max_points_per_voxel: int = 20
-    max_num_iterations: int = 500
-    convergence_criterion: float = 1e-4
-    max_num_threads: int = 1
-    map_spacing: float = 0.02
-    min_inlier_fraction: float = 0.5
+    voxel_sizes: tuple[float, ...] = (2.0, 1.0, 0.3, 0.1)  #: voxel size per stage, coarse first (m)
+    gate_factor: float = 3.0  #: correspondence gate per stage, in voxels
+    kernel_factor: float = 1.0  #: Geman–McClure kernel per stage, in voxels
+    max_points_per_voxel: int = 20  #: KISS-ICP's points per voxel
+    max_num_iterations: int = 500  #: KISS-ICP's ICP iterations per stage
+    convergence_criterion: float = 1e-4  #: KISS-ICP's stop on the update's norm
+    max_num_threads: int = 1  #: KISS-ICP's threads
+    map_spacing: float = 0.02  #: sampling of the map's geometry (metres)
+    min_inlier_fraction: float = 0.5  #: converged needs this share of scan points near the map
 
 
 def _voxel_map(problem_map: object, voxel: float, max_points: int, spacing: float) -> VoxelHashMap:

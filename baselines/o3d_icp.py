@@ -64,13 +64,13 @@ class Config:
         ">= 1": ("max_iterations",),
         "[0, 1]": ("min_fitness",)}
 
-    gates: tuple[float, ...] = (2.0, 1.0, 0.5, 0.2, 0.1)
-    max_iterations: int = 30
-    relative_fitness: float = 1e-6
-    relative_rmse: float = 1e-6
-    map_spacing: float = 0.05
-    crop_margin: float = 4.0
-    min_fitness: float = 0.5
+    gates: tuple[float, ...] = (2.0, 1.0, 0.5, 0.2, 0.1)  #: correspondence gate per stage (metres)
+    max_iterations: int = 30  #: open3d's iterations per stage
+    relative_fitness: float = 1e-6  #: open3d's stop on the fitness change
+    relative_rmse: float = 1e-6  #: open3d's stop on the RMSE change
+    map_spacing: float = 0.05  #: sampling of the map's geometry (metres)
+    crop_margin: float = 4.0  #: map kept within the laser's range plus this of the guess (metres)
+    min_fitness: float = 0.5  #: converged needs this open3d fitness (0–1)
 
 
 class Open3dIcpMatcher(Configured):

@@ -3,11 +3,32 @@ group (first ``per`` in file order, so "before" and "after" checkouts see the sa
 
 from __future__ import annotations
 
+import argparse
+import os
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER = ("office-pool", "detail-1", "detail-2", "detail-3")
 REAL = ("real-intel-scan-to-map",)
+
+
+def add_sample_args(ap: argparse.ArgumentParser) -> None:
+    """The sample's command-line options (``--per``, ``--per-real``, ``--datasets``)."""
+    ap.add_argument("--per", type=int, default=4)
+    ap.add_argument("--per-real", type=int, default=40)
+    ap.add_argument("--datasets", nargs="+", default=list(PAPER + REAL))
+
+
+def one_core() -> None:
+    """Time on one thread (:func:`tfloc.harness.threads.limit_threads`), pinned to the last core
+    where the system allows it, so that CPU times are comparable."""
+    from tfloc.harness.threads import limit_threads
+
+    limit_threads(1)
+    try:
+        os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[-1]})
+    except OSError:
+        pass
 
 
 def sample(datasets: tuple[str, ...], per: int, per_real: int) -> list[tuple[str, str, object]]:

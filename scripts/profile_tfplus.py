@@ -18,7 +18,7 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(__file__))
-from _sample import PAPER, REAL, sample  # noqa: E402
+from _sample import PAPER, add_sample_args, one_core, sample  # noqa: E402
 
 
 def staged(matcher, problem) -> dict[str, float]:
@@ -64,16 +64,9 @@ def staged(matcher, problem) -> dict[str, float]:
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--per", type=int, default=4)
-    ap.add_argument("--per-real", type=int, default=40)
-    ap.add_argument("--datasets", nargs="+", default=list(PAPER + REAL))
+    add_sample_args(ap)
     a = ap.parse_args()
-    from tfloc.harness.threads import limit_threads
-    limit_threads(1)
-    try:
-        os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[-1]})
-    except OSError:
-        pass
+    one_core()
     import numpy as np
     import pandas as pd
 

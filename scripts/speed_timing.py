@@ -19,25 +19,17 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(__file__))
-from _sample import PAPER, REAL, sample  # noqa: E402
+from _sample import add_sample_args, one_core, sample  # noqa: E402
 
 
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", required=True)
-    ap.add_argument("--per", type=int, default=4)
-    ap.add_argument("--per-real", type=int, default=40)
+    add_sample_args(ap)
     ap.add_argument("--matchers", nargs="+", default=["tf-plus", "tf", "csm-corr", "cv-corners"])
-    ap.add_argument("--datasets", nargs="+", default=list(PAPER + REAL))
     ap.add_argument("--repeat", type=int, default=1, help="timed calls per scan and matcher (min kept)")
     a = ap.parse_args()
-
-    from tfloc.harness.threads import limit_threads
-    limit_threads(1)
-    try:
-        os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[-1]})
-    except OSError:
-        pass
+    one_core()
     import numpy as np
 
     import tfloc

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import pytest
@@ -14,6 +15,16 @@ ROOT = Path(__file__).resolve().parents[1]
 @pytest.fixture(scope="session")
 def test_room() -> tfloc.VectorMap:
     return tfloc.load_map(ROOT / "data" / "maps" / "test-room.geojson")
+
+
+@pytest.fixture
+def office_maps(tmp_path) -> Path:
+    """A fresh data folder holding the bundled office maps (``maps/office-{1,2,3}.geojson``),
+    for the generators whose output is compared with the bundled datasets."""
+    (tmp_path / "maps").mkdir()
+    for lv in (1, 2, 3):
+        shutil.copy(ROOT / "data" / "maps" / f"office-{lv}.geojson", tmp_path / "maps")
+    return tmp_path
 
 
 @pytest.fixture(scope="session")

@@ -24,18 +24,15 @@ ROOT = Path(__file__).resolve().parents[1]
 SCEN = ROOT / "data" / "scenarios"
 
 
-def test_dev_office_sets_regenerate_bit_for_bit(tmp_path) -> None:
-    (tmp_path / "maps").mkdir()
-    for lv in (1, 2, 3):
-        shutil.copy(ROOT / "data" / "maps" / f"office-{lv}.geojson", tmp_path / "maps")
-    dirs = generate_global_offices(tmp_path, n=2, n_dev=DEV_SCANS)
+def test_dev_office_sets_regenerate_bit_for_bit(office_maps) -> None:
+    dirs = generate_global_offices(office_maps, n=2, n_dev=DEV_SCANS)
     for d in dirs:
         if d.name.startswith("global-dev-office"):
             for f in ("scenario.json", "scans.csv"):
                 assert (d / f).read_bytes() == (SCEN / d.name / f).read_bytes(), (d.name, f)
     # the evaluation sets' first scans too (the generator draws scan by scan)
     for lv in (1, 2, 3):
-        mine = (tmp_path / "scenarios" / f"global-office-{lv}" / "scans.csv").read_text().splitlines()
+        mine = (office_maps / "scenarios" / f"global-office-{lv}" / "scans.csv").read_text().splitlines()
         bundled = (SCEN / f"global-office-{lv}" / "scans.csv").read_text().splitlines()
         assert mine[:3] == bundled[:3]
 

@@ -22,8 +22,7 @@ from tfloc.evaluation.kidnap import (
 from tfloc.harness.track import odom_deltas, row
 from tfloc.io.scenario import SEQUENCE, read_scans, read_scenario
 
-ROOT = Path(__file__).resolve().parents[1]
-SCEN = ROOT / "data" / "scenarios"
+SCEN = Path(__file__).resolve().parents[1] / "data" / "scenarios"
 
 
 # -- metrics on hand-made trajectories ---------------------------------------------------------
@@ -99,16 +98,12 @@ def test_kidnapped_sequences_record_their_events(spec) -> None:
     assert sizes <= 5e6
 
 
-def test_kidnapped_sequences_regenerate_bit_for_bit(tmp_path) -> None:
+def test_kidnapped_sequences_regenerate_bit_for_bit(office_maps) -> None:
     """The bundled seq-kidnap-* are the bytes generate_kidnap_sequences writes (tfloc generate)."""
-    (tmp_path / "maps").mkdir()
-    for lv in (1, 2, 3):
-        (tmp_path / "maps" / f"office-{lv}.geojson").write_bytes(
-            (ROOT / "data" / "maps" / f"office-{lv}.geojson").read_bytes())
-    generate_kidnap_sequences(tmp_path)
+    generate_kidnap_sequences(office_maps)
     for ds in KIDNAP_BUNDLE:
         for f in ("scans.csv", "scenario.json"):
-            assert (tmp_path / "scenarios" / ds.name / f).read_bytes() == (SCEN / ds.name / f).read_bytes(), \
+            assert (office_maps / "scenarios" / ds.name / f).read_bytes() == (SCEN / ds.name / f).read_bytes(), \
                 f"{ds.name}/{f}"
 
 

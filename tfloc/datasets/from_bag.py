@@ -8,6 +8,7 @@ from __future__ import annotations
 import shutil
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import yaml
@@ -18,6 +19,9 @@ from tfloc.io.scenario import Scan, write_scenario
 
 from .interpolate import interpolate_poses
 
+if TYPE_CHECKING:
+    from tfloc.io.rosbag import PoseStream
+
 
 @dataclass(frozen=True)
 class BagImport:
@@ -25,43 +29,37 @@ class BagImport:
 
     Attributes:
         bag: a ROS 1 ``.bag`` file, or a ROS 2 bag directory / ``.db3`` / ``.mcap`` file.
-        scan_topic: a ``sensor_msgs/LaserScan`` topic.
         pose_topic: the reference poses (PoseStamped, PoseWithCovarianceStamped, Odometry or tf).
-        out: the dataset directory to write.
         map_file: a map_server YAML (or GeoJSON) copied into the dataset, or
         map_topic: a ``nav_msgs/OccupancyGrid`` topic saved as ``map.yaml`` + ``map.pgm``.
-        name: the dataset's name (default: the name of ``out``).
-        pose_frames: ``(parent, child)`` if ``pose_topic`` is a tf topic.
         initial_topic: take initial poses from this pose topic instead of perturbing;
         initial_frames: its frame pair if it is a tf topic;
         align_initial: the initial topic is in another frame (e.g. odometry): align it to the
             reference at the first imported scan, so its drift is the initial error.
         seed, clearance_m: the perturbation (paper's 3 × 3 offset bins) when no initial topic.
-        every: keep every n-th scan message; limit: at most this many scans (0 = all).
-        max_pose_gap_s: a scan between two poses further apart than this is not covered.
-        laser_offset: the laser's pose in the frame of the reference poses (m, m, rad).
         odom_topic: write a sequence dataset: the robot's odometry (nav_msgs/Odometry, a pose
             topic, or tf with ``odom_frames``, e.g. ``odom base_link``) interpolated to the scan
-            stamps; excludes ``initial_topic`` and the perturbation.
+            stamps; excludes ``initial_topic`` and the perturbation. ``odom_frames``: its frame
+            pair if it is a tf topic.
     """
 
     bag: Path
-    scan_topic: str
+    scan_topic: str  #: a sensor_msgs/LaserScan topic
     pose_topic: str
-    out: Path
+    out: Path  #: the dataset directory to write
     map_file: Path | None = None
     map_topic: str | None = None
-    name: str = ""
-    pose_frames: tuple[str, str] | None = None
+    name: str = ""  #: the dataset's name (default: the name of out)
+    pose_frames: tuple[str, str] | None = None  #: (parent, child) if pose_topic is tf
     initial_topic: str | None = None
     initial_frames: tuple[str, str] | None = None
     align_initial: bool = False
     seed: int | None = None
     clearance_m: float = 0.2
-    every: int = 1
-    limit: int = 0
-    max_pose_gap_s: float = 1.0
-    laser_offset: Pose = field(default_factory=Pose)
+    every: int = 1  #: keep every n-th scan message
+    limit: int = 0  #: at most this many scans (0 = all)
+    max_pose_gap_s: float = 1.0  #: a scan between poses further apart is not covered (s)
+    laser_offset: Pose = field(default_factory=Pose)  #: laser pose, reference frame (m, rad)
     odom_topic: str | None = None
     odom_frames: tuple[str, str] | None = None
 
@@ -124,20 +122,10 @@ def import_bag(cfg: BagImport) -> ImportSummary:
     keep = covered.copy()
     outside_init = 0
     if init is not None:
-        start, init_cov = interpolate_poses(init.stamps, init.poses, t, cfg.max_pose_gap_s)
-        outside_init = int(np.count_nonzero(keep & ~init_cov))
-        keep &= init_cov
-        if not keep.any():
-            raise BagError(f"{cfg.bag}: {cfg.initial_topic} covers none of the scans on {cfg.scan_topic} "
-                           f"that {cfg.pose_topic} covers (poses span {_span(init.stamps)})")
+        start, outside_init, keep = _also_covered(cfg, init, cfg.initial_topic, t, keep)
     outside_odom = 0
     if odom is not None:
-        odom_p, odom_cov = interpolate_poses(odom.stamps, odom.poses, t, cfg.max_pose_gap_s)
-        outside_odom = int(np.count_nonzero(keep & ~odom_cov))
-        keep &= odom_cov
-        if not keep.any():
-            raise BagError(f"{cfg.bag}: {cfg.odom_topic} covers none of the scans on {cfg.scan_topic} "
-                           f"that {cfg.pose_topic} covers (poses span {_span(odom.stamps)})")
+        odom_p, outside_odom, keep = _also_covered(cfg, odom, cfg.odom_topic, t, keep)
         # a sequence's stamps increase strictly: a scan not later than every earlier one is dropped
         late = t > np.maximum.accumulate(np.concatenate([[-np.inf], t[:-1]]))
         outside_odom += int(np.count_nonzero(keep & ~late))
@@ -203,6 +191,19 @@ def import_bag(cfg: BagImport) -> ImportSummary:
                    source=source)
     return ImportSummary(out, int(scans.index.size), int(rows.size), int(np.count_nonzero(~covered)),
                          outside_init, n_empty)
+
+
+def _also_covered(cfg: BagImport, stream: PoseStream, topic: str, t: np.ndarray,
+                  keep: np.ndarray) -> tuple[np.ndarray, int, np.ndarray]:
+    """A second pose stream (initial poses or odometry) at the scan stamps ``t`` (s): its poses
+    ``(len(t), 3)``, how many kept scans it does not cover, and ``keep`` without them."""
+    poses, cov = interpolate_poses(stream.stamps, stream.poses, t, cfg.max_pose_gap_s)
+    outside = int(np.count_nonzero(keep & ~cov))
+    keep = keep & cov
+    if not keep.any():
+        raise BagError(f"{cfg.bag}: {topic} covers none of the scans on {cfg.scan_topic} "
+                       f"that {cfg.pose_topic} covers (poses span {_span(stream.stamps)})")
+    return poses, outside, keep
 
 
 def _write_sequence(cfg: BagImport, scans, pick, rows, t, true_p, odom_p, grid, ref, out: Path,

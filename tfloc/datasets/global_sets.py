@@ -33,15 +33,7 @@ from tfloc.io.maps import load_map
 from tfloc.io.scenario import GLOBAL, Scan, write_scenario
 
 from .noise import NoiseModel
-from .real import (
-    ACES_LASER,
-    ACES_NO_RETURN_M,
-    CSAIL_LASER,
-    INTEL_LASER,
-    NO_RETURN_M,
-    clean_ranges,
-    front_scans,
-)
+from .real import REAL_LOGS, clean_ranges, front_scans
 from .synthetic import sample_free_pose
 
 GLOBAL_SEED = 20261201
@@ -52,11 +44,6 @@ CLEARANCE_M = 0.3
 EVAL, DEV = 0, 1  # the split, part of every dataset's seed
 NOISE = NoiseModel()  # the protocol's: sigma 1 cm
 LMS200 = LaserSpec.lms200()
-
-#: (key, log file under data/real, laser, no-return code) of the real logs.
-REAL_LOGS = (("intel", "intel/intel-corrected.log.gz", INTEL_LASER, NO_RETURN_M),
-             ("csail", "mit-csail/csail-corrected.log.gz", CSAIL_LASER, NO_RETURN_M),
-             ("aces", "aces/aces-corrected.log.gz", ACES_LASER, ACES_NO_RETURN_M))
 
 
 def _rng(seed: int, split: int, index: int) -> np.random.Generator:
@@ -79,8 +66,7 @@ def simulated_scans(m: Map, laser: LaserSpec, noise: NoiseModel, n: int, rng: np
 
 def _generator(seed: int, split: int, index: int, noise: NoiseModel, **extra) -> dict:
     return {"seed": seed, "split": "evaluation" if split == EVAL else "development", "index": index,
-            "clearance_m": CLEARANCE_M, "noise": {"sigma_m": noise.sigma_m, "dropout_prob": noise.dropout_prob,
-                                                  "spurious_prob": noise.spurious_prob}, **extra}
+            "clearance_m": CLEARANCE_M, "noise": noise.record(), **extra}
 
 
 def generate_global_offices(out: str | Path, seed: int = GLOBAL_SEED, n: int = OFFICE_SCANS,

@@ -154,9 +154,7 @@ def generate_kidnap_sequences(out: str | Path, spec: SimSpec | None = None, kid:
                        kidnap_events=sizes,
                        generator={"command": "tfloc generate", "seed": seed,
                                   "child": int(ss.spawn_key[-1]), "kidnapping": kid.to_dict(),
-                                  "noise": {"sigma_m": spec.noise.sigma_m,
-                                            "dropout_prob": spec.noise.dropout_prob,
-                                            "spurious_prob": spec.noise.spurious_prob}})
+                                  "noise": spec.noise.record()})
         dirs.append(root)
         if log:
             log(f"{root}: {item.scans} scans, kidnaps at {events} on {path.name}")

@@ -37,6 +37,12 @@ class NoiseModel:
             if not 0.0 <= p <= 1.0:
                 raise ConfigError(f"noise {name} must be in [0, 1], got {p}")
 
+    def record(self) -> dict[str, float]:
+        """The noise as a dataset's ``generator`` record states it (``sigma_m``, ``dropout_prob``,
+        ``spurious_prob``, in this order: the bundled datasets' bytes depend on it)."""
+        return {"sigma_m": self.sigma_m, "dropout_prob": self.dropout_prob,
+                "spurious_prob": self.spurious_prob}
+
     def apply(self, ranges: np.ndarray, laser: LaserSpec, rng: np.random.Generator) -> np.ndarray:
         """Noisy copy of ``ranges`` (metres, ``inf`` = no return). Always draws the same number of
         random values for a given beam count, so results depend only on the generator state."""

@@ -38,6 +38,11 @@ ACES_LASER = LaserSpec.from_degrees(MAX_RANGE_M, 179.0, 1.0, -90.0)
 #: largest real return is 49.91 m).
 ACES_NO_RETURN_M = 50.0
 
+#: The bundled corrected logs: (key, path under ``data/real``, laser, no-return range in metres)
+REAL_LOGS = (("intel", "intel/intel-corrected.log.gz", INTEL_LASER, NO_RETURN_M),
+             ("csail", "mit-csail/csail-corrected.log.gz", CSAIL_LASER, NO_RETURN_M),
+             ("aces", "aces/aces-corrected.log.gz", ACES_LASER, ACES_NO_RETURN_M))
+
 
 def clean_ranges(ranges: np.ndarray, no_return: float = NO_RETURN_M) -> np.ndarray:
     """The no-return code (ranges ≥ ``no_return`` metres) → ``inf``; metres."""
@@ -84,16 +89,14 @@ def build_all(real: Path, out: Path, seed: int = DEFAULT_SEED, resolution: float
     real, out = Path(real), Path(out)
     made = []
     cfg = Perturbation(seed=seed)
-    aces_note = (
-        "ACES building, UT Austin (440 scans, 180 beams at 1 deg from -90 deg: see "
-        "data/real/aces/SPACING.md; the log caps ranges at 50 m, and 50 m is its no-return code)")
-    for key, log_rel, laser, note, no_return in (
-            ("intel", "intel/intel-corrected.log.gz", INTEL_LASER,
-             "Intel Research Lab (910 scans, 180 beams at 1 deg from -90 deg: see data/real/intel/SPACING.md)",
-             NO_RETURN_M),
-            ("csail", "mit-csail/csail-corrected.log.gz", CSAIL_LASER,
-             "MIT CSAIL corrected log (406 scans, 361 beams at 0.5 deg)", NO_RETURN_M),
-            ("aces", "aces/aces-corrected.log.gz", ACES_LASER, aces_note, ACES_NO_RETURN_M)):
+    notes = {
+        "intel": "Intel Research Lab (910 scans, 180 beams at 1 deg from -90 deg: see "
+                 "data/real/intel/SPACING.md)",
+        "csail": "MIT CSAIL corrected log (406 scans, 361 beams at 0.5 deg)",
+        "aces": "ACES building, UT Austin (440 scans, 180 beams at 1 deg from -90 deg: see "
+                "data/real/aces/SPACING.md; the log caps ranges at 50 m, and 50 m is its no-return code)"}
+    for key, log_rel, laser, no_return in REAL_LOGS:
+        note = notes[key]
         grid, rows = scan_to_map(real / log_rel, laser, resolution, cfg, no_return)
         map_yaml = write_ros_map(grid, out / "maps" / f"real-{key}.yaml")
         root = out / "scenarios" / f"real-{key}-scan-to-map"

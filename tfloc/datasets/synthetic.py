@@ -108,9 +108,7 @@ def generate_bundle(out: str | Path, spec: BundleSpec = BundleSpec(), log=None) 
         write_scenario(root, name, path, spec.laser, scans, description=desc,
                        generator={"seed": spec.seed, "child": int(ss.spawn_key[-1]),
                                   "per_cell": per_cell, "clearance_m": spec.clearance_m,
-                                  "noise": {"sigma_m": spec.noise.sigma_m,
-                                            "dropout_prob": spec.noise.dropout_prob,
-                                            "spurious_prob": spec.noise.spurious_prob}})
+                                  "noise": spec.noise.record()})
         dirs.append(root)
         if log:
             log(f"{root}: {len(scans)} scans on {path.name}")

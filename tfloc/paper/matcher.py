@@ -76,7 +76,7 @@ class TfConfig:
     Attributes:
         spacing, window, straw_t, line_threshold, resampling, close_through_origin: how a scan
             becomes a polygon (Algs. 1–4), :class:`tfloc.paper.shape.ShapeConfig` (the readings
-            of the text, quoted there); :attr:`shape` collects them.
+            of the text, quoted there; a line each below); :attr:`shape` collects them.
         err_norm: Err. ``"l2"`` (default): Eq. 13, "Err = (∫₀¹ |Θ_R(L) − Θ_V(L)|² dL)^½";
             ``"l1"``: Sec. 4.3, "The area between the two graphs is then computed. Rectangles are
             created between two graphs because they are in the form of histograms. Each
@@ -105,13 +105,6 @@ class TfConfig:
             among B, NB and W with minimum error"); of the repetition the text says only "This
             operation is iterated by the algorithm until a suitable fixation between the two
             positions is found", which leaves the answer of the last iteration.
-        err_threshold: Eq. 13's threshold on Err (radians; radians × unit length for ``l1``).
-        xy_tol: simplex size (metres) and outer-iteration move below which the search stops.
-        theta_tol: outer-iteration heading change (radians) below which the search stops.
-        max_iterations: simplex iterations per outer iteration.
-        max_outer: outer iterations (re-simulations).
-        penalty: cost of an invalid candidate pose.
-        seed: seed of the random initial simplex.
     """
 
     RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params)
@@ -120,23 +113,23 @@ class TfConfig:
         ">= 1": ("window", "n_orientations", "max_iterations", "max_outer"),
         "(0, 1]": ("line_threshold",)}
 
-    spacing: float = 1.0
-    window: int = 1
-    straw_t: float = 0.99
-    line_threshold: float = 0.95
-    close_through_origin: bool = True
+    spacing: float = 1.0  #: S of Alg. 1, the resampling distance (metres)
+    window: int = 1  #: w of Alg. 2 (points)
+    straw_t: float = 0.99  #: t of Alg. 2
+    line_threshold: float = 0.95  #: Is-Line threshold of Alg. 3
+    close_through_origin: bool = True  #: close the polygon through the sensor (Alg. 4)
     n_orientations: int = 7
     orientation_step: float = math.radians(1.0)
     simplex_size: float = 1.0
-    err_threshold: float = 0.01
-    xy_tol: float = 0.005
-    theta_tol: float = math.radians(0.05)
-    max_iterations: int = 60
-    max_outer: int = 8
-    penalty: float = 1e3
-    seed: int = 0
+    err_threshold: float = 0.01  #: Eq. 13's threshold on Err (rad; rad × unit length for l1)
+    xy_tol: float = 0.005  #: stop below this simplex size and outer move (metres)
+    theta_tol: float = math.radians(0.05)  #: ... and this outer heading change (radians)
+    max_iterations: int = 60  #: simplex iterations per outer iteration
+    max_outer: int = 8  #: outer iterations (re-simulations)
+    penalty: float = 1e3  #: cost of an invalid candidate pose
+    seed: int = 0  #: seed of the random initial simplex
     err_norm: str = "l2"
-    resampling: str = "chord"
+    resampling: str = "chord"  #: how Alg. 1 steps: "chord" or "path"
     rotation_correction: bool = True
     heading_clamp: float = math.inf
     keep_best: bool = False

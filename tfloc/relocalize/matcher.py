@@ -49,26 +49,16 @@ class TfGlobalConfig:
     """Parameters of ``tf-global`` (metres, radians).
 
     Attributes:
-        places: index places resolved by ``tf-plus`` per scan, at least; ...
-        place_density: ... and at least this many per m² of the map's free area (a map twice
-            the size holds about twice the places that look alike; 0.08/m² gives the 24 places
-            chosen on the development offices, 270–300 m²).
-        place_separation: index entries within this distance ...
-        place_heading_separation: ... and this heading of a better one are the same place.
-        hypotheses: ranked answers returned (``Estimate.hypotheses``; the harness scores 5).
-        hypothesis_separation: hypotheses are at least this far apart ...
-        hypothesis_heading_separation: ... or this far apart in heading.
+        place_density: places resolved per scan: also at least this many per m² of the map's
+            free area (a map twice the size holds about twice the places that look alike;
+            0.08/m² gives the 24 places chosen on the development offices, 270–300 m²).
         resolve: ``"per-place"`` (tf-plus's ``localize`` from each place) or ``"batched"`` (its
             stages, the coarse candidates of all places competing for one refinement of the
             best ``refined``: :mod:`tfloc.relocalize.resolve`).
-        refined: see ``resolve``.
         local: a problem with an initial guess: ``"tf-plus"`` (``tf-plus`` with its own defaults
             from the guess: the local matcher) or ``"global"`` (the guess ignored).
         cache_dir: where the index is stored on disk ("" = ``$TFLOC_INDEX_CACHE`` or
             ``~/.cache/tfloc/index``).
-        disk_cache: store and read the index on disk (else build it once per process).
-        index: the place index (:class:`~tfloc.relocalize.index.IndexConfig`).
-        resolver: tf-plus's parameters when it resolves a place.
     """
 
     RULES: ClassVar[dict] = {
@@ -78,20 +68,20 @@ class TfGlobalConfig:
                  "hypothesis_heading_separation"),
         ("tf-plus", "global"): ("local",)}
 
-    places: int = 24
+    places: int = 24  #: index places resolved per scan, at least (see place_density)
     place_density: float = 0.08
-    place_separation: float = 0.75
-    place_heading_separation: float = math.radians(30.0)
-    hypotheses: int = 5
-    hypothesis_separation: float = 0.3
-    hypothesis_heading_separation: float = math.radians(10.0)
+    place_separation: float = 0.75  #: index entries within this distance (metres) ...
+    place_heading_separation: float = math.radians(30.0)  #: ... and heading (rad): one place
+    hypotheses: int = 5  #: ranked answers returned (Estimate.hypotheses; scored: 5)
+    hypothesis_separation: float = 0.3  #: hypotheses are at least this far apart (metres) ...
+    hypothesis_heading_separation: float = math.radians(10.0)  #: ... or this in heading (rad)
     resolve: str = "batched"
-    refined: int = 16
+    refined: int = 16  #: batched: candidates refined (see resolve)
     local: str = "tf-plus"
     cache_dir: str = ""
-    disk_cache: bool = True
-    index: IndexConfig = IndexConfig()
-    resolver: TfPlusConfig = RESOLVER
+    disk_cache: bool = True  #: store and read the index on disk (else once per process)
+    index: IndexConfig = IndexConfig()  #: the place index
+    resolver: TfPlusConfig = RESOLVER  #: tf-plus's parameters when it resolves a place
 
 
 def distinct(poses: np.ndarray, count: int, separation: float, heading_separation: float) -> list[int]:

@@ -35,20 +35,7 @@ from tfloc.tfplus.headings import edge_histogram
 
 @dataclass(frozen=True)
 class SignatureConfig:
-    """How a scan becomes its place signature (metres, radians).
-
-    Attributes:
-        edge_weight: weight of the edge-direction spectrum block (0 leaves it out).
-        turn_weight: weight of the turning-angle distribution block.
-        range_weight: weight of the range distribution block.
-        direction_bins: bins of the edge-direction histogram over [0, 2π).
-        direction_smoothing: its circular Gaussian smoothing (radians).
-        harmonics: DFT magnitudes kept (1…harmonics).
-        turn_bins: bins of the turning-angle distribution over [−π, π).
-        range_bins: bins of the range distribution over [0, range_cap].
-        range_cap: ranges beyond this (metres) count in the last bin.
-        spacing: the resampling distance of the scan's shape (as ``tf-plus``'s seeds: 5 cm).
-    """
+    """How a scan becomes its place signature (metres, radians; a field's meaning beside it)."""
 
     RULES: ClassVar[dict] = {
         ">= 0": ("edge_weight", "turn_weight", "range_weight", "length_weight", "pair_weight"),
@@ -56,21 +43,21 @@ class SignatureConfig:
                  "pair_bins", "pair_points"),
         "> 0": ("direction_smoothing", "range_cap", "spacing")}
 
-    edge_weight: float = 0.0
-    turn_weight: float = 0.5
-    range_weight: float = 1.0
-    length_weight: float = 0.5
-    pair_weight: float = 1.0
-    direction_bins: int = 72
-    direction_smoothing: float = float(np.radians(3.0))
-    harmonics: int = 12
-    turn_bins: int = 24
-    range_bins: int = 20
-    range_cap: float = 10.0
-    length_bins: int = 16
-    pair_bins: int = 24
-    pair_points: int = 60
-    spacing: float = 0.05
+    edge_weight: float = 0.0  #: weight of the edge-direction spectrum block (0 leaves it out)
+    turn_weight: float = 0.5  #: weight of the turning-angle distribution block
+    range_weight: float = 1.0  #: weight of the range distribution block
+    length_weight: float = 0.5  #: weight of the edge-length distribution block
+    pair_weight: float = 1.0  #: weight of the point-pair distance (D2) block
+    direction_bins: int = 72  #: bins of the edge-direction histogram over [0, 2π)
+    direction_smoothing: float = float(np.radians(3.0))  #: its circular Gaussian smoothing (rad)
+    harmonics: int = 12  #: DFT magnitudes kept (1…harmonics)
+    turn_bins: int = 24  #: bins of the turning-angle distribution over [−π, π)
+    range_bins: int = 20  #: bins of the range distribution over [0, range_cap]
+    range_cap: float = 10.0  #: ranges beyond this (metres) count in the last bin
+    length_bins: int = 16  #: bins of the edge-length distribution (log of the length)
+    pair_bins: int = 24  #: bins of the pair distances over [0, 2·range_cap]
+    pair_points: int = 60  #: scan points the pairs are drawn from, evenly spread
+    spacing: float = 0.05  #: resampling distance of the scan's shape (metres; as tf-plus's seeds)
 
     @property
     def size(self) -> int:

@@ -74,10 +74,6 @@ class TfPlusConfig:
     """Parameters of ``tf-plus`` (metres, radians).
 
     Attributes:
-        tf_seed: add headings seeded by the turning-function rotation estimates.
-        heading_sweep: sweep the headings θ_VP ± ``heading_span``.
-        grid: run the coarse grid search over positions (else only the VP's position).
-        refine: run the point-to-line refinement.
         refine_to: what the refinement fits the scan to: ``"field"``, the map itself (each
             scan point's nearest map point; on a grid map also the walls' surfaces and the
             returns' depth behind them, :func:`tfloc.tfplus.refine.refine_to_field`); ``"virtual"``,
@@ -87,35 +83,17 @@ class TfPlusConfig:
         select: how the final answer is picked among refined candidates: ``"residual"``
             (truncated point-to-line residual to the map's points), ``"virtual"`` (the same to
             the virtual scans) or ``"tf"`` (turning-function Err, Eq. 13).
-        search_radius: radius of the coarse search around the VP.
-        grid_step: lattice spacing of the coarse search.
-        clearance: minimum distance of a lattice position from walls.
-        heading_offsets: headings tried around each seed (radians).
-        rotation_seeds: rotation offsets taken from the turning functions' edge-direction
-            histograms (:mod:`tfloc.tfplus.headings`) ...
-        max_rotation: ... searched within ± this of the VP's heading.
-        heading_span: the heading sweep covers θ_VP ± this ...
-        heading_step: ... at this spacing.
-        field_resolution: cell size of the distance field.
-        field_truncation: truncation of the distance field.
         wall_thickness: on a grid map, walls are followed this far (metres) across to find their
             surfaces (:mod:`tfloc.maps.walls`).
-        scan_stride: every ``scan_stride``-th real point is used by the first coarse level ...
+        scan_stride: every ``scan_stride``-th real point is used by the first coarse level
             (if ``coarse_points`` is 0; else about ``coarse_points`` points, evenly spread,
-            whatever the scanner's beam count)
-        coarse_points: see ``scan_stride``.
+            whatever the scanner's beam count).
         coarse_bound: score the coarse search on the distance field pooled over ± half a
             lattice step (a lower bound over each lattice cell), so that the cell holding the
             true pose is not outscored because its lattice point is a few cm off a wall.
-        shortlist: ... and this many of its best poses are rescored on all points.
-        candidates: candidates refined.
-        separation: minimum distance between candidates.
-        min_returns: fewer valid returns than this is a no-answer.
-        beam_check: count see-through beams in the selection cost (:mod:`tfloc.tfplus.cost`).
         tie_tolerance: candidates whose cost is within this fraction of the best are a tie
             (the scan sees the same geometry from both, e.g. a bare corner), broken by
             distance to the VP (0: no tie-break).
-        refinement: the point-to-line refinement's parameters.
         shape: the scan-shape parameters (ShortStraw, polygon closure) of the turning-function
             seed and of the ``select="tf"`` Err; the resampling distance is 5 cm (the paper's
             S = 1 m gives edges too coarse for their directions to be a heading estimate).
@@ -130,33 +108,34 @@ class TfPlusConfig:
         ("residual", "virtual", "tf"): ("select",),
         ("auto", "field", "virtual"): ("refine_to",)}
 
-    tf_seed: bool = True
-    heading_sweep: bool = True
-    grid: bool = True
-    refine: bool = True
+    tf_seed: bool = True  #: add headings seeded by the turning-function rotation estimates
+    heading_sweep: bool = True  #: sweep the headings θ_VP ± heading_span
+    grid: bool = True  #: coarse grid search over positions (else only the VP's position)
+    refine: bool = True  #: run the point-to-line refinement
     refine_to: str = "auto"
     select: str = "residual"
-    search_radius: float = 3.3
-    grid_step: float = 0.2
-    clearance: float = 0.1
+    search_radius: float = 3.3  #: radius of the coarse search around the VP (metres)
+    grid_step: float = 0.2  #: lattice spacing of the coarse search (metres)
+    clearance: float = 0.1  #: least distance of a lattice position from walls (metres)
+    #: headings tried around each seed (radians)
     heading_offsets: tuple[float, ...] = tuple(math.radians(d) for d in (-1.0, 0.0, 1.0))
-    rotation_seeds: int = 3
-    max_rotation: float = math.radians(20.0)
-    heading_span: float = math.radians(17.0)
-    heading_step: float = math.radians(3.0)
-    field_resolution: float = 0.05
-    field_truncation: float = 0.3
+    rotation_seeds: int = 3  #: rotations from the edge-direction histograms (.headings) ...
+    max_rotation: float = math.radians(20.0)  #: ... within ± this of θ_VP (radians)
+    heading_span: float = math.radians(17.0)  #: the sweep covers θ_VP ± this (radians) ...
+    heading_step: float = math.radians(3.0)  #: ... at this spacing (radians)
+    field_resolution: float = 0.05  #: cell size of the distance field (metres)
+    field_truncation: float = 0.3  #: truncation of the distance field (metres)
     wall_thickness: float = 0.3
     scan_stride: int = 9
-    coarse_points: int = 20
+    coarse_points: int = 20  #: about this many points on the first coarse level (see scan_stride)
     coarse_bound: bool = True
-    shortlist: int = 64
-    candidates: int = 4
-    separation: float = 0.3
-    min_returns: int = 10
+    shortlist: int = 64  #: the first level's best poses rescored on all points
+    candidates: int = 4  #: candidates refined
+    separation: float = 0.3  #: least distance between candidates (metres)
+    min_returns: int = 10  #: fewer valid returns than this is a no-answer
     tie_tolerance: float = 0.1
-    beam_check: bool = True
-    refinement: RefineConfig = RefineConfig()
+    beam_check: bool = True  #: count see-through beams in the selection cost (.cost)
+    refinement: RefineConfig = RefineConfig()  #: the point-to-line refinement's parameters
     shape: ShapeConfig = ShapeConfig(spacing=0.05)
 
 

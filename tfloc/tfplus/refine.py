@@ -70,30 +70,16 @@ class RefineConfig:
     Attributes:
         iterations: outer iterations (each with its gate; against virtual scans, one simulated
             scan per candidate).
-        inner: Gauss–Newton steps per outer iteration, re-associating each time.
         window: beams either side of the bearing searched for the nearest virtual point (only
             against virtual scans).
-        gate_start: pair distance gate of the first iteration (metres).
-        gate_end: pair distance gate of the last iteration (metres).
         inlier_distance: truncation of the residual used to rank candidates (metres). 10 cm:
             on real grid maps the residuals at the true pose spread over a few cm (the map's own
             registration error), and 5 cm (chosen on simulated scans with 1 cm noise) cut
             into them; measured on the development logs, 10 cm gave 2 more successes on Intel
             (of 910) and none fewer on CSAIL or on the simulated protocol subset.
-        damping: Levenberg–Marquardt damping added to the normal equations.
         prune_after: after this many iterations only the ``keep`` candidates with the lowest
             truncated residual go on, duplicates (within 5 cm of a better one) dropped
             (0: never prune).
-        keep: see ``prune_after``.
-        faces: on a grid map, measure points from the walls' surfaces too (phase 2 of
-            :func:`refine_to_field`).
-        offset_prior: prior of the returns' depth behind the surfaces (metres): half a cell,
-            where a one-cell wall's returns lie.
-        offset_weight: weight of that prior, in units of one point.
-        offset_gate: phase 2 starts once the gate is at most this (metres).
-        max_depth: the depth is kept within ``[0, max_depth]`` when it starts (metres).
-        face_weight: weight of the surface residuals in phase 2 ...
-        cell_weight: ... and of the cell residuals.
     """
 
     RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params)
@@ -102,21 +88,21 @@ class RefineConfig:
         ">= 1": ("iterations", "inner", "keep")}
 
     iterations: int = 6
-    inner: int = 2
+    inner: int = 2  #: Gauss–Newton steps per outer iteration, re-associating each time
     window: int = 6
-    gate_start: float = 0.5
-    gate_end: float = 0.05
+    gate_start: float = 0.5  #: pair distance gate of the first iteration (metres)
+    gate_end: float = 0.05  #: pair distance gate of the last iteration (metres)
     inlier_distance: float = 0.1
-    damping: float = 1e-6
+    damping: float = 1e-6  #: Levenberg–Marquardt damping added to the normal equations
     prune_after: int = 3
-    keep: int = 2
-    faces: bool = True
-    offset_prior: float = 0.025
-    offset_weight: float = 1.0
-    offset_gate: float = 0.1
-    max_depth: float = 0.3
-    face_weight: float = 1.0
-    cell_weight: float = 1.0
+    keep: int = 2  #: candidates kept at ``prune_after``
+    faces: bool = True  #: grid maps: points from the walls' surfaces too (phase 2)
+    offset_prior: float = 0.025  #: prior depth of returns behind a surface (m; half a cell)
+    offset_weight: float = 1.0  #: weight of that prior, in units of one point
+    offset_gate: float = 0.1  #: phase 2 starts once the gate is at most this (metres)
+    max_depth: float = 0.3  #: the depth starts within [0, max_depth] (metres)
+    face_weight: float = 1.0  #: weight of the surface residuals in phase 2 ...
+    cell_weight: float = 1.0  #: ... and of the cell residuals
 
 
 def _virtual_geometry(ranges: np.ndarray, laser: LaserSpec) -> tuple[np.ndarray, np.ndarray]:
