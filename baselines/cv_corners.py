@@ -98,14 +98,14 @@ Configuration choices and why:
   the first step is a ``no-answer``: the initial pose is returned with ``converged=False`` and
   ``info["status"] = "no-answer"`` (never an exception). A later step that fails keeps the last
   good estimate. ``info["hypotheses_total"]`` counts the transforms scored in all steps.
-
-``score(problem, pose)`` is its own objective at ``pose``: minus the number of one-to-one corner
-inliers between the real scan and the virtual scan at ``pose`` (identity transform), plus their
-mean distance divided by ``inlier_tol`` (a tie-breaker in [0, 1]).
 * ``virtual_surface`` = ``near-face`` (the ray-cast range). ``run-centre`` ends each beam of the
   virtual scan in the middle of the occupied run it enters on a grid (as karto's base scans, see
   docs/baselines/karto.md); measured in issue 25 (docs/robustness.md): the same success on the
   as-built grids, more on hits-only and thickened maps, at 40–70 % more CPU; not the default.
+
+``score(problem, pose)`` is its own objective at ``pose``: minus the number of one-to-one corner
+inliers between the real scan and the virtual scan at ``pose`` (identity transform), plus their
+mean distance divided by ``inlier_tol`` (a tie-breaker in [0, 1]).
 """
 
 from __future__ import annotations
