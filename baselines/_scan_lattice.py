@@ -20,6 +20,7 @@ import math
 from typing import Any
 
 import numpy as np
+from numba import njit
 
 from tfloc.core.laser import LaserSpec
 from tfloc.maps.cache import cached
@@ -68,33 +69,51 @@ class ScanLattice:
         return np.array([self._ranges[int(i)] for i in idx]).reshape(len(idx), self.laser.n_beams)
 
 
+@njit(cache=True, nogil=True)
+def _run_centres(px: np.ndarray, py: np.ndarray, cos: np.ndarray, sin: np.ndarray, near: np.ndarray,
+                 offs: np.ndarray, occupied: np.ndarray, ox: float, oy: float, res: float) -> np.ndarray:
+    """:func:`run_centre_ranges`'s loop: per pose ``p`` and beam ``b``, the samples
+    ``near + offs[k]`` along the beam, the first occupied one and the run after it."""
+    P, B = near.shape
+    H, W = occupied.shape
+    out = near.copy()
+    for p in range(P):
+        for b in range(B):
+            r = near[p, b]
+            if not np.isfinite(r):
+                continue
+            first, end = -1, offs.size
+            for k in range(offs.size):
+                t = r + offs[k]
+                i = int(np.floor((px[p] + t * cos[p, b] - ox) / res))
+                j = int(np.floor((py[p] + t * sin[p, b] - oy) / res))
+                occ = 0 <= i < W and 0 <= j < H and occupied[j, i]
+                if first < 0:
+                    if occ:
+                        first = k
+                elif not occ:
+                    end = k
+                    break
+            if first >= 0:
+                out[p, b] = r + 0.5 * (offs[first] + offs[end - 1])
+    return out
+
+
 def run_centre_ranges(grid: Any, poses: np.ndarray, laser: LaserSpec, near: np.ndarray,
-                      max_depth: float = 0.5, chunk: int = 16) -> np.ndarray:
+                      max_depth: float = 0.5) -> np.ndarray:
     """Ranges (metres) to the middle of the run of occupied cells each beam enters at its
     ray-cast range ``near`` ``(P, B)``: the beam is sampled every quarter cell from one cell
     before ``near`` to ``max_depth`` beyond it; the run is the contiguous occupied samples from
     the first one. Beams without a return keep ``inf``."""
     res = grid.resolution
     offs = np.arange(-res, max_depth + 0.125 * res, 0.25 * res)
-    idx = np.arange(offs.size)
-    out = np.array(near, dtype=float, copy=True)
-    H, W = grid.shape
-    ox, oy = grid.origin
-    for a in range(0, len(poses), chunk):
-        p, r = poses[a: a + chunk], out[a: a + chunk]
-        ang = p[:, 2:3] + laser.angles[None, :]
-        t = np.where(np.isfinite(r), r, 0.0)[..., None] + offs
-        i = np.floor((p[:, 0, None, None] + t * np.cos(ang)[..., None] - ox) / res).astype(np.int64)
-        j = np.floor((p[:, 1, None, None] + t * np.sin(ang)[..., None] - oy) / res).astype(np.int64)
-        inside = (i >= 0) & (i < W) & (j >= 0) & (j < H)
-        occ = np.zeros(t.shape, dtype=bool)
-        occ[inside] = grid.occupied[j[inside], i[inside]]
-        first = np.argmax(occ, axis=-1)
-        after = ~occ & (idx >= first[..., None])
-        end = np.where(after.any(axis=-1), np.argmax(after, axis=-1), offs.size)
-        centre = r + 0.5 * (offs[first] + offs[end - 1])
-        out[a: a + chunk] = np.where(np.isfinite(r) & occ.any(axis=-1), centre, r)
-    return out
+    poses = np.asarray(poses, dtype=float).reshape(-1, 3)
+    ang = poses[:, 2:3] + laser.angles[None, :]
+    return _run_centres(np.ascontiguousarray(poses[:, 0]), np.ascontiguousarray(poses[:, 1]),
+                        np.ascontiguousarray(np.cos(ang)), np.ascontiguousarray(np.sin(ang)),
+                        np.ascontiguousarray(np.asarray(near, dtype=float).reshape(len(poses), -1)),
+                        offs, np.ascontiguousarray(grid.occupied), float(grid.origin[0]),
+                        float(grid.origin[1]), float(res))
 
 
 def scan_lattice(map_: Any, spacing: float, clearance: float, max_range: float,

@@ -61,3 +61,18 @@ def test_lattice_uses_the_surface_on_grids_only() -> None:
     if len(a.positions):
         i = np.arange(len(a.positions))
         np.testing.assert_array_equal(a.ranges(i), b.ranges(i))
+
+
+def test_cv_corners_virtual_surface_option() -> None:
+    from tfloc.baselines.cv_corners import CvCornersMatcher
+
+    from tfloc.core.laser import LaserSpec
+    from tfloc.core.pose import Pose
+    from tfloc.core.problem import Problem
+
+    g, laser, pose = _wall_grid(5), LaserSpec.from_degrees(10.0, 180.0, 1.0), Pose(1.0, 2.0, 0.0)
+    problem = Problem(g, laser, g.raycast(pose, laser), pose)
+    near = CvCornersMatcher()._virtual(pose, problem)
+    mid = CvCornersMatcher(virtual_surface="run-centre")._virtual(pose, problem)
+    np.testing.assert_array_equal(near, g.raycast(pose, laser))
+    assert mid[90] == pytest.approx(3.025 - 1.0, abs=0.013) and near[90] == pytest.approx(1.925, abs=0.013)
