@@ -12,7 +12,6 @@ Example:
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
@@ -25,12 +24,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from tfloc.errors import ResultsError
     from tfloc.evaluation.metrics import prepare
-    from tfloc.evaluation.outcome import Thresholds
-    from tfloc.io.estimates import read_estimates
+    from tfloc.io.rundir import RunDir
     from tfloc.io.scenario import read_scenario
-    from tfloc.io.text import parse_text
     from tfloc.report.robustness import (
         axes_of,
         paired_changes,
@@ -39,14 +35,11 @@ def run(args: argparse.Namespace) -> int:
         robustness_markdown,
     )
 
-    run_json = args.run / "run.json"
-    if not run_json.is_file() or not (args.run / "estimates.csv").is_file():
-        raise ResultsError(f"{args.run}: no run.json or estimates.csv (run 'tfloc bench' first)")
-    doc = parse_text(run_json, ResultsError, "run.json file", json.loads, ValueError, "JSON")
-    datasets = doc.get("config", {}).get("datasets", []) if isinstance(doc, dict) else []
-    scenarios = [read_scenario(d if isinstance(d, str) else d.get("path", "")) for d in datasets]
+    rd = RunDir(args.run)
+    info = rd.info(required=True)
+    scenarios = [read_scenario(d) for d in info.datasets.values()]
     axes = axes_of((s.name, s.extra) for s in scenarios)
-    prepared = prepare(read_estimates(args.run), Thresholds.from_run(doc))
+    prepared = prepare(rd.results(), info.thresholds)
     cells, changes = robustness_cells(prepared, axes), paired_changes(prepared, axes)
     fig = None if args.no_figures else robustness_figure(cells, args.run / "figures" / "robustness.png")
     out = args.run / "robustness.md"
