@@ -30,11 +30,7 @@ from tfloc.io.scenario import SEQUENCE, Scan, write_scenario
 
 from .motion import OdometryNoise, densify, draw_odometry
 from .real import (
-    ACES_LASER,
-    ACES_NO_RETURN_M,
-    CSAIL_LASER,
-    INTEL_LASER,
-    NO_RETURN_M,
+    REAL_LOGS,
     clean_ranges,
     front_scans,
 )
@@ -43,9 +39,9 @@ from .real import (
 ALPHA = 0.05
 SEQ_SEED = 20091201
 
-LOGS = (("intel", "intel/intel-corrected.log.gz", INTEL_LASER, NO_RETURN_M, "Intel Research Lab"),
-        ("csail", "mit-csail/csail-corrected.log.gz", CSAIL_LASER, NO_RETURN_M, "MIT CSAIL"),
-        ("aces", "aces/aces-corrected.log.gz", ACES_LASER, ACES_NO_RETURN_M, "ACES building, UT Austin"))
+#: each bundled log (:data:`tfloc.datasets.real.REAL_LOGS`) with its title in the descriptions
+TITLES = {"intel": "Intel Research Lab", "csail": "MIT CSAIL", "aces": "ACES building, UT Austin"}
+LOGS = tuple((*log, TITLES[log[0]]) for log in REAL_LOGS)
 
 
 def sequence_scans(log_path: Path, laser, no_return: float, rng: np.random.Generator,

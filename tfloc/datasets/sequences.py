@@ -229,9 +229,7 @@ def generate_sequences(out: str | Path, spec: SimSpec = SimSpec(), log=None) -> 
                        condition=cond.to_dict(), route=item.route, **extra,
                        generator={"command": "tfloc generate", "seed": spec.seed,
                                   "child": int(ss.spawn_key[-1]), **summary,
-                                  "noise": {"sigma_m": spec.noise.sigma_m,
-                                            "dropout_prob": spec.noise.dropout_prob,
-                                            "spurious_prob": spec.noise.spurious_prob}})
+                                  "noise": spec.noise.record()})
         dirs.append(root)
         if log:
             log(f"{root}: {summary['scans']} scans, {summary['distance_m']:.0f} m on {path.name}")

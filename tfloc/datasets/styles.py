@@ -17,15 +17,12 @@ from tfloc.maps import styles as st
 from tfloc.maps.build import scan_counts
 
 from .protocol import DEFAULT_SEED, Perturbation
-from .real import ACES_LASER, ACES_NO_RETURN_M, CSAIL_LASER, INTEL_LASER, NO_RETURN_M, scan_to_map
+from .real import REAL_LOGS, scan_to_map
 
 #: Every SUBSAMPLE-th scan of each log (Intel 228, MIT CSAIL 102, ACES 110 scans per style).
 SUBSAMPLE = 4
 #: The styles, in report order.
 STYLES = ("as-built", "hits-only", "thick-1", "thick-2", "cartographer", "gmapping", "incomplete")
-LOGS = (("intel", "intel/intel-corrected.log.gz", INTEL_LASER, NO_RETURN_M),
-        ("csail", "mit-csail/csail-corrected.log.gz", CSAIL_LASER, NO_RETURN_M),
-        ("aces", "aces/aces-corrected.log.gz", ACES_LASER, ACES_NO_RETURN_M))
 DESCRIPTIONS = {
     "as-built": "tfloc's own grid (hit counting with free-space carving, occupied if > 25 % of the "
                 "beams reaching a cell end there): the map of real-<log>-scan-to-map",
@@ -49,7 +46,7 @@ def build_styles(real: Path, out: Path, seed: int = DEFAULT_SEED, resolution: fl
     real, out = Path(real), Path(out)
     cfg = Perturbation(seed=seed)
     made = []
-    for key, log_rel, laser, no_return in LOGS:
+    for key, log_rel, laser, no_return in REAL_LOGS:
         grid, rows = scan_to_map(real / log_rel, laser, resolution, cfg, no_return)
         R = [r.ranges for r in rows]
         P = [r.true.as_array() for r in rows]

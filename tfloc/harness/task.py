@@ -29,6 +29,7 @@ from tfloc.core.pose import Pose, angdiff
 from tfloc.errors import InvalidProblemError
 from tfloc.evaluation.outcome import AMBIGUOUS, NO_ANSWER, Thresholds, outcome
 from tfloc.evaluation.relocalization import HYPOTHESES_KEY, hypotheses_info
+from tfloc.io.estimates import pose_fields
 from tfloc.io.scenario import Scan
 
 from .workspace import load_dataset, load_matcher, problem_of, status_of, timed_localize, warm
@@ -54,18 +55,12 @@ class Task:
         return (self.dataset_name, self.scan_id, self.label)
 
 
-def _pose_fields(prefix: str, p: Pose | None) -> dict[str, Any]:
-    if p is None:
-        return {f"{prefix}_x": "", f"{prefix}_y": "", f"{prefix}_theta": ""}
-    return {f"{prefix}_x": p.x, f"{prefix}_y": p.y, f"{prefix}_theta": p.theta}
-
-
 def base_row(task: Task, scan: Scan | None) -> dict[str, Any]:
     """The identifying part of a result row (also used for timeout/error rows)."""
     row: dict[str, Any] = {"dataset": task.dataset_name, "scan_id": task.scan_id,
                            "group": scan.group if scan else "", "matcher": task.label}
-    row.update(_pose_fields("true", scan.true if scan else None))
-    row.update(_pose_fields("init", scan.initial if scan else None))
+    row.update(pose_fields("true", scan.true if scan else None))
+    row.update(pose_fields("init", scan.initial if scan else None))
     if scan is not None and scan.true is not None and scan.initial is not None:
         row["init_dist_err_m"] = scan.initial.distance_to(scan.true)
         row["init_orient_err_rad"] = abs(angdiff(scan.initial.theta, scan.true.theta))

@@ -27,8 +27,10 @@ from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
 from tfloc.core.tracker import PREDICTED, DeadReckoning, LocalTracker, as_tracker, is_tracker
 from tfloc.errors import DatasetError, InvalidProblemError
-from tfloc.io.estimates import COLUMNS
+from tfloc.io.estimates import COLUMNS, pose_fields
 from tfloc.io.scenario import SEQUENCE, Scan, Scenario, map_for
+
+from .workspace import warm
 
 #: status of a row whose estimate is the matcher's own answer / the prediction kept
 OK, FAILED = "ok", "failed"
@@ -52,32 +54,13 @@ def odom_deltas(scans: Sequence[Scan]) -> list[Pose]:
     return out
 
 
-def _pose_fields(prefix: str, p: Pose | None) -> dict[str, Any]:
-    if p is None:
-        return {f"{prefix}_x": "", f"{prefix}_y": "", f"{prefix}_theta": ""}
-    return {f"{prefix}_x": p.x, f"{prefix}_y": p.y, f"{prefix}_theta": p.theta}
-
-
-def _warm(matcher, problem: Problem) -> None:
-    """Untimed: ``prepare`` (map-only structures), one ``score`` and one ``localize`` (numba
-    kernels compiled or loaded), as the runner's warm-up does before a run."""
-    try:
-        prepare = getattr(matcher, "prepare", None)
-        if prepare is not None:
-            prepare(problem)
-        matcher.score(problem, problem.initial)
-        matcher.localize(problem)
-    except Exception:  # noqa: BLE001 - the timed steps report what is wrong
-        pass
-
-
 def row(dataset: str, label: str, scan: Scan, pred: Pose, est: Pose, status: str, cpu_s: float,
         wall_s: float, estimate: Estimate | None = None, info: dict | None = None) -> dict[str, Any]:
     """One result row of the loop (columns of :data:`tfloc.io.estimates.COLUMNS`)."""
     out = {c: "" for c in COLUMNS}
     out.update(dataset=dataset, scan_id=scan.scan_id, group=scan.group, matcher=label,
-               **_pose_fields("true", scan.true), **_pose_fields("init", pred),
-               **_pose_fields("est", est), runtime_s=wall_s, cpu_s=cpu_s, status=status)
+               **pose_fields("true", scan.true), **pose_fields("init", pred),
+               **pose_fields("est", est), runtime_s=wall_s, cpu_s=cpu_s, status=status)
     if estimate is not None:
         out.update(converged=int(bool(estimate.converged)), iterations=estimate.iterations,
                    evaluations=estimate.evaluations)
@@ -100,9 +83,11 @@ def track(scenario: Scenario, scans: Sequence[Scan], matcher, *, label: str | No
     start = scans[0].initial
     if not is_tracker(matcher):
         where = f"{scenario.scans_path}:{scans[0].line}"
-        try:
-            _warm(matcher, Problem(the_map, laser, scans[0].ranges, start, where=where))
-        except InvalidProblemError:
+        try:  # untimed: map-only structures and numba kernels, as the runner's warm-up
+            problem = Problem(the_map, laser, scans[0].ranges, start, where=where)
+            warm(matcher, problem)
+            matcher.localize(problem)
+        except Exception:  # noqa: BLE001 - the timed steps report what is wrong
             pass
     tracker = as_tracker(matcher)
     tracker.start(the_map, laser, start)
@@ -149,7 +134,9 @@ def run_sequence(dataset: str, label: str, matcher: str, params_json: str = "{}"
     sequence tracked; the rows carry ``label`` as their matcher. Dataset errors raise
     :class:`DatasetError`; a matcher that raises on a scan is that scan's ``error:`` row, the
     run goes on."""
-    from .workspace import load_dataset, load_matcher
+    from .workspace import load_dataset, load_matcher, map_of
 
     scenario, by_id = load_dataset(dataset)
-    return track(scenario, list(by_id.values()), load_matcher(matcher, params_json), label=label)
+    scans = list(by_id.values())
+    return track(scenario, scans, load_matcher(matcher, params_json), label=label,
+                 map=map_of(scenario, scans[0]) if scans else None)

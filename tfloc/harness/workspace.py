@@ -47,11 +47,17 @@ def use_map(scenario: Scenario, map_) -> None:
     _MAPS[scenario.map_path] = map_
 
 
+def map_of(scenario: Scenario, scan: Scan):
+    """The map ``scan`` is localized in: the dataset's map, loaded once per process, or the
+    scan's reference scan (:func:`tfloc.io.scenario.map_for`)."""
+    return map_for(scenario, scan, _MAPS)
+
+
 def problem_of(scenario: Scenario, scan: Scan, initial=...) -> Problem:
     """The :class:`Problem` of one scan: the dataset's map (loaded once per process) or the
     scan's reference scan; ``initial`` overrides the scan's guess (a tracker's prediction)."""
     guess = scan.initial if initial is ... else initial
-    return Problem(map_for(scenario, scan, _MAPS), scenario.laser, scan.ranges, guess,
+    return Problem(map_of(scenario, scan), scenario.laser, scan.ranges, guess,
                    where=f"{scenario.scans_path}:{scan.line}")
 
 

@@ -37,6 +37,14 @@ TEXT = ("dataset", "scan_id", "group", "matcher", "status", "outcome", "info")
 STATUS_KINDS = ("ok", "failed", "invalid", "timeout", "error")
 
 
+def pose_fields(prefix: str, pose) -> dict[str, Any]:
+    """A pose (:class:`~tfloc.core.pose.Pose` or None) as the row's ``<prefix>_x/y/theta``
+    columns (empty when None)."""
+    if pose is None:
+        return {f"{prefix}_x": "", f"{prefix}_y": "", f"{prefix}_theta": ""}
+    return {f"{prefix}_x": pose.x, f"{prefix}_y": pose.y, f"{prefix}_theta": pose.theta}
+
+
 def status_kind(status: str) -> str | None:
     """``ok``, ``failed``, ``invalid``, ``timeout`` or ``error`` (``invalid:…``/``error:…`` carry a
     message); ``None`` for anything else."""
