@@ -76,12 +76,18 @@ class LocalTracker:
             raise RuntimeError("LocalTracker.step before start")
         return self.pose.compose(odom_delta)
 
-    def step(self, ranges: np.ndarray, odom_delta: Pose, stamp: float, where: str = "scan") -> Estimate:
-        guess = self.predict(odom_delta)
-        est = self.matcher.localize(Problem(self._map, self._laser, ranges, guess, where=where))
+    def answer(self, ranges: np.ndarray, guess: Pose, where: str = "scan") -> tuple[Problem, Estimate]:
+        """The matcher's answer to the scan from ``guess`` (the prediction, kept when it
+        declines), and the problem it answered."""
+        problem = Problem(self._map, self._laser, ranges, guess, where=where)
+        est = self.matcher.localize(problem)
         if est.info.get("status") == "no-answer" or not est.pose.is_finite():
             est = Estimate(guess, False, est.iterations, est.evaluations,
                            {**est.info, "status": PREDICTED})
+        return problem, est
+
+    def step(self, ranges: np.ndarray, odom_delta: Pose, stamp: float, where: str = "scan") -> Estimate:
+        _, est = self.answer(ranges, self.predict(odom_delta), where)
         self.pose = est.pose
         return est
 

@@ -20,7 +20,7 @@ from tfloc.core.map import Map
 from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
-from tfloc.core.tracker import PREDICTED
+from tfloc.core.tracker import LocalTracker
 from tfloc.tfplus.matcher import TfPlusConfig, TurningFunctionPlusMatcher
 
 from .matcher import TfGlobalConfig, TurningFunctionGlobalMatcher
@@ -45,19 +45,23 @@ class RecoveryConfig:
     accept_score: float = 0.05
 
 
-class RecoveringTracker:
-    """A local matcher as a tracker, with a global matcher for when it is lost (see the module
-    notes). ``info`` of each step: ``score`` (the answer's), ``lost`` (the tracker counted itself
-    lost at this scan), ``relocalized`` (the global answer was taken)."""
+class RecoveringTracker(LocalTracker):
+    """A local matcher as a tracker (:class:`~tfloc.core.tracker.LocalTracker`), with a global
+    matcher for when it is lost (see the module notes). ``info`` of each step: ``score`` (the
+    answer's), ``lost`` (the tracker counted itself lost at this scan), ``relocalized`` (the
+    global answer was taken)."""
 
     def __init__(self, local, global_, config: RecoveryConfig | None = None, **overrides) -> None:
-        self.local, self.global_ = local, global_
+        super().__init__(local)
+        self.global_ = global_
         self.config = resolve_params(RecoveryConfig, config, overrides)
         self.name = f"{getattr(local, 'name', 'local')}+{getattr(global_, 'name', 'global')}"
-        self._map: Map | None = None
-        self._laser: LaserSpec | None = None
-        self.pose: Pose | None = None
         self.bad = 0
+
+    @property
+    def local(self):
+        """The local matcher (tracking from the prediction)."""
+        return self.matcher
 
     def prepare(self, problem: Problem) -> None:
         """Map-only work of both matchers (``tf-global``'s place index), untimed: call it before
@@ -68,17 +72,12 @@ class RecoveringTracker:
                 prepare(problem)
 
     def start(self, map: Map, laser: LaserSpec, pose: Pose) -> None:
-        self._map, self._laser, self.pose, self.bad = map, laser, pose, 0
+        super().start(map, laser, pose)
+        self.bad = 0
 
     def step(self, ranges, odom_delta: Pose, stamp: float, where: str = "scan") -> Estimate:
-        if self.pose is None:
-            raise RuntimeError("RecoveringTracker.step before start")
         cfg = self.config
-        guess = self.pose.compose(odom_delta)
-        problem = Problem(self._map, self._laser, ranges, guess, where=where)
-        est = self.local.localize(problem)
-        if est.info.get("status") == "no-answer" or not est.pose.is_finite():
-            est = Estimate(guess, False, est.iterations, est.evaluations, {**est.info, "status": PREDICTED})
+        problem, est = self.answer(ranges, self.predict(odom_delta), where)
         score = float(self.local.score(problem, est.pose))
         self.bad = self.bad + 1 if not score <= cfg.lost_score else 0
         lost = self.bad >= cfg.lost_after
@@ -138,6 +137,3 @@ class TfPlusRecoverTracker(RecoveringTracker):
         self.local.score(warm, pose)
         self.local.localize(warm)
 
-    def reset(self, pose: Pose) -> None:
-        """Put the estimate at ``pose`` (the loop's prediction after a step raised)."""
-        self.pose = pose
