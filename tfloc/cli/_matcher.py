@@ -12,16 +12,25 @@ from tfloc.harness.workspace import load_matcher
 
 
 def parse_params(items: list[str]) -> dict:
-    """``KEY=VALUE`` options as a dict; VALUE is read as TOML (a bare word is a string)."""
-    out = {}
+    """``KEY=VALUE`` options as a dict; VALUE is read as TOML (a bare word is a string); a dotted
+    KEY sets a field of a nested configuration (``index.step=0.5`` → ``{"index": {"step": 0.5}}``)."""
+    out: dict = {}
     for item in items:
-        key, eq, value = item.partition("=")
-        if not eq or not key.strip():
+        key, eq, text = item.partition("=")
+        key = key.strip()
+        if not eq or not key:
             raise ConfigError(f"--param {item!r}: expected KEY=VALUE")
         try:
-            out[key.strip()] = tomllib.loads(f"v = {value}")["v"]
+            value = tomllib.loads(f"v = {text}")["v"]
         except tomllib.TOMLDecodeError:
-            out[key.strip()] = value
+            value = text
+        *heads, last = key.split(".")
+        node = out
+        for h in heads:
+            node = node.setdefault(h, {})
+            if not isinstance(node, dict):
+                raise ConfigError(f"--param {key}: {h} is given both as a value and as a table")
+        node[last] = value
     return out
 
 
@@ -31,6 +40,8 @@ def matcher_from_args(name: str, param_items: list[str], command: str):
     if ":" in name:
         raise ConfigError(f"--matcher {name}: {command} runs registered matchers only")
     params = parse_params(param_items)
-    spec = MatcherSpec.make(name, params, where=f"--matcher {name}", keys={k: f"--param {k}" for k in params})
+    given = [item.partition("=")[0].strip() for item in param_items]
+    keys = {**{k.split(".")[0]: f"--param {k}" for k in given}, **{k: f"--param {k}" for k in given}}
+    spec = MatcherSpec.make(name, params, where=f"--matcher {name}", keys=keys)
     build_matcher(spec)
     return load_matcher(spec.name, spec.params_json)

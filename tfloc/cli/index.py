@@ -37,25 +37,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="a matcher parameter, VALUE in TOML syntax (repeatable)")
 
 
-def nested(params: dict) -> dict:
-    """``{"index.step": v}`` → ``{"index": {"step": v}}`` (a nested parameter on the command line)."""
-    out: dict = {}
-    for key, value in params.items():
-        *heads, last = key.split(".")
-        node = out
-        for h in heads:
-            node = node.setdefault(h, {})
-            if not isinstance(node, dict):
-                raise ConfigError(f"--param {key}: {h} is given both as a value and as a table")
-        node[last] = value
-    return out
-
-
 def run(args: argparse.Namespace) -> int:
     limit_threads(1)
-    params = nested(parse_params(args.param))
-    try:
-        matcher = get_matcher(args.matcher, **params)
+    try:  # a fresh matcher (not the workspace's cached one), so a second call loads from disk
+        matcher = get_matcher(args.matcher, **parse_params(args.param))
     except ParameterError as exc:
         key = f"--param {exc.names[0]}" if exc.names else f"--matcher {args.matcher}"
         raise ConfigError(f"{key}: {exc}") from None
@@ -65,6 +50,8 @@ def run(args: argparse.Namespace) -> int:
     scan = next(iter_scans(scenario), None)
     if scan is None:
         raise DatasetError(f"{scenario.scans_path}: no scans")
+    # the map loaded afresh (not the workspace's per-process copy): the index is then loaded from
+    # disk, not found in memory, and the command says so
     problem = Problem(map_for(scenario, scan, {}), scenario.laser, scan.ranges, None,
                       where=f"{scenario.scans_path}:{scan.line}")
     c0 = time.process_time()

@@ -67,10 +67,11 @@ class MatcherSpec:
                    json.dumps(keys or {}, sort_keys=True))
 
     def key_of(self, param: str) -> str:
-        """The configuration key that set ``param`` (``a.b`` and ``a[1]`` were set by ``a``; else
-        the entry that made this spec)."""
+        """The configuration key that set ``param`` (``a.b`` itself if a key names it, else ``a``,
+        which also set ``a[1]``; else the entry that made this spec)."""
+        keys = json.loads(self.keys_json)
         top = param.split(".")[0].split("[")[0]
-        return json.loads(self.keys_json).get(top) or self.where or f"matcher {self.label}"
+        return keys.get(param) or keys.get(top) or self.where or f"matcher {self.label}"
 
 
 @dataclass(frozen=True)
