@@ -27,7 +27,7 @@ from tfloc.evaluation.summary import (
     summary_table,
     write_summary,
 )
-from tfloc.harness.workspace import load_dataset
+from tfloc.harness.workspace import load_dataset, map_of
 from tfloc.io.estimates import status_kind
 from tfloc.io.rundir import RunDir, RunInfo
 from tfloc.io.scenario import GLOBAL, SCAN_TO_SCAN, SEQUENCE
@@ -279,15 +279,23 @@ def line_figure_matchers(p: pd.DataFrame, order: list[str], most: int = 8) -> li
     return [order[0], *best]
 
 
+def _maps(info: RunInfo, names: set[str]) -> dict:
+    """The maps of the run's datasets ``names``, from the workspace (read once per process)."""
+    out = {}
+    for n, d in info.datasets.items():
+        scenario, scans = load_dataset(str(d)) if n in names else (None, {})
+        if scans:
+            out[n] = map_of(scenario, next(iter(scans.values())))
+    return out
+
+
 def _tracking(run_dir: Path, df: pd.DataFrame, info: RunInfo, thr: Thresholds, with_figures: bool) -> str:
     """The tracking section of a run's sequence datasets (:mod:`tfloc.report.tracking`); their
     scores per (sequence, matcher) go to ``tracking.csv``."""
-    from tfloc.io.maps import load_map
-
     from .tracking import sequence_scores, tracking_section
 
     scenarios = {n: load_dataset(str(d))[0] for n, d in info.datasets.items() if n in set(df["dataset"])}
-    maps = {n: load_map(sc.map_path) for n, sc in scenarios.items()} if with_figures else {}
+    maps = _maps(info, set(df["dataset"])) if with_figures else {}
     sequence_scores(df, scenarios, thr).drop(columns="cpu_ms_all").to_csv(
         run_dir / "tracking.csv", index=False, float_format="%.6g")
     return tracking_section(df, scenarios, maps, run_dir, thr, figures=with_figures)
@@ -295,12 +303,9 @@ def _tracking(run_dir: Path, df: pd.DataFrame, info: RunInfo, thr: Thresholds, w
 
 def _relocalization(run_dir: Path, df: pd.DataFrame, info: RunInfo, thr: Thresholds) -> str:
     """The global section of a run's global datasets (:mod:`tfloc.report.relocalization`)."""
-    from tfloc.io.maps import load_map
-
     from .relocalization import relocalization_section
 
-    maps = {n: load_map(load_dataset(str(d))[0].map_path) for n, d in info.datasets.items()
-            if n in set(df["dataset"])}
+    maps = _maps(info, set(df["dataset"]))
     return relocalization_section(df, maps, run_dir, thr)
 
 
