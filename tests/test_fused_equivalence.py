@@ -173,9 +173,24 @@ def test_pairs_kernel_equals_the_reference(test_room, lms200) -> None:
             assert a.tobytes() == b.tobytes()
 
 
-def test_rotation_candidates_equal_the_step_by_step_histograms(test_room, lms200) -> None:
+def _fft_rotations(real, virtual, skip: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The histograms' correlation by FFTs, step by step: the window's shifts, its values and the
+    order of its local maxima (highest first)."""
+    from tfloc.tfplus.headings import edge_histogram
+
+    hr = edge_histogram(real, 720, math.radians(1.0), skip)
+    hv = edge_histogram(virtual, 720, math.radians(1.0), skip)
+    corr = np.real(np.fft.ifft(np.fft.fft(hr) * np.conj(np.fft.fft(hv))))
+    k = int(np.floor(math.radians(20) / (2 * np.pi / 720)))
+    c = corr[np.arange(-k, k + 1) % 720]
+    peak = (c >= np.roll(c, 1)) & (c >= np.roll(c, -1))
+    peak[0] = peak[-1] = False
+    order = np.argsort(-np.where(peak, c, -np.inf))
+    return np.arange(-k, k + 1), c, order[peak[order]]
+
+
+def _rotation_cases(test_room, lms200):
     from tfloc.paper.shape import ShapeConfig, scan_turning_function
-    from tfloc.tfplus.headings import edge_histogram, rotation_candidates
 
     shape = ShapeConfig(spacing=0.05)
     rng = np.random.default_rng(4)
@@ -183,20 +198,114 @@ def test_rotation_candidates_equal_the_step_by_step_histograms(test_room, lms200
     for pose in _poses(rng, 12):
         virtual = scan_turning_function(test_room.raycast(pose, lms200), lms200, shape)
         for skip in (True, False):
-            hr = edge_histogram(real, 720, math.radians(1.0), skip)
-            hv = edge_histogram(virtual, 720, math.radians(1.0), skip)
-            corr = np.real(np.fft.ifft(np.fft.fft(hr) * np.conj(np.fft.fft(hv))))
-            k = int(np.floor(math.radians(20) / (2 * np.pi / 720)))
-            c = corr[np.arange(-k, k + 1) % 720]
-            peak = (c >= np.roll(c, 1)) & (c >= np.roll(c, -1))
-            peak[0] = peak[-1] = False
-            order = np.argsort(-np.where(peak, c, -np.inf))[:3]
-            order = order[peak[order]]
-            if len(order) == 0:
-                order = np.array([int(np.argmax(c))])
-            expect = np.arange(-k, k + 1)[order] * (2 * np.pi / 720)
-            got = rotation_candidates(real, virtual, math.radians(20), 3, skip_closure=skip)
-            assert got.tobytes() == expect.tobytes()
+            yield real, virtual, skip
+    # a bare box: its walls' directions correlate in one peak within ±20°
+    from shapely.geometry import box
+
+    from tfloc.maps.vector import VectorMap
+
+    room = VectorMap(outline=box(0, 0, 6, 4))
+    for d_theta in (0.0, 0.05, -0.12):
+        real = scan_turning_function(noisy_scan(room, lms200, Pose(2.5, 1.5, 0.3)), lms200, shape)
+        virtual = scan_turning_function(room.raycast(Pose(2.6, 1.4, 0.3 + d_theta), lms200),
+                                        lms200, shape)
+        yield real, virtual, True
+
+
+def test_fft_rotation_candidates_equal_the_step_by_step_histograms(test_room, lms200) -> None:
+    from tfloc.tfplus.headings import rotation_candidates_fft
+
+    for real, virtual, skip in _rotation_cases(test_room, lms200):
+        shifts, c, order = _fft_rotations(real, virtual, skip)
+        order = order[:3] if len(order) else np.array([int(np.argmax(c))])
+        expect = shifts[order] * (2 * np.pi / 720)
+        got = rotation_candidates_fft(real, virtual, math.radians(20), 3, skip_closure=skip)
+        assert got.tobytes() == expect.tobytes()
+
+
+def test_rotation_candidates_are_the_fft_peaks_above_rounding_noise(test_room, lms200) -> None:
+    """The direct correlation gives the FFT's real peaks, in its order, and drops the local
+    maxima of its rounding noise; the values agree to rounding."""
+    from tfloc.tfplus.headings import (
+        _NOISE,
+        _correlation,
+        _pair_kernel,
+        _raw_histograms,
+        rotation_candidates,
+    )
+
+    fewer = 0
+    for real, virtual, skip in _rotation_cases(test_room, lms200):
+        shifts, c, order = _fft_rotations(real, virtual, skip)
+        raw = _raw_histograms(real.breaks, real.angles, virtual.breaks, virtual.angles, 720, skip)
+        direct = _correlation(raw, _pair_kernel(720, math.radians(1.0)), len(shifts) // 2)
+        np.testing.assert_allclose(direct, c, rtol=0, atol=1e-12 * np.abs(c).max())
+        real_peaks = order[c[order] > _NOISE * c.max()][:3]
+        expect = shifts[real_peaks if len(real_peaks) else [int(np.argmax(c))]] * (2 * np.pi / 720)
+        got = rotation_candidates(real, virtual, math.radians(20), 3, skip_closure=skip)
+        assert got.tobytes() == expect.tobytes()
+        fewer += len(real_peaks) < min(3, len(order))
+    assert fewer > 0          # the noise rule was exercised
+
+
+def test_smallest_kernel_orders_by_score_then_index() -> None:
+    from tfloc.tfplus.kernels import smallest_kernel
+
+    rng = np.random.default_rng(8)
+    for n in (0, 1, 7, 64, 65, 500, 3000):
+        for _ in range(5):
+            scores = rng.integers(0, 25, n) / 7.0          # many ties
+            got = smallest_kernel(scores, 64)
+            assert np.array_equal(got, np.lexsort((np.arange(n), scores))[:64])
+
+
+def test_coarse_search_shortlists_the_lowest_first_level_scores(test_room, lms200) -> None:
+    from tfloc.tfplus.coarse import grid_scores, lattice, pose_scores, search
+    from tfloc.tfplus.view import map_view
+
+    field = map_view(test_room, 0.05, 0.3, 0.3)
+    pooled = map_view(test_room, 0.05, 0.3, 0.3, 0.1)
+    points = lms200.to_points(noisy_scan(test_room, lms200, TRUE))
+    positions = lattice(test_room, field, np.array([TRUE.x + 0.4, TRUE.y - 0.3]), 2.0, 0.2, 0.1)
+    headings = TRUE.theta + np.radians(np.arange(-9, 10, 3.0))
+    poses, scores = search(pooled, points, positions, headings, 9, 64)
+    first = grid_scores(pooled, points[::9], positions, headings).ravel()
+    top = np.lexsort((np.arange(first.size), first))[:64]
+    expect = np.column_stack((positions[top // len(headings)], headings[top % len(headings)]))
+    assert poses.tobytes() == expect.tobytes()
+    assert scores.tobytes() == pose_scores(pooled, points, expect).tobytes()
+
+
+def test_pairwise_sum_is_numpys_mean() -> None:
+    from tfloc.tfplus.refine import truncated_cost
+    from tfloc.tfplus.virtual_kernel import _pairwise_sum, truncated_cost_kernel
+
+    rng = np.random.default_rng(9)
+    for n in [*range(1, 140), 181, 255, 256, 361, 721, 1081, 4000]:
+        x = rng.random(n) ** 3
+        assert _pairwise_sum(x, 0, n) / n == np.vstack((x, x)).mean(axis=1)[0]
+    r = rng.normal(0, 0.1, (4, 361))
+    r[:, ::13] = np.nan
+    assert truncated_cost_kernel(r, 0.1).tobytes() == truncated_cost(np.abs(r), 0.1).tobytes()
+
+
+@pytest.mark.parametrize("grid", [False, True])
+def test_compiled_selection_cost_equals_the_numpy_steps(grid: bool, test_room, lms200) -> None:
+    from tfloc.maps.build import rasterize
+    from tfloc.tfplus.cost import scan_cost, scan_cost_steps
+    from tfloc.tfplus.view import map_view
+
+    m = rasterize(test_room, 0.05) if grid else test_room
+    field = map_view(m, 0.05, 0.3, 0.3)
+    rng = np.random.default_rng(10)
+    for seed in range(4):
+        ranges = noisy_scan(test_room, lms200, TRUE, seed)
+        ranges[::17] = np.inf                     # no returns
+        ranges[5:9] += 0.5                        # seen through a wall
+        poses = np.vstack((TRUE.as_array(), _poses(rng, 3)))
+        got = scan_cost(m, lms200, ranges, poses, 6, 0.1, True, field)
+        ref = scan_cost_steps(m, lms200, ranges, poses, 6, 0.1, True, field)
+        assert got.tobytes() == ref.tobytes()
 
 
 def test_tf_plus_turning_function_equals_the_step_by_step_one(test_room, lms200) -> None:

@@ -20,7 +20,13 @@ from tfloc.core.map import Map
 from tfloc.maps.inside import SURE
 from tfloc.maps.vector import VectorMap
 
-from .kernels import grid_scores_kernel, lattice_kernel, pose_scores_kernel, separated_kernel
+from .kernels import (
+    grid_scores_kernel,
+    lattice_kernel,
+    pose_scores_kernel,
+    separated_kernel,
+    smallest_kernel,
+)
 from .view import MapView
 
 
@@ -80,12 +86,16 @@ def pose_scores(field: MapView, points: np.ndarray, poses: np.ndarray) -> np.nda
 def search(field: MapView, points: np.ndarray, positions: np.ndarray, headings: np.ndarray,
            stride: int, shortlist: int) -> tuple[np.ndarray, np.ndarray]:
     """Two-level grid search: every position × heading on every ``stride``-th point, then the best
-    ``shortlist`` of them on all points. Returns those poses ``(S, 3)`` and their scores ``(S,)``."""
-    coarse = grid_scores(field, points[::stride], positions, headings).ravel()
-    if shortlist < coarse.size:
-        top = np.argpartition(coarse, shortlist)[:shortlist]
-    else:
-        top = np.arange(coarse.size)
+    ``shortlist`` of them on all points. Returns those poses ``(S, 3)`` and their scores ``(S,)``.
+
+    The shortlist is ordered by the first level's score, ties for a place by lower index
+    (position-major; :func:`~tfloc.tfplus.kernels.smallest_kernel`). Until issue 26 it was
+    ``np.argpartition``'s, which leaves ties to its selection algorithm: the first level's
+    scores are means of a few float32 distances of ~20 distinct values, and the last place
+    was tied in about one scan in five, so a rule of its own makes the answer independent of
+    numpy's internals."""
+    top = smallest_kernel(grid_scores(field, points[::stride], positions, headings).ravel(),
+                          shortlist)
     poses = np.column_stack((positions[top // len(headings)], headings[top % len(headings)]))
     return poses, pose_scores(field, points, poses)
 

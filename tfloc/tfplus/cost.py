@@ -34,8 +34,9 @@ import numpy as np
 from tfloc.core.laser import LaserSpec
 from tfloc.core.map import Map
 from tfloc.maps.grid import GridMap
+from tfloc.maps.vector import VectorMap
 
-from .kernels import see_through_kernel
+from .kernels import residual_pen_kernel, see_through_kernel, vector_see_through_kernel
 from .refine import field_pairs, residuals_to
 from .view import MapView
 
@@ -45,7 +46,35 @@ def scan_cost(map_: Map, laser: LaserSpec, ranges: np.ndarray, poses: np.ndarray
               field: MapView | None = None) -> np.ndarray:
     """Cost ``(K,)`` (metres²) of the real scan ``ranges`` at each of ``(K, 3)`` poses. The
     point-to-line term is to the map's nearest points (``field``, see :mod:`tfloc.tfplus.refine`), or,
-    without a field, to the virtual scans (ray-cast)."""
+    without a field, to the virtual scans (ray-cast). On vector and grid maps with a field, the
+    per-beam terms come from compiled kernels (:func:`_per_beam`); :func:`scan_cost_steps` is the
+    same cost in numpy steps (the reference of the tests) and serves every other case."""
+    poses = np.reshape(poses, (-1, 3))
+    if field is not None and isinstance(map_, VectorMap | GridMap):
+        return _per_beam(map_, laser, ranges, poses, inlier_distance, beam_check, field).mean(axis=1)
+    return scan_cost_steps(map_, laser, ranges, poses, window, inlier_distance, beam_check, field)
+
+
+def _per_beam(map_: VectorMap | GridMap, laser: LaserSpec, ranges: np.ndarray, poses: np.ndarray,
+              c: float, beam_check: bool, field: MapView) -> np.ndarray:
+    """:func:`scan_cost_steps`'s per-beam terms ``(K, n_beams)`` (metres²), compiled: the same
+    values element by element."""
+    poses = np.ascontiguousarray(poses, dtype=float)
+    ranges = np.ascontiguousarray(ranges, dtype=float)
+    pen = residual_pen_kernel(field.nearest, float(field.origin[0]), float(field.origin[1]),
+                              field.resolution, field.points, field.normals, ranges,
+                              laser.directions, float(laser.max_range), poses, c)
+    if beam_check and isinstance(map_, GridMap):
+        pen[see_through(map_, laser, ranges, poses, c)] = c * c
+    elif beam_check:
+        vector_see_through_kernel(pen, ranges, map_.raycast(poses, laser), float(laser.max_range), c)
+    return pen
+
+
+def scan_cost_steps(map_: Map, laser: LaserSpec, ranges: np.ndarray, poses: np.ndarray,
+                    window: int, inlier_distance: float, beam_check: bool = True,
+                    field: MapView | None = None) -> np.ndarray:
+    """:func:`scan_cost` in numpy steps, for any map."""
     c = inlier_distance
     poses = np.reshape(poses, (-1, 3))
     real_ok = laser.valid(ranges)

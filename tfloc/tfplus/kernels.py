@@ -61,6 +61,50 @@ def grid_scores_kernel(table: np.ndarray, origin_x: float, origin_y: float, reso
 
 
 @njit(cache=True, nogil=True)
+def _before(v: float, f: int, w: float, g: int) -> bool:
+    """Whether ``(v, f)`` comes before ``(w, g)``: lower score, ties by lower index."""
+    return v < w or (v == w and f < g)
+
+
+@njit(cache=True, nogil=True)
+def smallest_kernel(scores: np.ndarray, count: int) -> np.ndarray:
+    """Indices of the ``count`` lowest of ``scores`` ``(N,)``, ordered by score, ties by index (a
+    max-heap of the best so far: one comparison for most entries)."""
+    k = min(count, scores.shape[0])
+    heap = np.empty(k, dtype=np.int64)          # heap[0]: the worst kept
+    for f in range(k):                          # the first k, then sift each up
+        heap[f] = f
+        c = f
+        while c > 0:
+            parent = (c - 1) // 2
+            if _before(scores[heap[parent]], heap[parent], scores[heap[c]], heap[c]):
+                heap[parent], heap[c] = heap[c], heap[parent]
+                c = parent
+            else:
+                break
+    for f in range(k, scores.shape[0]):
+        v = scores[f]
+        if not _before(v, f, scores[heap[0]], heap[0]):
+            continue
+        heap[0] = f                              # replace the worst, sift it down
+        c = 0
+        while True:
+            a, b = 2 * c + 1, 2 * c + 2
+            big = c
+            if a < k and _before(scores[heap[big]], heap[big], scores[heap[a]], heap[a]):
+                big = a
+            if b < k and _before(scores[heap[big]], heap[big], scores[heap[b]], heap[b]):
+                big = b
+            if big == c:
+                break
+            heap[c], heap[big] = heap[big], heap[c]
+            c = big
+    # sorted: by index first, then a stable sort by score
+    kept = np.sort(heap)
+    return kept[np.argsort(scores[kept], kind="mergesort")]
+
+
+@njit(cache=True, nogil=True)
 def pose_scores_kernel(table: np.ndarray, origin_x: float, origin_y: float, resolution: float,
                        points: np.ndarray, poses: np.ndarray) -> np.ndarray:
     """Mean distance-field value ``(K,)`` of ``points`` ``(M, 2)`` at each of ``(K, 3)`` poses."""
@@ -404,3 +448,57 @@ def lattice_kernel(xy: np.ndarray, table: np.ndarray, corner_x: float, corner_y:
             return keep, False
         keep[i] = code == 1
     return keep, True
+
+
+@njit(cache=True, nogil=True)
+def _returned(r: float, max_range: float) -> bool:
+    """Whether a range is a return (finite, > 0, < ``max_range``), as ``LaserSpec.valid``."""
+    return np.isfinite(r) and r > 0.0 and r < max_range
+
+
+@njit(cache=True, nogil=True)
+def residual_pen_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, resolution: float,
+                        map_points: np.ndarray, map_normals: np.ndarray, ranges: np.ndarray,
+                        directions: np.ndarray, max_range: float, poses: np.ndarray,
+                        c: float) -> np.ndarray:
+    """The point-to-line part of ``tf-plus``'s selection cost (:mod:`tfloc.tfplus.cost`), per
+    beam ``(K, n)`` (metres²): each return's ranking residual to the nearest map point of its
+    cell (:func:`field_pairs_kernel`'s, with the cell size as slack) truncated at ``c``, squared;
+    0 for a beam with no return. The same arithmetic as the numpy steps it replaces (the scan
+    points of :meth:`LaserSpec.to_points`, the ranking residual, ``min(r, c)²``)."""
+    k_n, n = poses.shape[0], ranges.shape[0]
+    out = np.zeros((k_n, n))
+    field = (nearest, origin_x, origin_y, 1.0 / resolution, map_points)
+    for k in range(k_n):
+        px, py = poses[k, 0], poses[k, 1]
+        cs, sn = math.cos(poses[k, 2]), math.sin(poses[k, 2])
+        for b in range(n):
+            r = ranges[b]
+            if not _returned(r, max_range):
+                continue
+            x, y = directions[b, 0] * r, directions[b, 1] * r
+            _, _, j, dx, dy = _to_nearest(field, px, py, cs, sn, x, y)
+            if j < 0:
+                out[k, b] = c * c
+                continue
+            res = map_normals[j, 0] * dx + map_normals[j, 1] * dy
+            rank = max(abs(res), math.sqrt(dx * dx + dy * dy) - resolution)
+            t = min(rank, c)
+            out[k, b] = t * t
+    return out
+
+
+@njit(cache=True, nogil=True)
+def vector_see_through_kernel(pen: np.ndarray, ranges: np.ndarray, virtual: np.ndarray,
+                              max_range: float, c: float) -> None:
+    """Set ``pen`` ``(K, n)`` to ``c²`` at the beams a vector map says cannot be, given its
+    virtual scans ``(K, n)``: the map has a wall within range and the real return lies more than
+    ``c`` beyond it, or there is none (:func:`tfloc.tfplus.cost.see_through`)."""
+    for k in range(pen.shape[0]):
+        for b in range(pen.shape[1]):
+            v = virtual[k, b]
+            if not _returned(v, max_range):
+                continue
+            r = ranges[b]
+            if not _returned(r, max_range) or r > v + c:
+                pen[k, b] = c * c

@@ -47,6 +47,7 @@ real points ``p`` (sensor frame) to ``R(φ) p + t`` in the virtual pose's frame,
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import ClassVar
 
 import numpy as np
@@ -58,7 +59,7 @@ from tfloc.maps.vector import VectorMap
 
 from .kernels import face_depths_kernel, field_pairs_kernel, pairs_kernel, refine_field_kernel
 from .view import MapView
-from .virtual_kernel import refine_virtual_kernel
+from .virtual_kernel import refine_vector_kernel
 
 _FUSED = True  # refine on vector maps in compiled runs (tests switch it off to compare)
 
@@ -144,6 +145,19 @@ def residuals_to(virtual: np.ndarray, laser: LaserSpec, points: np.ndarray, wind
     return np.abs(r)
 
 
+@lru_cache(maxsize=32)
+def _gates_of(start: float, end: float, iterations: int) -> np.ndarray:
+    gates = np.geomspace(start, end, max(iterations, 1))[:iterations]
+    gates.setflags(write=False)
+    return gates
+
+
+def _gates(cfg: RefineConfig) -> np.ndarray:
+    """The pair gates (metres) of the iterations, shrinking geometrically from ``gate_start`` to
+    ``gate_end`` (read-only; made once per configuration)."""
+    return _gates_of(float(cfg.gate_start), float(cfg.gate_end), int(cfg.iterations))
+
+
 def truncated_cost(residuals: np.ndarray, inlier_distance: float) -> np.ndarray:
     """Mean squared residual truncated at ``inlier_distance`` (metres²), per row; NaN counts as far."""
     r = np.where(np.isnan(residuals), inlier_distance, np.minimum(residuals, inlier_distance))
@@ -159,9 +173,9 @@ def refine(map_: Map, laser: LaserSpec, points: np.ndarray, poses: np.ndarray,
     poses = np.array(poses, dtype=float).reshape(-1, 3)
     points = np.ascontiguousarray(points, dtype=float)
     cfg = config
-    gates = np.geomspace(cfg.gate_start, cfg.gate_end, max(cfg.iterations, 1))
+    gates = _gates(cfg)
     if _FUSED and isinstance(map_, VectorMap):
-        return _refine_vector(map_, laser, points, poses, cfg, gates[:cfg.iterations])
+        return _refine_vector(map_, laser, points, poses, cfg, gates)
     for it in range(cfg.iterations):
         q, normal = _virtual_geometry(map_.raycast(poses, laser), laser)
         delta = np.zeros_like(poses)
@@ -180,24 +194,15 @@ def refine(map_: Map, laser: LaserSpec, points: np.ndarray, poses: np.ndarray,
 
 def _refine_vector(map_: VectorMap, laser: LaserSpec, points: np.ndarray, poses: np.ndarray,
                    cfg: RefineConfig, gates: np.ndarray) -> np.ndarray:
-    """:func:`refine` on a vector map in compiled runs of iterations
-    (:func:`~tfloc.tfplus.virtual_kernel.refine_virtual_kernel`), pruning between them: the same
-    poses as the step-by-step loop, without its per-iteration Python and numpy overhead."""
-    angles = np.asarray(laser.angles, dtype=float)
+    """:func:`refine` on a vector map in one compiled call
+    (:func:`~tfloc.tfplus.virtual_kernel.refine_vector_kernel`: the iterations, the pruning
+    between them): the same poses as the step-by-step loop, without its per-iteration Python and
+    numpy overhead."""
     cos_a, sin_a = _beam_trig(laser)
-    prune_at = 0 < cfg.prune_after <= len(gates)     # as the loop: after iteration prune_after
-    cut = cfg.prune_after if prune_at else len(gates)
-    for part, prune in ((gates[:cut], prune_at), (gates[cut:], False)):
-        if len(part) == 0:
-            continue
-        poses, r = refine_virtual_kernel(poses, points, angles, cos_a, sin_a,
-                                         float(laser.angle_min), float(laser.resolution),
-                                         map_.segments, float(laser.max_range),
-                                         np.ascontiguousarray(part), cfg.inner, cfg.window,
-                                         cfg.damping)
-        if prune and len(poses) > cfg.keep:
-            poses = _prune(poses, truncated_cost(np.abs(r), cfg.inlier_distance), cfg.keep)
-    return poses
+    return refine_vector_kernel(poses, points, laser.angles, cos_a, sin_a,
+                                float(laser.angle_min), float(laser.resolution), map_.segments,
+                                float(laser.max_range), gates, cfg.inner, cfg.window,
+                                cfg.damping, cfg.prune_after, cfg.keep, cfg.inlier_distance)
 
 
 _TRIG: dict = {}
@@ -268,7 +273,7 @@ def refine_to_field(field: MapView, points: np.ndarray, poses: np.ndarray,
     cfg = config
     faces = bool(cfg.faces and field.faces)
     offsets = np.full(len(poses), cfg.offset_prior)
-    gates = np.geomspace(cfg.gate_start, cfg.gate_end, max(cfg.iterations, 1))[:cfg.iterations]
+    gates = _gates(cfg)
     cut = cfg.prune_after if 0 < cfg.prune_after < cfg.iterations else cfg.iterations
     started = False
     for first, part in ((True, gates[:cut]), (False, gates[cut:])):

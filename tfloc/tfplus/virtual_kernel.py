@@ -104,3 +104,131 @@ def refine_virtual_kernel(poses: np.ndarray, points: np.ndarray, rel_angles: np.
             poses[k, 0], poses[k, 1] = x, y
             poses[k, 2] = (poses[k, 2] + delta[k, 2] + np.pi) % (2.0 * np.pi) - np.pi
     return poses, r
+
+
+@njit(cache=True, nogil=True)
+def _block_sum(a: np.ndarray, lo: int, n: int) -> float:
+    """numpy's ``pairwise_sum`` of ``a[lo:lo + n]`` for ``n ≤ 128``: a plain sum below 8, else
+    eight partial sums over the multiples of 8, combined in pairs, then the rest."""
+    if n < 8:
+        res = 0.0
+        for i in range(lo, lo + n):
+            res += a[i]
+        return res
+    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
+    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
+    i = 8
+    while i < n - (n % 8):
+        r0 += a[lo + i]
+        r1 += a[lo + i + 1]
+        r2 += a[lo + i + 2]
+        r3 += a[lo + i + 3]
+        r4 += a[lo + i + 4]
+        r5 += a[lo + i + 5]
+        r6 += a[lo + i + 6]
+        r7 += a[lo + i + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        res += a[lo + i]
+        i += 1
+    return res
+
+
+@njit(cache=True, nogil=True)
+def _pairwise_sum(a: np.ndarray, lo: int, n: int) -> float:
+    """numpy's pairwise sum of ``a[lo:lo + n]``: blocks of at most 128 (:func:`_block_sum`),
+    halves (cut at a multiple of 8) added as numpy's recursion adds them, so that a mean over a
+    row is numpy's bit for bit (``tests/test_fused_equivalence.py`` checks it against
+    ``np.mean``). Written without recursion: numba's cache cannot hold recursive functions
+    (a cached one crashed when loaded)."""
+    if n <= 128:
+        return _block_sum(a, lo, n)
+    # post-order walk of numpy's halving tree: a segment is pushed once to be split (state 0)
+    # and once to add its two halves' sums (state 1)
+    seg_lo = np.empty(128, dtype=np.int64)
+    seg_n = np.empty(128, dtype=np.int64)
+    state = np.empty(128, dtype=np.int64)
+    sums = np.empty(128)
+    top, n_sums = 0, 0
+    seg_lo[0], seg_n[0], state[0] = lo, n, 0
+    top = 1
+    while top > 0:
+        top -= 1
+        s_lo, s_n, st = seg_lo[top], seg_n[top], state[top]
+        if s_n <= 128:
+            sums[n_sums] = _block_sum(a, s_lo, s_n)
+            n_sums += 1
+        elif st == 1:                                   # both halves summed: left + right
+            n_sums -= 1
+            sums[n_sums - 1] = sums[n_sums - 1] + sums[n_sums]
+        else:
+            n2 = s_n // 2
+            n2 -= n2 % 8
+            seg_lo[top], seg_n[top], state[top] = s_lo, s_n, 1
+            seg_lo[top + 1], seg_n[top + 1], state[top + 1] = s_lo + n2, s_n - n2, 0
+            seg_lo[top + 2], seg_n[top + 2], state[top + 2] = s_lo, n2, 0
+            top += 3
+    return sums[0]
+
+
+@njit(cache=True, nogil=True)
+def truncated_cost_kernel(residuals: np.ndarray, inlier_distance: float) -> np.ndarray:
+    """:func:`tfloc.tfplus.refine.truncated_cost` of ``|residuals|`` ``(K, M)``, bit for bit."""
+    k_n, m = residuals.shape
+    out = np.empty(k_n)
+    sq = np.empty(m)
+    for k in range(k_n):
+        for i in range(m):
+            r = abs(residuals[k, i])
+            r = inlier_distance if math.isnan(r) else min(r, inlier_distance)
+            sq[i] = r * r
+        out[k] = _pairwise_sum(sq, 0, m) / m
+    return out
+
+
+@njit(cache=True, nogil=True)
+def prune_index_kernel(poses: np.ndarray, cost: np.ndarray, keep: int, same: float) -> np.ndarray:
+    """:func:`tfloc.tfplus.refine._prune_index`: ascending indices of the ``keep`` lowest-cost
+    poses, a pose within ``same`` metres of a better kept one counted once."""
+    kept = np.empty(keep, dtype=np.int64)
+    n = 0
+    for i in np.argsort(cost, kind="mergesort"):
+        ok = True
+        for t in range(n):
+            j = kept[t]
+            if not math.hypot(poses[i, 0] - poses[j, 0], poses[i, 1] - poses[j, 1]) >= same:
+                ok = False
+                break
+        if ok:
+            kept[n] = i
+            n += 1
+            if n == keep:
+                break
+    return np.sort(kept[:n])
+
+
+@njit(cache=True, nogil=True)
+def refine_vector_kernel(poses: np.ndarray, points: np.ndarray, rel_angles: np.ndarray,
+                         cos_a: np.ndarray, sin_a: np.ndarray, angle_min: float,
+                         resolution: float, segs: np.ndarray, max_range: float,
+                         gates: np.ndarray, inner: int, window: int, damping: float,
+                         prune_after: int, keep: int, inlier_distance: float) -> np.ndarray:
+    """The whole of :func:`tfloc.tfplus.refine.refine` on a vector map in one call: the
+    iterations up to ``prune_after`` (:func:`refine_virtual_kernel`), the pruning to the ``keep``
+    best by truncated residual, the rest of the iterations."""
+    n_it = gates.shape[0]
+    prune_at = 0 < prune_after <= n_it
+    cut = prune_after if prune_at else n_it
+    if cut > 0:
+        poses, r = refine_virtual_kernel(poses, points, rel_angles, cos_a, sin_a, angle_min,
+                                         resolution, segs, max_range, gates[:cut], inner, window,
+                                         damping)
+        if prune_at and poses.shape[0] > keep:
+            cost = truncated_cost_kernel(r, inlier_distance)
+            poses = poses[prune_index_kernel(poses, cost, keep, 0.05)]
+    if cut < n_it:
+        poses, _ = refine_virtual_kernel(poses, points, rel_angles, cos_a, sin_a, angle_min,
+                                         resolution, segs, max_range, gates[cut:], inner, window,
+                                         damping)
+    return poses
