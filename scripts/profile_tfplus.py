@@ -44,8 +44,8 @@ def staged(matcher, problem) -> dict[str, float]:
     t["lattice (free positions)"] = clock() - c0
     c0 = clock()
     stride = max(1, len(points) // cfg.coarse_points)
-    poses, scores = mm.search(coarse_field, points, positions, heads, stride, cfg.shortlist)
-    cands = mm.best_candidates(poses, scores, cfg.candidates, cfg.separation)
+    cands, _, _ = mm.candidates(coarse_field, points, positions, heads, stride, cfg.shortlist,
+                                cfg.candidates, cfg.separation)
     t["coarse search + candidates"] = clock() - c0
     c0 = clock()
     if isinstance(problem.map, mm.GridMap):

@@ -259,8 +259,8 @@ def test_smallest_kernel_orders_by_score_then_index() -> None:
             assert np.array_equal(got, np.lexsort((np.arange(n), scores))[:64])
 
 
-def test_coarse_search_shortlists_the_lowest_first_level_scores(test_room, lms200) -> None:
-    from tfloc.tfplus.coarse import grid_scores, lattice, pose_scores, search
+def test_coarse_candidates_are_the_shortlist_rescored_and_thinned(test_room, lms200) -> None:
+    from tfloc.tfplus.coarse import best_candidates, candidates, grid_scores, lattice, pose_scores
     from tfloc.tfplus.view import map_view
 
     field = map_view(test_room, 0.05, 0.3, 0.3)
@@ -268,12 +268,16 @@ def test_coarse_search_shortlists_the_lowest_first_level_scores(test_room, lms20
     points = lms200.to_points(noisy_scan(test_room, lms200, TRUE))
     positions = lattice(test_room, field, np.array([TRUE.x + 0.4, TRUE.y - 0.3]), 2.0, 0.2, 0.1)
     headings = TRUE.theta + np.radians(np.arange(-9, 10, 3.0))
-    poses, scores = search(pooled, points, positions, headings, 9, 64)
-    first = grid_scores(pooled, points[::9], positions, headings).ravel()
-    top = np.lexsort((np.arange(first.size), first))[:64]
-    expect = np.column_stack((positions[top // len(headings)], headings[top % len(headings)]))
-    assert poses.tobytes() == expect.tobytes()
-    assert scores.tobytes() == pose_scores(pooled, points, expect).tobytes()
+    for shortlist, count in ((64, 4), (5, 3), (10_000, 2)):
+        got, scores, rescored = candidates(pooled, points, positions, headings, 9, shortlist,
+                                           count, 0.3)
+        first = grid_scores(pooled, points[::9], positions, headings).ravel()
+        top = np.lexsort((np.arange(first.size), first))[:shortlist]   # ties by index
+        poses = np.column_stack((positions[top // len(headings)], headings[top % len(headings)]))
+        expect = best_candidates(poses, pose_scores(pooled, points, poses), count, 0.3)
+        assert rescored == len(top)
+        assert got.tobytes() == expect.tobytes()
+        assert scores.tobytes() == pose_scores(pooled, points, expect).tobytes()
 
 
 def test_pairwise_sum_is_numpys_mean() -> None:

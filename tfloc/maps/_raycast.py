@@ -121,18 +121,45 @@ def _uniform_spacing(rel_angles: np.ndarray) -> tuple[float, float, float]:
     return a0, res, dev
 
 
+_ORDER_BINS = 32  # distance bins of the segments' near-first order (speed only)
+
+
+@njit(cache=True, nogil=True)
+def _near_first(dist: np.ndarray, k: int, max_range: float) -> np.ndarray:
+    """An order of the first ``k`` segments that is near first to within ``max_range / 32``
+    (a counting sort by distance bin; in a bin, in index order).
+
+    The ranges do not depend on the order the segments are visited in: a beam's range is the
+    least hit over all segments, and a segment is skipped for a beam only where the beam's
+    nearest hit so far provably lies before it. Visiting near segments first only makes the
+    skips frequent; a full sort (``np.argsort``, until issue 26) cost about a third of a ray
+    cast from a new position."""
+    counts = np.zeros(_ORDER_BINS + 1, dtype=np.int64)
+    scale = _ORDER_BINS / max_range
+    for j in range(k):
+        counts[min(int(dist[j] * scale), _ORDER_BINS - 1) + 1] += 1
+    for b in range(_ORDER_BINS):
+        counts[b + 1] += counts[b]
+    out = np.empty(k, dtype=np.int64)
+    for j in range(k):
+        b = min(int(dist[j] * scale), _ORDER_BINS - 1)
+        out[counts[b]] = j
+        counts[b] += 1
+    return out
+
+
 @njit(cache=True, nogil=True)
 def _arcs(ox: float, oy: float, segs: np.ndarray, max_range: float, dev: float,
           near: np.ndarray, dist: np.ndarray, seg_of: np.ndarray, every: np.ndarray,
           start: np.ndarray, width: np.ndarray, margin: np.ndarray, h_safe: np.ndarray,
           den_min: np.ndarray, ex: np.ndarray, ey: np.ndarray) -> int:
     """What :func:`raycast_segments` needs of the segments seen from ``(ox, oy)``, independent of
-    the heading: the segments within ``max_range``, nearest first (``seg_of``), whether each must
+    the heading: the segments within ``max_range``, near first (``seg_of``, :func:`_near_first`), whether each must
     be tested against every beam (``every``), else the arc it subtends (``start``, ``width``,
     ``margin``) and its occlusion test (``h_safe``, ``den_min``, ``ex``, ``ey``); returns their count."""
     two_pi = 2.0 * np.pi
     k = _near_segments(ox, oy, segs, max_range, near, dist)
-    order = np.argsort(dist[:k])
+    order = _near_first(dist, k, max_range)
     for jj in range(k):
         j = order[jj]
         m = near[j]
@@ -179,7 +206,7 @@ def raycast_segments(poses: np.ndarray, rel_angles: np.ndarray, segs: np.ndarray
     segment is intersected only with the beams inside the arc it subtends (wrap-around of
     360° scanners included). A segment within rounding distance of the sensor is intersected
     with every beam, so the answer never depends on the arc computation. Segments are visited
-    nearest first, and a beam whose hit so far is nearer than a segment's distance skips it
+    nearest first (by distance bins, :func:`_near_first`), and a beam whose hit so far is nearer than a segment's distance skips it
     (only when the skip provably agrees with the brute force's test). Consecutive poses at the
     same position (e.g. several headings) share the heading-independent work (:func:`_arcs`).
     """

@@ -23,7 +23,7 @@ import numpy as np
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Problem
 from tfloc.maps.grid import GridMap
-from tfloc.tfplus.coarse import best_candidates, lattice, pose_scores, search
+from tfloc.tfplus.coarse import best_candidates, candidates, lattice
 from tfloc.tfplus.cost import scan_cost
 from tfloc.tfplus.matcher import TfPlusConfig, heading_seeds
 from tfloc.tfplus.refine import refine, refine_to_field
@@ -48,11 +48,11 @@ def resolve_places(problem: Problem, places: np.ndarray, cfg: TfPlusConfig,
                      if cfg.grid else np.empty((0, 2)))
         if len(positions) == 0:
             positions = place[None, :2]
-        poses, s = search(coarse, points, positions, heads, stride, cfg.shortlist)
-        best = best_candidates(poses, s, cfg.candidates, cfg.separation)
+        best, s, rescored = candidates(coarse, points, positions, heads, stride, cfg.shortlist,
+                                       cfg.candidates, cfg.separation)
         cands.append(best)
-        scores.append(pose_scores(coarse, points, best))
-        evaluations += len(positions) * len(heads) + len(poses)
+        scores.append(s)
+        evaluations += len(positions) * len(heads) + rescored
     poses = best_candidates(np.concatenate(cands), np.concatenate(scores), refined, cfg.separation)
     to = cfg.refine_to if cfg.refine_to != "auto" else ("field" if isinstance(m, GridMap) else "virtual")
     if cfg.refine and to == "field":

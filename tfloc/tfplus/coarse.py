@@ -21,11 +21,11 @@ from tfloc.maps.inside import SURE
 from tfloc.maps.vector import VectorMap
 
 from .kernels import (
+    candidates_kernel,
     grid_scores_kernel,
     lattice_kernel,
     pose_scores_kernel,
     separated_kernel,
-    smallest_kernel,
 )
 from .view import MapView
 
@@ -35,18 +35,20 @@ def lattice(map_: Map, field: MapView, centre: np.ndarray, radius: float, step: 
     """Free lattice positions ``(N, 2)`` (metres) within ``radius`` of ``centre``, centre first,
     at least ``clearance`` from the map's points (by the distance field: a clearance query to
     the map itself can cost more than the whole search on a map used once)."""
-    xy = centre[None, :] + _offsets(float(radius), float(step))
+    offsets = _offsets(float(radius), float(step))
     if isinstance(map_, VectorMap):            # the same tests in one compiled call (the field
         # compared in its own dtype, as numpy compares a float32 array with a Python float)
         area, free = map_.area_rings(), map_.free_rings()
         if area is not None and free is not None:
             corner = field.origin
-            keep, decided = lattice_kernel(
-                xy, field.table, float(corner[0]), float(corner[1]), field.resolution,
-                field.table.dtype.type(clearance), area.codes, area.x0, area.y0, area.res, area.segs, free.codes,
-                free.x0, free.y0, free.res, free.segs, SURE)
+            positions, decided = lattice_kernel(
+                float(centre[0]), float(centre[1]), offsets, field.table, float(corner[0]),
+                float(corner[1]), field.resolution, field.table.dtype.type(clearance), area.codes,
+                area.x0, area.y0, area.res, area.segs, free.codes, free.x0, free.y0, free.res,
+                free.segs, SURE)
             if decided:
-                return xy[keep]
+                return positions
+    xy = centre[None, :] + offsets
     keep = field(xy) >= clearance
     keep[keep] = map_.in_bounds(xy[keep])
     keep[keep] = map_.is_free(xy[keep])
@@ -83,10 +85,14 @@ def pose_scores(field: MapView, points: np.ndarray, poses: np.ndarray) -> np.nda
                               np.ascontiguousarray(np.reshape(poses, (-1, 3)), dtype=float))
 
 
-def search(field: MapView, points: np.ndarray, positions: np.ndarray, headings: np.ndarray,
-           stride: int, shortlist: int) -> tuple[np.ndarray, np.ndarray]:
+def candidates(field: MapView, points: np.ndarray, positions: np.ndarray, headings: np.ndarray,
+               stride: int, shortlist: int, count: int,
+               separation: float) -> tuple[np.ndarray, np.ndarray, int]:
     """Two-level grid search: every position × heading on every ``stride``-th point, then the best
-    ``shortlist`` of them on all points. Returns those poses ``(S, 3)`` and their scores ``(S,)``.
+    ``shortlist`` of them on all points, of which up to ``count`` of lowest score at least
+    ``separation`` metres apart are returned: ``(C, 3)`` poses, their scores ``(C,)`` and the
+    number of poses rescored. One compiled call
+    (:func:`~tfloc.tfplus.kernels.candidates_kernel`).
 
     The shortlist is ordered by the first level's score, ties for a place by lower index
     (position-major; :func:`~tfloc.tfplus.kernels.smallest_kernel`). Until issue 26 it was
@@ -94,10 +100,11 @@ def search(field: MapView, points: np.ndarray, positions: np.ndarray, headings: 
     scores are means of a few float32 distances of ~20 distinct values, and the last place
     was tied in about one scan in five, so a rule of its own makes the answer independent of
     numpy's internals."""
-    top = smallest_kernel(grid_scores(field, points[::stride], positions, headings).ravel(),
-                          shortlist)
-    poses = np.column_stack((positions[top // len(headings)], headings[top % len(headings)]))
-    return poses, pose_scores(field, points, poses)
+    return candidates_kernel(field.table, float(field.origin[0]), float(field.origin[1]),
+                             field.resolution, np.ascontiguousarray(points, dtype=float),
+                             int(stride), np.ascontiguousarray(positions, dtype=float),
+                             np.ascontiguousarray(headings, dtype=float), int(shortlist),
+                             int(count), float(separation))
 
 
 def best_candidates(poses: np.ndarray, scores: np.ndarray, count: int,

@@ -147,14 +147,31 @@ def separated_kernel(poses: np.ndarray, count: int, separation: float) -> np.nda
 
 
 @njit(cache=True, nogil=True)
-def _bearing_index(x: float, y: float, angle_min: float, resolution: float) -> int:
+def _bearing_index(x: float, y: float, angle_min: float, resolution: float) -> tuple[int, float]:
     """``round((atan2(y, x) − angle_min) / resolution)``, the beam nearest the bearing of
     ``(x, y)``: from the cheap :func:`~tfloc.maps._raycast._atan2` (error below 1e-5 rad), and
-    from ``math.atan2`` where the two could round differently (within 1e-4 rad of a half step)."""
+    from ``math.atan2`` where the two could round differently (within 1e-4 rad of a half step);
+    and the bearing in beams from the cheap one (error below 1e-5 rad / ``resolution``)."""
     v = (_atan2(y, x) - angle_min) / resolution
     if abs(v - math.floor(v) - 0.5) > 1e-4 / resolution:
-        return int(math.floor(v + 0.5))
-    return int(round((math.atan2(y, x) - angle_min) / resolution))
+        return int(math.floor(v + 0.5)), v
+    return int(round((math.atan2(y, x) - angle_min) / resolution)), v
+
+
+_BEARING_SLACK = 2e-5  # radians: more than _atan2's error and the beam angles' rounding
+
+
+@njit(cache=True, nogil=True)
+def _off_ray(rho: float, beams: float, resolution: float) -> float:
+    """A lower bound (metres) of the distance from a point ``rho`` metres from the sensor to any
+    point on a ray ``beams`` beams of ``resolution`` radians away from its bearing (the distance
+    to the ray's line, ``rho·sin(angle)``, with ``sin a ≥ a − a³/6``; ``rho`` beyond 90°)."""
+    a = abs(beams) * resolution - _BEARING_SLACK
+    if a <= 0.0:
+        return 0.0
+    if a >= 0.5 * math.pi:
+        return rho
+    return rho * (a - a * a * a / 6.0)
 
 
 @njit(cache=True, nogil=True)
@@ -188,13 +205,38 @@ def pairs_kernel(points: np.ndarray, delta: np.ndarray, q: np.ndarray, normal: n
             rx = c * points[i, 0] - s * points[i, 1]
             ry = s * points[i, 0] + c * points[i, 1]
             x, y = rx + delta[k, 0], ry + delta[k, 1]
-            j0 = _bearing_index(x, y, angle_min, resolution)
+            j0, v = _bearing_index(x, y, angle_min, resolution)
+            lo, hi = max(j0 - window, 0), min(j0 + window, n - 1)
+            if lo > hi:
+                continue
+            # the nearest virtual point within the window (the lowest beam among equals), searched
+            # outwards from the bearing: each side stops at a beam whose ray lies farther from the
+            # point than the best so far (every later beam on that side lies farther still)
+            rho = math.sqrt(x * x + y * y)
             best, bj = gate * gate, -1
-            for j in range(max(j0 - window, 0), min(j0 + window + 1, n)):
-                dx, dy = x - vx[j], y - vy[j]
-                d2 = dx * dx + dy * dy
-                if d2 < best:
-                    best, bj = d2, j
+            left = min(max(j0, lo), hi)
+            right = left + 1
+            while left >= lo or right <= hi:
+                if left >= lo:
+                    bound = _off_ray(rho, left - v, resolution)
+                    if bound * bound > best and left < v:
+                        left = lo - 1
+                    else:
+                        dx, dy = x - vx[left], y - vy[left]
+                        d2 = dx * dx + dy * dy
+                        if d2 < best or (d2 == best and left < bj):
+                            best, bj = d2, left
+                        left -= 1
+                if right <= hi:
+                    bound = _off_ray(rho, right - v, resolution)
+                    if bound * bound > best and right > v:
+                        right = hi + 1
+                    else:
+                        dx, dy = x - vx[right], y - vy[right]
+                        d2 = dx * dx + dy * dy
+                        if d2 < best:
+                            best, bj = d2, right
+                        right += 1
             if bj < 0:
                 continue
             nx, ny = normal[k, bj, 0], normal[k, bj, 1]
@@ -419,35 +461,40 @@ def see_through_kernel(occ: np.ndarray, origin_x: float, origin_y: float, resolu
 
 
 @njit(cache=True, nogil=True)
-def lattice_kernel(xy: np.ndarray, table: np.ndarray, corner_x: float, corner_y: float,
-                   resolution: float, clearance: float, area_codes: np.ndarray, area_x0: float,
-                   area_y0: float, area_res: float, area_segs: np.ndarray, free_codes: np.ndarray,
-                   free_x0: float, free_y0: float, free_res: float, free_segs: np.ndarray,
+def lattice_kernel(centre_x: float, centre_y: float, offsets: np.ndarray, table: np.ndarray,
+                   corner_x: float, corner_y: float, resolution: float, clearance: float,
+                   area_codes: np.ndarray, area_x0: float, area_y0: float, area_res: float,
+                   area_segs: np.ndarray, free_codes: np.ndarray, free_x0: float, free_y0: float,
+                   free_res: float, free_segs: np.ndarray,
                    sure: float) -> tuple[np.ndarray, bool]:
-    """:func:`tfloc.tfplus.coarse.lattice`'s test of the positions ``xy`` ``(N, 2)`` on a vector
-    map, in one call: the distance field (``table``, cells of ``resolution`` from the corner) at
-    least ``clearance`` (of the table's dtype), in the mapped area and in free space (:func:`tfloc.maps.inside.raster_code`
-    on the area's and the free space's rings). Returns the mask and whether every point was
-    decided (False: one lay too near a boundary for the compiled test; ask the map)."""
+    """:func:`tfloc.tfplus.coarse.lattice`'s positions on a vector map, in one call: of the
+    points ``centre + offsets`` ``(N, 2)``, those where the distance field (``table``, cells of
+    ``resolution`` from the corner) is at least ``clearance`` (of the table's dtype), in the
+    mapped area and in free space (:func:`tfloc.maps.inside.raster_code` on the area's and the
+    free space's rings), in order. Returns them ``(K, 2)`` and whether every point was decided
+    (False: one lay too near a boundary for the compiled test; ask the map)."""
     h, w = table.shape
     flat = table.ravel()
-    keep = np.zeros(xy.shape[0], dtype=np.bool_)
-    for i in range(xy.shape[0]):
-        x, y = xy[i, 0], xy[i, 1]
+    out = np.empty((offsets.shape[0], 2))
+    k = 0
+    for i in range(offsets.shape[0]):
+        x, y = centre_x + offsets[i, 0], centre_y + offsets[i, 1]
         ix = min(max(np.int64(math.floor((x - corner_x) / resolution)), 0), w - 1)
         iy = min(max(np.int64(math.floor((y - corner_y) / resolution)), 0), h - 1)
         if not flat[iy * w + ix] >= clearance:
             continue
         code = raster_code(x, y, area_codes, area_x0, area_y0, area_res, area_segs, sure)
         if code < 0:
-            return keep, False
+            return out[:0], False
         if code == 0:
             continue
         code = raster_code(x, y, free_codes, free_x0, free_y0, free_res, free_segs, sure)
         if code < 0:
-            return keep, False
-        keep[i] = code == 1
-    return keep, True
+            return out[:0], False
+        if code == 1:
+            out[k, 0], out[k, 1] = x, y
+            k += 1
+    return out[:k].copy(), True
 
 
 @njit(cache=True, nogil=True)
@@ -502,3 +549,30 @@ def vector_see_through_kernel(pen: np.ndarray, ranges: np.ndarray, virtual: np.n
             r = ranges[b]
             if not _returned(r, max_range) or r > v + c:
                 pen[k, b] = c * c
+
+
+@njit(cache=True, nogil=True)
+def candidates_kernel(table: np.ndarray, origin_x: float, origin_y: float, resolution: float,
+                      points: np.ndarray, stride: int, positions: np.ndarray,
+                      headings: np.ndarray, shortlist: int, count: int,
+                      separation: float) -> tuple[np.ndarray, np.ndarray, int]:
+    """The coarse search of :mod:`tfloc.tfplus.coarse` in one call: every position × heading
+    scored on every ``stride``-th of ``points`` (:func:`grid_scores_kernel`), the ``shortlist``
+    lowest (:func:`smallest_kernel`: ties by index) rescored on all points
+    (:func:`pose_scores_kernel`), ordered by that score (stable) and thinned to at most ``count``
+    poses ``separation`` metres apart (:func:`separated_kernel`). Returns those candidates
+    ``(C, 3)``, their scores ``(C,)`` and the size of the shortlist."""
+    sub = np.ascontiguousarray(points[::stride])
+    h = headings.shape[0]
+    first = grid_scores_kernel(table, origin_x, origin_y, resolution, sub, positions,
+                               headings).ravel()
+    top = smallest_kernel(first, shortlist)
+    poses = np.empty((top.shape[0], 3))
+    for i in range(top.shape[0]):
+        p, j = top[i] // h, top[i] % h
+        poses[i, 0], poses[i, 1], poses[i, 2] = positions[p, 0], positions[p, 1], headings[j]
+    scores = pose_scores_kernel(table, origin_x, origin_y, resolution, points, poses)
+    order = np.argsort(scores, kind="mergesort")
+    ordered = poses[order]
+    keep = separated_kernel(ordered, count, separation)
+    return ordered[keep], scores[order][keep], top.shape[0]

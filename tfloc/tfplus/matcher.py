@@ -62,7 +62,7 @@ from tfloc.paper.kernels import scan_turning
 from tfloc.paper.shape import ShapeConfig, scan_turning_function
 from tfloc.paper.turning import TurningFunction, match
 
-from .coarse import best_candidates, lattice, pose_scores, search
+from .coarse import candidates, lattice, pose_scores
 from .cost import scan_cost
 from .headings import rotation_candidates
 from .refine import RefineConfig, refine, refine_to_field
@@ -203,12 +203,13 @@ def tf_errs(problem: Problem, poses: np.ndarray, cfg: TfPlusConfig) -> np.ndarra
 def pick(cost: np.ndarray, poses: np.ndarray, vp: Pose, tie_tolerance: float) -> int:
     """Index of the answer: the lowest ``cost``, or, among the candidates within a factor
     ``1 + tie_tolerance`` of it (the scan cannot tell them apart), the one nearest the VP."""
-    best = float(np.min(cost))
-    tied = np.flatnonzero(cost <= best * (1.0 + tie_tolerance))
+    costs = [float(c) for c in cost]        # a handful of candidates: plain floats
+    best = min(costs)
+    tied = [i for i, c in enumerate(costs) if c <= best * (1.0 + tie_tolerance)]
     if len(tied) == 1:
-        return int(tied[0])
-    near = np.hypot(poses[tied, 0] - vp.x, poses[tied, 1] - vp.y)
-    return int(tied[np.argmin(near)])
+        return tied[0]
+    near = [math.hypot(poses[i, 0] - vp.x, poses[i, 1] - vp.y) for i in tied]
+    return tied[near.index(min(near))]
 
 
 class TurningFunctionPlusMatcher(Configured):
@@ -245,10 +246,9 @@ class TurningFunctionPlusMatcher(Configured):
             if len(positions) == 0:
                 positions = vp.xy[None, :]
             stride = max(1, len(points) // cfg.coarse_points) if cfg.coarse_points else cfg.scan_stride
-            poses, scores = search(_coarse_field(problem.map, cfg), points, positions, heads, stride,
-                                   cfg.shortlist)
-            cands = best_candidates(poses, scores, cfg.candidates, cfg.separation)
-            evaluations = len(positions) * len(heads) + len(poses)
+            cands, _, rescored = candidates(_coarse_field(problem.map, cfg), points, positions, heads,
+                                            stride, cfg.shortlist, cfg.candidates, cfg.separation)
+            evaluations = len(positions) * len(heads) + rescored
         else:
             cands = np.column_stack((np.full(len(heads), vp.x), np.full(len(heads), vp.y), heads))
             if not cfg.refine:
