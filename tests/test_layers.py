@@ -16,6 +16,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 #: Bottom to top. Each entry is a module or package prefix of ``tfloc``.
 LAYERS = (
+    "tfloc._kernel_cache",  # where numba caches the compiled kernels (one folder per source version)
     "tfloc.errors",      # the TflocError tree
     "tfloc.core",        # pose, laser, the map protocol, problem, matcher protocol + registry, parameters
     "tfloc.maps",        # vector and grid maps, ray casting, the distance field, the per-map cache

@@ -8,8 +8,13 @@ Public API::
     m = tfloc.load_map("data/maps/office-2.geojson")
     est = tfloc.localize(m, tfloc.LaserSpec.lms200(), ranges, tfloc.Pose(1.0, 2.0, 0.1), matcher="tf")
 """
+# ruff: noqa: E402  (numba's cache is pointed at this version's directory before any import)
 
 from __future__ import annotations
+
+from . import _kernel_cache
+
+_kernel_cache.configure()  # before any module with a compiled kernel is imported
 
 from typing import Any
 
