@@ -353,6 +353,26 @@ def test_lattice_on_a_vector_map_equals_the_map_queries() -> None:
             assert got.tobytes() == xy[keep].tobytes()
 
 
+def test_lattice_on_a_grid_map_equals_the_map_queries() -> None:
+    from tfloc.io.maps import load_map
+    from tfloc.maps.build import rasterize
+    from tfloc.tfplus.coarse import _offsets, lattice
+    from tfloc.tfplus.view import map_view
+
+    grid = rasterize(load_map(ROOT / "data" / "maps" / "office-2.geojson"), 0.05)
+    view = map_view(grid, 0.05, 0.3, 0.3)
+    rng = np.random.default_rng(12)
+    x0, y0, x1, y1 = grid.bounds
+    for centre in rng.uniform((x0 - 1, y0 - 1), (x1 + 1, y1 + 1), (40, 2)):
+        for clearance in (0.1, 0.07, 0.0):
+            xy = centre[None, :] + _offsets(3.3, 0.2)
+            keep = view(xy) >= clearance
+            keep &= grid.in_bounds(xy)
+            keep &= grid.is_free(xy)
+            got = lattice(grid, view, centre, 3.3, 0.2, clearance)
+            assert got.tobytes() == xy[keep].tobytes()
+
+
 def test_compiled_tf_search_gives_up_to_python_near_boundaries(
         test_room, lms200, monkeypatch: pytest.MonkeyPatch) -> None:
     """With the compiled free test unsure within 0.5 m of the free space's boundary, the compiled

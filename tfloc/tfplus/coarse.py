@@ -17,11 +17,13 @@ from functools import lru_cache
 import numpy as np
 
 from tfloc.core.map import Map
+from tfloc.maps.grid import GridMap
 from tfloc.maps.inside import SURE
 from tfloc.maps.vector import VectorMap
 
 from .kernels import (
     candidates_kernel,
+    grid_lattice_kernel,
     grid_scores_kernel,
     lattice_kernel,
     pose_scores_kernel,
@@ -48,6 +50,13 @@ def lattice(map_: Map, field: MapView, centre: np.ndarray, radius: float, step: 
                 free.segs, SURE)
             if decided:
                 return positions
+    if isinstance(map_, GridMap):
+        corner = field.origin
+        return grid_lattice_kernel(
+            float(centre[0]), float(centre[1]), offsets, field.table, float(corner[0]),
+            float(corner[1]), field.resolution, field.table.dtype.type(clearance),
+            float(map_.origin[0]), float(map_.origin[1]), float(map_.resolution), map_.free,
+            map_.distance, 0.5 * map_.resolution)
     xy = centre[None, :] + offsets
     keep = field(xy) >= clearance
     keep[keep] = map_.in_bounds(xy[keep])

@@ -576,3 +576,35 @@ def candidates_kernel(table: np.ndarray, origin_x: float, origin_y: float, resol
     ordered = poses[order]
     keep = separated_kernel(ordered, count, separation)
     return ordered[keep], scores[order][keep], top.shape[0]
+
+
+@njit(cache=True, nogil=True)
+def grid_lattice_kernel(centre_x: float, centre_y: float, offsets: np.ndarray, table: np.ndarray,
+                        corner_x: float, corner_y: float, resolution: float, clearance: float,
+                        origin_x: float, origin_y: float, cell: float, free: np.ndarray,
+                        distance: np.ndarray, min_distance: float) -> np.ndarray:
+    """:func:`tfloc.tfplus.coarse.lattice`'s positions on a grid map, in one call: of the points
+    ``centre + offsets`` ``(N, 2)``, in order, those where the distance field (``table``, cells of
+    ``resolution`` from its corner) is at least ``clearance`` (of the table's dtype) and that lie
+    in a known free cell of the grid (cells of ``cell`` metres from ``origin``; ``free`` ``(H, W)``)
+    whose centre is at least ``min_distance`` from every occupied cell's (``distance``): the
+    tests of :meth:`tfloc.maps.grid.GridMap.in_bounds` and ``is_free``, element by element."""
+    h, w = table.shape
+    gh, gw = free.shape
+    flat = table.ravel()
+    out = np.empty((offsets.shape[0], 2))
+    k = 0
+    for n in range(offsets.shape[0]):
+        x, y = centre_x + offsets[n, 0], centre_y + offsets[n, 1]
+        ix = min(max(np.int64(math.floor((x - corner_x) / resolution)), 0), w - 1)
+        iy = min(max(np.int64(math.floor((y - corner_y) / resolution)), 0), h - 1)
+        if not flat[iy * w + ix] >= clearance:
+            continue
+        i = np.int64(math.floor((x - origin_x) / cell))
+        j = np.int64(math.floor((y - origin_y) / cell))
+        if i < 0 or i >= gw or j < 0 or j >= gh:
+            continue
+        if free[j, i] and distance[j, i] >= min_distance:
+            out[k, 0], out[k, 1] = x, y
+            k += 1
+    return out[:k].copy()
