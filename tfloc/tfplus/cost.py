@@ -36,7 +36,8 @@ from tfloc.core.map import Map
 from tfloc.maps.grid import GridMap
 from tfloc.maps.vector import VectorMap
 
-from .kernels import residual_pen_kernel, see_through_kernel, vector_see_through_kernel
+from .cost_kernel import grid_cost_kernel, vector_cost_kernel
+from .kernels import see_through_kernel
 from .refine import field_pairs, residuals_to
 from .view import MapView
 
@@ -46,29 +47,28 @@ def scan_cost(map_: Map, laser: LaserSpec, ranges: np.ndarray, poses: np.ndarray
               field: MapView | None = None) -> np.ndarray:
     """Cost ``(K,)`` (metres²) of the real scan ``ranges`` at each of ``(K, 3)`` poses. The
     point-to-line term is to the map's nearest points (``field``, see :mod:`tfloc.tfplus.refine`), or,
-    without a field, to the virtual scans (ray-cast). On vector and grid maps with a field, the
-    per-beam terms come from compiled kernels (:func:`_per_beam`); :func:`scan_cost_steps` is the
-    same cost in numpy steps (the reference of the tests) and serves every other case."""
+    without a field, to the virtual scans (ray-cast). On vector and grid maps with a field it is
+    one compiled call (:func:`_compiled_cost`); :func:`scan_cost_steps` is the same cost in numpy
+    steps (the reference of the tests) and serves every other case."""
     poses = np.reshape(poses, (-1, 3))
     if field is not None and isinstance(map_, VectorMap | GridMap):
-        return _per_beam(map_, laser, ranges, poses, inlier_distance, beam_check, field).mean(axis=1)
+        return _compiled_cost(map_, laser, ranges, poses, inlier_distance, beam_check, field)
     return scan_cost_steps(map_, laser, ranges, poses, window, inlier_distance, beam_check, field)
 
 
-def _per_beam(map_: VectorMap | GridMap, laser: LaserSpec, ranges: np.ndarray, poses: np.ndarray,
-              c: float, beam_check: bool, field: MapView) -> np.ndarray:
-    """:func:`scan_cost_steps`'s per-beam terms ``(K, n_beams)`` (metres²), compiled: the same
-    values element by element."""
+def _compiled_cost(map_: VectorMap | GridMap, laser: LaserSpec, ranges: np.ndarray,
+                   poses: np.ndarray, c: float, beam_check: bool, field: MapView) -> np.ndarray:
+    """:func:`scan_cost_steps` in one compiled call (:mod:`tfloc.tfplus.cost_kernel`): the same
+    values."""
     poses = np.ascontiguousarray(poses, dtype=float)
     ranges = np.ascontiguousarray(ranges, dtype=float)
-    pen = residual_pen_kernel(field.nearest, float(field.origin[0]), float(field.origin[1]),
-                              field.resolution, field.points, field.normals, ranges,
-                              laser.directions, float(laser.max_range), poses, c)
-    if beam_check and isinstance(map_, GridMap):
-        pen[see_through(map_, laser, ranges, poses, c)] = c * c
-    elif beam_check:
-        vector_see_through_kernel(pen, ranges, map_.raycast(poses, laser), float(laser.max_range), c)
-    return pen
+    args = (field.nearest, float(field.origin[0]), float(field.origin[1]), field.resolution,
+            field.points, field.normals, ranges, laser.directions, laser.angles,
+            float(laser.max_range), poses)
+    if isinstance(map_, GridMap):
+        return grid_cost_kernel(*args, map_.occupied, float(map_.origin[0]),
+                                float(map_.origin[1]), float(map_.resolution), c, beam_check)
+    return vector_cost_kernel(*args, map_.segments, c, beam_check)
 
 
 def scan_cost_steps(map_: Map, laser: LaserSpec, ranges: np.ndarray, poses: np.ndarray,

@@ -498,60 +498,6 @@ def lattice_kernel(centre_x: float, centre_y: float, offsets: np.ndarray, table:
 
 
 @njit(cache=True, nogil=True)
-def _returned(r: float, max_range: float) -> bool:
-    """Whether a range is a return (finite, > 0, < ``max_range``), as ``LaserSpec.valid``."""
-    return np.isfinite(r) and r > 0.0 and r < max_range
-
-
-@njit(cache=True, nogil=True)
-def residual_pen_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, resolution: float,
-                        map_points: np.ndarray, map_normals: np.ndarray, ranges: np.ndarray,
-                        directions: np.ndarray, max_range: float, poses: np.ndarray,
-                        c: float) -> np.ndarray:
-    """The point-to-line part of ``tf-plus``'s selection cost (:mod:`tfloc.tfplus.cost`), per
-    beam ``(K, n)`` (metres²): each return's ranking residual to the nearest map point of its
-    cell (:func:`field_pairs_kernel`'s, with the cell size as slack) truncated at ``c``, squared;
-    0 for a beam with no return. The same arithmetic as the numpy steps it replaces (the scan
-    points of :meth:`LaserSpec.to_points`, the ranking residual, ``min(r, c)²``)."""
-    k_n, n = poses.shape[0], ranges.shape[0]
-    out = np.zeros((k_n, n))
-    field = (nearest, origin_x, origin_y, 1.0 / resolution, map_points)
-    for k in range(k_n):
-        px, py = poses[k, 0], poses[k, 1]
-        cs, sn = math.cos(poses[k, 2]), math.sin(poses[k, 2])
-        for b in range(n):
-            r = ranges[b]
-            if not _returned(r, max_range):
-                continue
-            x, y = directions[b, 0] * r, directions[b, 1] * r
-            _, _, j, dx, dy = _to_nearest(field, px, py, cs, sn, x, y)
-            if j < 0:
-                out[k, b] = c * c
-                continue
-            res = map_normals[j, 0] * dx + map_normals[j, 1] * dy
-            rank = max(abs(res), math.sqrt(dx * dx + dy * dy) - resolution)
-            t = min(rank, c)
-            out[k, b] = t * t
-    return out
-
-
-@njit(cache=True, nogil=True)
-def vector_see_through_kernel(pen: np.ndarray, ranges: np.ndarray, virtual: np.ndarray,
-                              max_range: float, c: float) -> None:
-    """Set ``pen`` ``(K, n)`` to ``c²`` at the beams a vector map says cannot be, given its
-    virtual scans ``(K, n)``: the map has a wall within range and the real return lies more than
-    ``c`` beyond it, or there is none (:func:`tfloc.tfplus.cost.see_through`)."""
-    for k in range(pen.shape[0]):
-        for b in range(pen.shape[1]):
-            v = virtual[k, b]
-            if not _returned(v, max_range):
-                continue
-            r = ranges[b]
-            if not _returned(r, max_range) or r > v + c:
-                pen[k, b] = c * c
-
-
-@njit(cache=True, nogil=True)
 def candidates_kernel(table: np.ndarray, origin_x: float, origin_y: float, resolution: float,
                       points: np.ndarray, stride: int, positions: np.ndarray,
                       headings: np.ndarray, shortlist: int, count: int,
@@ -608,3 +554,69 @@ def grid_lattice_kernel(centre_x: float, centre_y: float, offsets: np.ndarray, t
             out[k, 0], out[k, 1] = x, y
             k += 1
     return out[:k].copy()
+
+
+@njit(cache=True, nogil=True)
+def _block_sum(a: np.ndarray, lo: int, n: int) -> float:
+    """numpy's ``pairwise_sum`` of ``a[lo:lo + n]`` for ``n ≤ 128``: a plain sum below 8, else
+    eight partial sums over the multiples of 8, combined in pairs, then the rest."""
+    if n < 8:
+        res = 0.0
+        for i in range(lo, lo + n):
+            res += a[i]
+        return res
+    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
+    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
+    i = 8
+    while i < n - (n % 8):
+        r0 += a[lo + i]
+        r1 += a[lo + i + 1]
+        r2 += a[lo + i + 2]
+        r3 += a[lo + i + 3]
+        r4 += a[lo + i + 4]
+        r5 += a[lo + i + 5]
+        r6 += a[lo + i + 6]
+        r7 += a[lo + i + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        res += a[lo + i]
+        i += 1
+    return res
+
+
+@njit(cache=True, nogil=True)
+def _pairwise_sum(a: np.ndarray, lo: int, n: int) -> float:
+    """numpy's pairwise sum of ``a[lo:lo + n]``: blocks of at most 128 (:func:`_block_sum`),
+    halves (cut at a multiple of 8) added as numpy's recursion adds them, so that a mean over a
+    row is numpy's bit for bit (``tests/test_fused_equivalence.py`` checks it against
+    ``np.mean``). Written without recursion: numba's cache cannot hold recursive functions
+    (a cached one crashed when loaded)."""
+    if n <= 128:
+        return _block_sum(a, lo, n)
+    # post-order walk of numpy's halving tree: a segment is pushed once to be split (state 0)
+    # and once to add its two halves' sums (state 1)
+    seg_lo = np.empty(128, dtype=np.int64)
+    seg_n = np.empty(128, dtype=np.int64)
+    state = np.empty(128, dtype=np.int64)
+    sums = np.empty(128)
+    top, n_sums = 0, 0
+    seg_lo[0], seg_n[0], state[0] = lo, n, 0
+    top = 1
+    while top > 0:
+        top -= 1
+        s_lo, s_n, st = seg_lo[top], seg_n[top], state[top]
+        if s_n <= 128:
+            sums[n_sums] = _block_sum(a, s_lo, s_n)
+            n_sums += 1
+        elif st == 1:                                   # both halves summed: left + right
+            n_sums -= 1
+            sums[n_sums - 1] = sums[n_sums - 1] + sums[n_sums]
+        else:
+            n2 = s_n // 2
+            n2 -= n2 % 8
+            seg_lo[top], seg_n[top], state[top] = s_lo, s_n, 1
+            seg_lo[top + 1], seg_n[top + 1], state[top + 1] = s_lo + n2, s_n - n2, 0
+            seg_lo[top + 2], seg_n[top + 2], state[top + 2] = s_lo, n2, 0
+            top += 3
+    return sums[0]

@@ -19,7 +19,7 @@ from numba import njit
 
 from tfloc.maps._raycast import raycast_segments
 
-from .kernels import pairs_kernel
+from .kernels import _pairwise_sum, pairs_kernel
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
@@ -104,72 +104,6 @@ def refine_virtual_kernel(poses: np.ndarray, points: np.ndarray, rel_angles: np.
             poses[k, 0], poses[k, 1] = x, y
             poses[k, 2] = (poses[k, 2] + delta[k, 2] + np.pi) % (2.0 * np.pi) - np.pi
     return poses, r
-
-
-@njit(cache=True, nogil=True)
-def _block_sum(a: np.ndarray, lo: int, n: int) -> float:
-    """numpy's ``pairwise_sum`` of ``a[lo:lo + n]`` for ``n ≤ 128``: a plain sum below 8, else
-    eight partial sums over the multiples of 8, combined in pairs, then the rest."""
-    if n < 8:
-        res = 0.0
-        for i in range(lo, lo + n):
-            res += a[i]
-        return res
-    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
-    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
-    i = 8
-    while i < n - (n % 8):
-        r0 += a[lo + i]
-        r1 += a[lo + i + 1]
-        r2 += a[lo + i + 2]
-        r3 += a[lo + i + 3]
-        r4 += a[lo + i + 4]
-        r5 += a[lo + i + 5]
-        r6 += a[lo + i + 6]
-        r7 += a[lo + i + 7]
-        i += 8
-    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
-    while i < n:
-        res += a[lo + i]
-        i += 1
-    return res
-
-
-@njit(cache=True, nogil=True)
-def _pairwise_sum(a: np.ndarray, lo: int, n: int) -> float:
-    """numpy's pairwise sum of ``a[lo:lo + n]``: blocks of at most 128 (:func:`_block_sum`),
-    halves (cut at a multiple of 8) added as numpy's recursion adds them, so that a mean over a
-    row is numpy's bit for bit (``tests/test_fused_equivalence.py`` checks it against
-    ``np.mean``). Written without recursion: numba's cache cannot hold recursive functions
-    (a cached one crashed when loaded)."""
-    if n <= 128:
-        return _block_sum(a, lo, n)
-    # post-order walk of numpy's halving tree: a segment is pushed once to be split (state 0)
-    # and once to add its two halves' sums (state 1)
-    seg_lo = np.empty(128, dtype=np.int64)
-    seg_n = np.empty(128, dtype=np.int64)
-    state = np.empty(128, dtype=np.int64)
-    sums = np.empty(128)
-    top, n_sums = 0, 0
-    seg_lo[0], seg_n[0], state[0] = lo, n, 0
-    top = 1
-    while top > 0:
-        top -= 1
-        s_lo, s_n, st = seg_lo[top], seg_n[top], state[top]
-        if s_n <= 128:
-            sums[n_sums] = _block_sum(a, s_lo, s_n)
-            n_sums += 1
-        elif st == 1:                                   # both halves summed: left + right
-            n_sums -= 1
-            sums[n_sums - 1] = sums[n_sums - 1] + sums[n_sums]
-        else:
-            n2 = s_n // 2
-            n2 -= n2 % 8
-            seg_lo[top], seg_n[top], state[top] = s_lo, s_n, 1
-            seg_lo[top + 1], seg_n[top + 1], state[top + 1] = s_lo + n2, s_n - n2, 0
-            seg_lo[top + 2], seg_n[top + 2], state[top + 2] = s_lo, n2, 0
-            top += 3
-    return sums[0]
 
 
 @njit(cache=True, nogil=True)
