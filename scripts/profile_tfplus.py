@@ -45,7 +45,7 @@ def staged(matcher, problem) -> dict[str, float]:
     c0 = clock()
     stride = max(1, len(points) // cfg.coarse_points)
     cands, _, _ = mm.candidates(coarse_field, points, positions, heads, stride, cfg.shortlist,
-                                cfg.candidates, cfg.separation)
+                                cfg.candidates, cfg.separation, cfg.grid_step)
     t["coarse search + candidates"] = clock() - c0
     c0 = clock()
     if isinstance(problem.map, mm.GridMap):

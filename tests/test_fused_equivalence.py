@@ -81,6 +81,30 @@ def test_grid_scores_kernel_equals_the_plain_sum(test_room, lms200) -> None:
     assert got.tobytes() == (expect / len(points)).tobytes()
 
 
+def test_grid_scores_on_a_lattice_equal_the_plain_sum(test_room, lms200) -> None:
+    """The lattice path (one cell index per heading and point) gives the plain loop's scores,
+    also where the pattern leaves the table (clipped) and on a lattice that is no whole number
+    of cells (the plain path)."""
+    from tfloc.maps.fields import distance_field
+    from tfloc.tfplus.coarse import _offsets
+    from tfloc.tfplus.kernels import grid_scores_kernel
+
+    f = distance_field(test_room, 0.05, 0.3)
+    table, (ox, oy) = f.distance, f.corner
+    rng = np.random.default_rng(13)
+    points = np.ascontiguousarray(lms200.to_points(noisy_scan(test_room, lms200, TRUE)))
+    headings = rng.uniform(-math.pi, math.pi, 9)
+    for centre in rng.uniform(-2.0, 9.0, (12, 2)):
+        for step in (0.2, 0.15, 0.07):
+            positions = centre + _offsets(3.3, step)
+            positions = np.ascontiguousarray(positions[rng.random(len(positions)) < 0.7])
+            plain = grid_scores_kernel(table, float(ox), float(oy), f.resolution, points,
+                                       positions, headings)
+            fast = grid_scores_kernel(table, float(ox), float(oy), f.resolution, points,
+                                      positions, headings, step)
+            assert fast.tobytes() == plain.tobytes()
+
+
 def _office_problems(count: int):
     """The first ``count`` scans of each offset cell of detail-1 (the furnished office)."""
     from tfloc.harness.task import load_dataset, problem_of

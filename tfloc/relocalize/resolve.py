@@ -49,7 +49,7 @@ def resolve_places(problem: Problem, places: np.ndarray, cfg: TfPlusConfig,
         if len(positions) == 0:
             positions = place[None, :2]
         best, s, rescored = candidates(coarse, points, positions, heads, stride, cfg.shortlist,
-                                       cfg.candidates, cfg.separation)
+                                       cfg.candidates, cfg.separation, cfg.grid_step)
         cands.append(best)
         scores.append(s)
         evaluations += len(positions) * len(heads) + rescored

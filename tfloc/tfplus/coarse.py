@@ -95,12 +95,13 @@ def pose_scores(field: MapView, points: np.ndarray, poses: np.ndarray) -> np.nda
 
 
 def candidates(field: MapView, points: np.ndarray, positions: np.ndarray, headings: np.ndarray,
-               stride: int, shortlist: int, count: int,
-               separation: float) -> tuple[np.ndarray, np.ndarray, int]:
+               stride: int, shortlist: int, count: int, separation: float,
+               step: float = 0.0) -> tuple[np.ndarray, np.ndarray, int]:
     """Two-level grid search: every position × heading on every ``stride``-th point, then the best
     ``shortlist`` of them on all points, of which up to ``count`` of lowest score at least
     ``separation`` metres apart are returned: ``(C, 3)`` poses, their scores ``(C,)`` and the
-    number of poses rescored. One compiled call
+    number of poses rescored. ``step``: the spacing (metres) of the lattice the positions lie on
+    (:func:`lattice`'s; 0 if none), which saves a cell index per look-up. One compiled call
     (:func:`~tfloc.tfplus.kernels.candidates_kernel`).
 
     The shortlist is ordered by the first level's score, ties for a place by lower index
@@ -113,7 +114,7 @@ def candidates(field: MapView, points: np.ndarray, positions: np.ndarray, headin
                              field.resolution, np.ascontiguousarray(points, dtype=float),
                              int(stride), np.ascontiguousarray(positions, dtype=float),
                              np.ascontiguousarray(headings, dtype=float), int(shortlist),
-                             int(count), float(separation))
+                             int(count), float(separation), float(step))
 
 
 def best_candidates(poses: np.ndarray, scores: np.ndarray, count: int,

@@ -15,17 +15,55 @@ from tfloc.maps._gridcast import _entry, _start, _step
 from tfloc.maps._raycast import _atan2
 from tfloc.maps.inside import raster_code
 
+_EDGE = 1e-6  # cells: a lattice look-up this close to a cell edge is made the plain way
+
+
+@njit(cache=True, nogil=True)
+def _lattice_offsets(positions: np.ndarray, step: float, inv: float,
+                     nx: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """For positions on a square lattice of spacing ``step`` metres, a whole number ``w`` of
+    table cells (``1 / inv`` metres, ``nx`` columns): each one's lattice offset ``(kx, ky)`` from
+    ``positions[0]`` and its flat table offset ``w·(ky·nx + kx)``; ``w`` = 0 when the positions
+    are on no such lattice."""
+    n = positions.shape[0]
+    kx = np.zeros(n, dtype=np.int64)
+    ky = np.zeros(n, dtype=np.int64)
+    flat = np.zeros(n, dtype=np.int64)
+    cells = step * inv
+    w = np.int64(round(cells)) if step > 0.0 else np.int64(0)
+    if n == 0 or w < 1:
+        return kx, ky, flat, 0
+    worst = 0.0
+    for p in range(n):
+        fx = (positions[p, 0] - positions[0, 0]) / step
+        fy = (positions[p, 1] - positions[0, 1]) / step
+        kx[p], ky[p] = np.int64(round(fx)), np.int64(round(fy))
+        if abs(fx - kx[p]) > 1e-6 or abs(fy - ky[p]) > 1e-6:
+            return kx, ky, flat, 0
+        worst = max(worst, abs(float(kx[p])), abs(float(ky[p])))
+        flat[p] = w * (ky[p] * nx + kx[p])
+    if abs(cells - w) * (worst + 1.0) > 1e-8:     # the lattice drifts off the cells
+        return kx, ky, flat, 0
+    return kx, ky, flat, w
+
 
 @njit(cache=True, nogil=True)
 def grid_scores_kernel(table: np.ndarray, origin_x: float, origin_y: float, resolution: float,
-                       points: np.ndarray, positions: np.ndarray,
-                       headings: np.ndarray) -> np.ndarray:
+                       points: np.ndarray, positions: np.ndarray, headings: np.ndarray,
+                       step: float = 0.0) -> np.ndarray:
     """Mean distance-field value ``(N, H)`` of ``points`` ``(M, 2)`` at every position × heading
     (indices clipped into the table, whose border holds the truncation value).
 
     Per heading and point, the cell indices of all positions are computed first (a loop the
     compiler vectorises), then their table values are added; each sum runs over the points in
-    order, so the scores are those of the plain triple loop, bit for bit."""
+    order, so the scores are those of the plain triple loop, bit for bit.
+
+    Positions on a lattice of ``step`` metres that is a whole number ``w`` of cells (the coarse
+    search's; 0: no lattice) need no cell index each: for one heading and point, position ``p``
+    at lattice offset ``(kx, ky)`` from ``positions[0]`` falls in cell ``(ix₀ + w·kx,
+    iy₀ + w·ky)``, ``(ix₀, iy₀)`` the cell of ``positions[0]``'s point. That holds exactly when
+    that point lies more than ``_EDGE`` cells from a cell edge (the plain formula's rounding is
+    ~1e-11 cells) and no index needs clipping; elsewhere the indices are computed as above."""
     ny, nx = table.shape
     n, h, m = positions.shape[0], headings.shape[0], points.shape[0]
     qx = np.empty((h, m))
@@ -39,6 +77,11 @@ def grid_scores_kernel(table: np.ndarray, origin_x: float, origin_y: float, reso
     px = np.ascontiguousarray(positions[:, 0])
     py = np.ascontiguousarray(positions[:, 1])
     flat = table.ravel()
+    kx, ky, offset, w = _lattice_offsets(positions, step, inv, nx)
+    if w > 0:
+        kx_lo, kx_hi, ky_lo, ky_hi = kx.min(), kx.max(), ky.min(), ky.max()
+    else:
+        kx_lo = kx_hi = ky_lo = ky_hi = 0
     acc = np.zeros((h, n))
     idx = np.empty(n, dtype=np.int64)
     # point-major, positions innermost: consecutive look-ups walk the lattice, which is local
@@ -47,6 +90,18 @@ def grid_scores_kernel(table: np.ndarray, origin_x: float, origin_y: float, reso
         row = acc[j]
         for i in range(m):
             x0, y0 = qx[j, i], qy[j, i]
+            if w > 0:
+                bx, by = (px[0] + x0) * inv, (py[0] + y0) * inv
+                fx, fy = math.floor(bx), math.floor(by)
+                ix0, iy0 = np.int64(fx), np.int64(fy)
+                if (bx - fx > _EDGE and fx + 1.0 - bx > _EDGE and by - fy > _EDGE
+                        and fy + 1.0 - by > _EDGE and ix0 + w * kx_lo >= 0
+                        and ix0 + w * kx_hi <= nx - 1 and iy0 + w * ky_lo >= 0
+                        and iy0 + w * ky_hi <= ny - 1):
+                    base = iy0 * nx + ix0
+                    for p in range(n):
+                        row[p] += flat[base + offset[p]]
+                    continue
             for p in range(n):
                 ix = min(max(np.int64(math.floor((px[p] + x0) * inv)), 0), nx - 1)
                 iy = min(max(np.int64(math.floor((py[p] + y0) * inv)), 0), ny - 1)
@@ -501,9 +556,10 @@ def lattice_kernel(centre_x: float, centre_y: float, offsets: np.ndarray, table:
 def candidates_kernel(table: np.ndarray, origin_x: float, origin_y: float, resolution: float,
                       points: np.ndarray, stride: int, positions: np.ndarray,
                       headings: np.ndarray, shortlist: int, count: int,
-                      separation: float) -> tuple[np.ndarray, np.ndarray, int]:
+                      separation: float, step: float) -> tuple[np.ndarray, np.ndarray, int]:
     """The coarse search of :mod:`tfloc.tfplus.coarse` in one call: every position × heading
-    scored on every ``stride``-th of ``points`` (:func:`grid_scores_kernel`), the ``shortlist``
+    scored on every ``stride``-th of ``points`` (:func:`grid_scores_kernel`; positions on a
+    lattice of ``step`` metres, 0: none), the ``shortlist``
     lowest (:func:`smallest_kernel`: ties by index) rescored on all points
     (:func:`pose_scores_kernel`), ordered by that score (stable) and thinned to at most ``count``
     poses ``separation`` metres apart (:func:`separated_kernel`). Returns those candidates
@@ -511,7 +567,7 @@ def candidates_kernel(table: np.ndarray, origin_x: float, origin_y: float, resol
     sub = np.ascontiguousarray(points[::stride])
     h = headings.shape[0]
     first = grid_scores_kernel(table, origin_x, origin_y, resolution, sub, positions,
-                               headings).ravel()
+                               headings, step).ravel()
     top = smallest_kernel(first, shortlist)
     poses = np.empty((top.shape[0], 3))
     for i in range(top.shape[0]):

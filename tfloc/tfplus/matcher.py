@@ -247,7 +247,8 @@ class TurningFunctionPlusMatcher(Configured):
                 positions = vp.xy[None, :]
             stride = max(1, len(points) // cfg.coarse_points) if cfg.coarse_points else cfg.scan_stride
             cands, _, rescored = candidates(_coarse_field(problem.map, cfg), points, positions, heads,
-                                            stride, cfg.shortlist, cfg.candidates, cfg.separation)
+                                            stride, cfg.shortlist, cfg.candidates, cfg.separation,
+                                            cfg.grid_step)
             evaluations = len(positions) * len(heads) + rescored
         else:
             cands = np.column_stack((np.full(len(heads), vp.x), np.full(len(heads), vp.y), heads))
