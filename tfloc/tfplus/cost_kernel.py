@@ -4,7 +4,7 @@ Per beam of the real scan at each candidate pose: the truncated point-to-line re
 map's nearest points (:func:`residual_pen_kernel`), ``c²`` where the map says the beam cannot be
 (see-through: on a vector map against the ray-cast range, :func:`vector_see_through_kernel`; on a
 grid map beyond the far side of the first wall, :func:`~tfloc.tfplus.kernels.see_through_kernel`),
-and the mean over the beams as numpy takes it (:func:`~tfloc.tfplus.kernels._pairwise_sum`). The
+and the mean over the beams as numpy takes it (:func:`tfloc.paper.turning._pairwise_sum`). The
 same values as :func:`tfloc.tfplus.cost.scan_cost_steps`, element by element; from Python the
 steps were a dozen numpy calls, each costing more than its arithmetic.
 """
@@ -17,8 +17,9 @@ import numpy as np
 from numba import njit
 
 from tfloc.maps._raycast import raycast_segments
+from tfloc.paper.turning import _pairwise_sum
 
-from .kernels import _pairwise_sum, _to_nearest, see_through_kernel
+from .kernels import _to_nearest, see_through_kernel
 
 
 @njit(cache=True, nogil=True)
@@ -80,7 +81,7 @@ def _row_means(pen: np.ndarray) -> np.ndarray:
     """``pen.mean(axis=1)`` bit for bit."""
     out = np.empty(pen.shape[0])
     for k in range(pen.shape[0]):
-        out[k] = _pairwise_sum(pen[k], 0, pen.shape[1]) / pen.shape[1]
+        out[k] = _pairwise_sum(pen[k]) / pen.shape[1]
     return out
 
 

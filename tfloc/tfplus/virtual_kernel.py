@@ -18,8 +18,9 @@ import numpy as np
 from numba import njit
 
 from tfloc.maps._raycast import raycast_segments
+from tfloc.paper.turning import _pairwise_sum
 
-from .kernels import _pairwise_sum, pairs_kernel
+from .kernels import pairs_kernel
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
@@ -117,7 +118,7 @@ def truncated_cost_kernel(residuals: np.ndarray, inlier_distance: float) -> np.n
             r = abs(residuals[k, i])
             r = inlier_distance if math.isnan(r) else min(r, inlier_distance)
             sq[i] = r * r
-        out[k] = _pairwise_sum(sq, 0, m) / m
+        out[k] = _pairwise_sum(sq) / m
     return out
 
 
