@@ -190,7 +190,8 @@ def test_pairs_kernel_equals_the_reference(test_room, lms200) -> None:
         poses = _poses(rng, 4)
         q, normal = _virtual_geometry(test_room.raycast(poses, lms200), lms200)
         delta = rng.normal(0.0, 0.02, (4, 3)) if gate > 0.1 else np.zeros((4, 3))
-        got = pairs_kernel(points, delta, q, normal, lms200.angle_min, lms200.resolution, 6, gate)
+        got = pairs_kernel(points, delta, q, normal, lms200.angle_min, lms200.resolution, 6, gate,
+                           np.cos(lms200.angles), np.sin(lms200.angles))
         ref = _pairs_reference(points, delta, q, normal, lms200.angle_min, lms200.resolution, 6,
                                gate)
         for a, b in zip(got, ref, strict=True):

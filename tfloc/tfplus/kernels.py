@@ -213,30 +213,19 @@ def _bearing_index(x: float, y: float, angle_min: float, resolution: float) -> t
     return int(round((math.atan2(y, x) - angle_min) / resolution)), v
 
 
-_BEARING_SLACK = 2e-5  # radians: more than _atan2's error and the beam angles' rounding
-
-
-@njit(cache=True, nogil=True)
-def _off_ray(rho: float, beams: float, resolution: float) -> float:
-    """A lower bound (metres) of the distance from a point ``rho`` metres from the sensor to any
-    point on a ray ``beams`` beams of ``resolution`` radians away from its bearing (the distance
-    to the ray's line, ``rho·sin(angle)``, with ``sin a ≥ a − a³/6``; ``rho`` beyond 90°)."""
-    a = abs(beams) * resolution - _BEARING_SLACK
-    if a <= 0.0:
-        return 0.0
-    if a >= 0.5 * math.pi:
-        return rho
-    return rho * (a - a * a * a / 6.0)
+_SHRINK = 1.0 - 1e-9  # a line's squared distance, less 1e-9 of it and 1e-18 m² for rounding, bounds a pair's
 
 
 @njit(cache=True, nogil=True)
 def pairs_kernel(points: np.ndarray, delta: np.ndarray, q: np.ndarray, normal: np.ndarray,
                  angle_min: float, resolution: float, window: int, gate: float,
+                 cos_a: np.ndarray, sin_a: np.ndarray,
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Point-to-line pairs of each candidate and one Gauss–Newton system.
 
     ``points`` ``(M, 2)`` real points (sensor frame), ``delta`` ``(K, 3)`` current corrections
-    ``(tx, ty, φ)``, ``q``/``normal`` ``(K, n, 2)`` virtual points/unit normals (NaN: none).
+    ``(tx, ty, φ)``, ``q``/``normal`` ``(K, n, 2)`` virtual points/unit normals (NaN: none),
+    ``cos_a``/``sin_a`` ``(n,)`` the beams' directions (the virtual points lie on them).
     Each transformed point ``R(φ) p + t`` is paired with the nearest virtual point within
     ``window`` beams of its bearing if closer than ``gate`` (metres). Returns the normal
     equations ``H`` ``(K, 3, 3)``, ``g`` ``(K, 3)`` and the signed residuals ``(K, M)`` (NaN:
@@ -249,6 +238,7 @@ def pairs_kernel(points: np.ndarray, delta: np.ndarray, q: np.ndarray, normal: n
     res = np.full((k_n, m), np.nan)
     vx = np.empty(n)          # a candidate's virtual points, +inf where there is none (never
     vy = np.empty(n)          # nearer than the gate: the same pairs as skipping them)
+    stops = (window + 1.0) * resolution < 0.5 * math.pi - 0.01   # the lines' distances grow
     for k in range(k_n):
         for j in range(n):
             if math.isnan(q[k, j, 0]) or math.isnan(normal[k, j, 0]):
@@ -265,16 +255,16 @@ def pairs_kernel(points: np.ndarray, delta: np.ndarray, q: np.ndarray, normal: n
             if lo > hi:
                 continue
             # the nearest virtual point within the window (the lowest beam among equals), searched
-            # outwards from the bearing: each side stops at a beam whose ray lies farther from the
-            # point than the best so far (every later beam on that side lies farther still)
-            rho = math.sqrt(x * x + y * y)
+            # outwards from the bearing: each side stops at a beam whose line lies farther from
+            # the point than the best so far (on that side, past the bearing and within 90° of
+            # it, every later beam's line lies farther still)
             best, bj = gate * gate, -1
             left = min(max(j0, lo), hi)
             right = left + 1
             while left >= lo or right <= hi:
                 if left >= lo:
-                    bound = _off_ray(rho, left - v, resolution)
-                    if bound * bound > best and left < v:
+                    off = cos_a[left] * y - sin_a[left] * x      # signed distance to the line
+                    if stops and off * off * _SHRINK - 1e-18 > best and left < v - 0.01:
                         left = lo - 1
                     else:
                         dx, dy = x - vx[left], y - vy[left]
@@ -283,8 +273,8 @@ def pairs_kernel(points: np.ndarray, delta: np.ndarray, q: np.ndarray, normal: n
                             best, bj = d2, left
                         left -= 1
                 if right <= hi:
-                    bound = _off_ray(rho, right - v, resolution)
-                    if bound * bound > best and right > v:
+                    off = cos_a[right] * y - sin_a[right] * x
+                    if stops and off * off * _SHRINK - 1e-18 > best and right > v + 0.01:
                         right = hi + 1
                     else:
                         dx, dy = x - vx[right], y - vy[right]

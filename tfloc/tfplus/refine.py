@@ -141,7 +141,8 @@ def residuals_to(virtual: np.ndarray, laser: LaserSpec, points: np.ndarray, wind
     neighbour within ``gate``."""
     q, normal = _virtual_geometry(virtual, laser)
     _, _, r = pairs_kernel(np.ascontiguousarray(points, dtype=float), np.zeros((len(virtual), 3)),
-                           q, normal, laser.angle_min, laser.resolution, window, gate)
+                           q, normal, laser.angle_min, laser.resolution, window, gate,
+                           *_beam_trig(laser))
     return np.abs(r)
 
 
@@ -181,7 +182,7 @@ def refine(map_: Map, laser: LaserSpec, points: np.ndarray, poses: np.ndarray,
         delta = np.zeros_like(poses)
         for _ in range(cfg.inner):
             h, g, r = pairs_kernel(points, delta, q, normal, laser.angle_min, laser.resolution,
-                                   cfg.window, gates[it])
+                                   cfg.window, gates[it], *_beam_trig(laser))
             enough = (~np.isnan(r)).sum(axis=1) >= 3
             if enough.any():
                 h = h[enough] + cfg.damping * np.eye(3)

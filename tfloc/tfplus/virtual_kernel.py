@@ -88,7 +88,7 @@ def refine_virtual_kernel(poses: np.ndarray, points: np.ndarray, rel_angles: np.
         delta = np.zeros_like(poses)
         for _ in range(inner):
             h, g, r = pairs_kernel(points, delta, q, normal, angle_min, resolution, window,
-                                   gates[it])
+                                   gates[it], cos_a, sin_a)
             for k in range(k_n):
                 paired = 0
                 for i in range(m):
