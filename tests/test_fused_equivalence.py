@@ -337,9 +337,11 @@ def test_compiled_selection_cost_equals_the_numpy_steps(grid: bool, test_room, l
         assert got.tobytes() == ref.tobytes()
 
 
-def test_tf_plus_turning_function_equals_the_step_by_step_one(test_room, lms200) -> None:
+def test_tf_plus_scan_rotations_equal_the_step_by_step_ones(test_room, lms200) -> None:
+    """The seeds' fused call (both turning functions, histograms, correlation, peaks) gives the
+    rotations of the step-by-step turning functions, and None where a polygon is degenerate."""
     from tfloc.paper.shape import ShapeConfig, scan_turning_function
-    from tfloc.tfplus.matcher import _turning_function
+    from tfloc.tfplus.headings import rotation_candidates, scan_rotations
 
     rng = np.random.default_rng(6)
     for shape in (ShapeConfig(spacing=0.05), ShapeConfig(spacing=0.05, resampling="path"),
@@ -347,12 +349,15 @@ def test_tf_plus_turning_function_equals_the_step_by_step_one(test_room, lms200)
         for seed, pose in enumerate(_poses(rng, 6)):
             ranges = noisy_scan(test_room, lms200, Pose(*pose), seed)
             ranges[::23] = np.inf
-            a, b = scan_turning_function(ranges, lms200, shape), _turning_function(ranges, lms200, shape)
-            assert a.breaks.tobytes() == b.breaks.tobytes()
-            assert a.angles.tobytes() == b.angles.tobytes()
+            virtual = test_room.raycast(TRUE, lms200)
+            a, b = scan_turning_function(ranges, lms200, shape), scan_turning_function(virtual, lms200, shape)
+            expect = rotation_candidates(a, b, math.radians(20), 3)
+            got = scan_rotations(ranges, virtual, lms200, shape, math.radians(20), 3)
+            assert got.tobytes() == expect.tobytes()
     few = np.full(lms200.n_beams, np.inf)
     few[90:92] = 2.0
-    assert scan_turning_function(few, lms200) is None and _turning_function(few, lms200, ShapeConfig()) is None
+    assert scan_turning_function(few, lms200) is None
+    assert scan_rotations(few, test_room.raycast(TRUE, lms200), lms200, ShapeConfig(), 0.3, 3) is None
 
 
 def test_lattice_on_a_vector_map_equals_the_map_queries() -> None:

@@ -16,6 +16,7 @@ from functools import lru_cache
 import numpy as np
 from numba import njit
 
+from tfloc.paper.kernels import scan_turning
 from tfloc.paper.turning import TurningFunction
 
 
@@ -138,6 +139,42 @@ def rotation_candidates(real: TurningFunction, virtual: TurningFunction, max_rot
     k = int(np.floor(max_rotation / width))
     c = _correlation(raw, _pair_kernel(bins, float(smoothing)), k)
     return (_peaks(c, count) - k) * width
+
+
+@njit(cache=True, nogil=True)
+def _scan_rotations(real_ranges: np.ndarray, virtual_ranges: np.ndarray, directions: np.ndarray,
+                    max_range: float, spacing: float, window: int, t: float, line_threshold: float,
+                    close_through_origin: bool, along_path: bool, bins: int, skip_closure: bool,
+                    g2: np.ndarray, k_max: int, count: int) -> tuple[np.ndarray, bool]:
+    """:func:`scan_rotations` in one call: both turning functions
+    (:func:`tfloc.paper.kernels.scan_turning`), their histograms and correlation, the peaks;
+    ``False`` (and no rotations) when either polygon has fewer than 3 edges."""
+    rb, ra = scan_turning(real_ranges, directions, max_range, spacing, window, t, line_threshold,
+                          close_through_origin, along_path)
+    vb, va = scan_turning(virtual_ranges, directions, max_range, spacing, window, t,
+                          line_threshold, close_through_origin, along_path)
+    if ra.shape[0] < 3 or va.shape[0] < 3:
+        return np.empty(0), False
+    raw = _raw_histograms(rb, ra, vb, va, bins, skip_closure)
+    c = _correlation(raw, g2, k_max)
+    return (_peaks(c, count) - k_max) * (2 * np.pi / bins), True
+
+
+def scan_rotations(real_ranges: np.ndarray, virtual_ranges: np.ndarray, laser, shape,
+                   max_rotation: float, count: int, bins: int = 720,
+                   smoothing: float = np.radians(1.0), skip_closure: bool = True) -> np.ndarray | None:
+    """:func:`rotation_candidates` of the turning functions of a real and a virtual scan
+    (ranges, metres; a :class:`~tfloc.core.laser.LaserSpec` and a
+    :class:`~tfloc.paper.shape.ShapeConfig`), in one compiled call; ``None`` when either scan's
+    polygon has fewer than 3 edges (no turning function)."""
+    width = 2 * np.pi / bins
+    rots, ok = _scan_rotations(
+        np.asarray(real_ranges, dtype=float), np.asarray(virtual_ranges, dtype=float),
+        laser.directions, float(laser.max_range), float(shape.spacing), int(shape.window),
+        float(shape.straw_t), float(shape.line_threshold), bool(shape.close_through_origin),
+        shape.resampling == "path", bins, skip_closure, _pair_kernel(bins, float(smoothing)),
+        int(np.floor(max_rotation / width)), int(count))
+    return rots if ok else None
 
 
 def rotation_candidates_fft(real: TurningFunction, virtual: TurningFunction, max_rotation: float,

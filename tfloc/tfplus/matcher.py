@@ -47,24 +47,23 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import ClassVar
 
 import numpy as np
 
-from tfloc.core.laser import LaserSpec
 from tfloc.core.map import Map
 from tfloc.core.params import Configured
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
 from tfloc.maps.grid import GridMap
 from tfloc.maps.vector import VectorMap
-from tfloc.paper.kernels import scan_turning
 from tfloc.paper.shape import ShapeConfig, scan_turning_function
-from tfloc.paper.turning import TurningFunction, match
+from tfloc.paper.turning import match
 
 from .coarse import candidates, lattice, pose_scores
 from .cost import scan_cost
-from .headings import rotation_candidates
+from .headings import scan_rotations
 from .refine import RefineConfig, refine, refine_to_field
 from .view import MapView, map_view
 
@@ -158,33 +157,32 @@ def heading_seeds(problem: Problem, cfg: TfPlusConfig) -> tuple[np.ndarray, dict
     ``heading_offsets`` around each (``tf_seed``); θ_VP with its offsets if neither is on."""
     th0 = problem.initial.theta
     info: dict = {}
-    offsets = np.asarray(cfg.heading_offsets)
-    heads = []
-    if cfg.heading_sweep:
-        k = int(round(cfg.heading_span / cfg.heading_step))
-        heads.append(th0 + np.arange(-k, k + 1) * cfg.heading_step)
-    else:
-        heads.append(th0 + offsets)
+    offsets = _heading_offsets(cfg.heading_offsets)
+    heads = [th0 + (_sweep(cfg.heading_span, cfg.heading_step) if cfg.heading_sweep else offsets)]
     if cfg.tf_seed:
-        real = _turning_function(problem.ranges, problem.laser, cfg.shape)
-        virtual = _turning_function(problem.map.raycast(problem.initial, problem.laser),
-                                    problem.laser, cfg.shape)
-        if real is not None and virtual is not None:
-            rots = rotation_candidates(real, virtual, cfg.max_rotation, cfg.rotation_seeds)
-            heads += [th0 - r + offsets for r in rots]
-            info = {"tf_rotations": [float(r) for r in rots]}
+        rots = scan_rotations(problem.ranges, problem.map.raycast(problem.initial, problem.laser),
+                              problem.laser, cfg.shape, cfg.max_rotation, cfg.rotation_seeds)
+        if rots is not None:
+            heads.append(((th0 - rots)[:, None] + offsets[None, :]).ravel())
+            info = {"tf_rotations": rots.tolist()}
     return np.concatenate(heads), info
 
 
-def _turning_function(ranges: np.ndarray, laser: LaserSpec,
-                      shape: ShapeConfig) -> TurningFunction | None:
-    """:func:`tfloc.paper.shape.scan_turning_function` in one compiled call
-    (:func:`tfloc.paper.kernels.scan_turning`, the same kernels in the same order)."""
-    breaks, angles = scan_turning(np.asarray(ranges, dtype=float), laser.directions,
-                                  float(laser.max_range), float(shape.spacing), int(shape.window),
-                                  float(shape.straw_t), float(shape.line_threshold),
-                                  bool(shape.close_through_origin), shape.resampling == "path")
-    return TurningFunction(breaks, angles) if len(angles) >= 3 else None
+@lru_cache(maxsize=16)
+def _sweep(span: float, step: float) -> np.ndarray:
+    """The sweep's offsets ``k·step`` for ``|k| ≤ round(span / step)`` (radians; read-only)."""
+    k = int(round(span / step))
+    out = np.arange(-k, k + 1) * step
+    out.setflags(write=False)
+    return out
+
+
+@lru_cache(maxsize=16)
+def _heading_offsets(offsets: tuple[float, ...]) -> np.ndarray:
+    """``offsets`` as a read-only array (radians)."""
+    out = np.asarray(offsets, dtype=float)
+    out.setflags(write=False)
+    return out
 
 
 def tf_errs(problem: Problem, poses: np.ndarray, cfg: TfPlusConfig) -> np.ndarray:
