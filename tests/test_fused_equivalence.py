@@ -42,6 +42,33 @@ def test_virtual_geometry_kernel_matches_numpy() -> None:
     np.testing.assert_array_equal(kn, n)
 
 
+def test_tangent_rule_from_squares_equals_the_rule_from_hypot() -> None:
+    """The tangent choice of the virtual geometry, decided from squared step lengths where they
+    are clearly apart, equals the choice from ``hypot`` everywhere: also at steps exactly 3:1
+    apart, exactly equal, a ulp apart, zero or missing (NaN)."""
+    from tfloc.tfplus.virtual_kernel import _sides
+
+    def by_hypot(f, b):
+        lf, lb = float(np.hypot(*f)), float(np.hypot(*b))     # libm's, as numba's and numpy's
+        lf, lb = (math.inf if math.isnan(x) else x for x in (lf, lb))
+        return 0 if (lf < 3 * lb and lb < 3 * lf) else (-1 if lf <= lb else 1)
+
+    rng = np.random.default_rng(14)
+    cases = [((3.0, 0.0), (1.0, 0.0)), ((1.0, 0.0), (3.0, 0.0)), ((0.0, 2.0), (2.0, 0.0)),
+             ((0.6, 0.8), (1.0, 0.0)), ((3.0, 4.0), (0.0, 5.0)), ((0.0, 0.0), (1.0, 0.0)),
+             ((0.0, 0.0), (0.0, 0.0)), ((np.nan, np.nan), (1.0, 0.0)),
+             ((1.0, 0.0), (np.nan, np.nan)), ((np.nan, np.nan), (np.nan, np.nan)),
+             ((math.nextafter(3.0, 4.0), 0.0), (1.0, 0.0)), ((math.nextafter(3.0, 2.0), 0.0), (1.0, 0.0))]
+    for _ in range(2000):
+        f = rng.normal(0, 1, 2)
+        k = rng.choice([1.0, 3.0, 1 / 3, rng.uniform(0.1, 10)])
+        angle = rng.uniform(-math.pi, math.pi)
+        b = np.hypot(*f) * k * np.array([math.cos(angle), math.sin(angle)])
+        cases.append((tuple(f), tuple(b)))
+    for f, b in cases:
+        assert _sides(f[0], f[1], b[0], b[1]) == by_hypot(f, b), (f, b)
+
+
 @pytest.mark.parametrize("config", [RefineConfig(), RefineConfig(prune_after=0),
                                     RefineConfig(iterations=3, prune_after=3, keep=1),
                                     RefineConfig(iterations=4, inner=1, prune_after=9)])

@@ -22,6 +22,38 @@ from tfloc.paper.turning import _pairwise_sum
 
 from .kernels import pairs_kernel
 
+_SURE = 1e-12  # relative: squared lengths this far apart order their hypot()s the same way
+
+
+@njit(cache=True, nogil=True)
+def _sides(fx: float, fy: float, bx: float, by: float) -> int:
+    """Which tangent :func:`tfloc.tfplus.refine._virtual_geometry` takes at a virtual point, with
+    steps ``f`` to the next and ``b`` from the previous point (NaN: none): 0 the central
+    difference (``lf < 3·lb`` and ``lb < 3·lf``), -1 the forward step (``lf ≤ lb``), 1 the
+    backward one, for the lengths ``lf = hypot(f)``, ``lb = hypot(b)`` (NaN as +inf).
+
+    Decided from the squared lengths where they are clearly apart (``hypot`` is within an ulp of
+    the true length, so the comparisons agree) and from ``hypot`` itself where they are within
+    ``_SURE``: the same decisions as with ``hypot`` alone, for a third of its calls."""
+    sf, sb = fx * fx + fy * fy, bx * bx + by * by
+    if not (math.isnan(sf) or math.isnan(sb) or math.isinf(sf) or math.isinf(sb)):
+        lo, hi = 1.0 - _SURE, 1.0 + _SURE
+        c1 = 1 if sf < 9.0 * sb * lo else (0 if sf > 9.0 * sb * hi else -1)   # lf < 3·lb?
+        c2 = 1 if sb < 9.0 * sf * lo else (0 if sb > 9.0 * sf * hi else -1)   # lb < 3·lf?
+        c3 = 1 if sf < sb * lo else (0 if sf > sb * hi else -1)               # lf ≤ lb?
+        if c1 >= 0 and c2 >= 0 and (c1 == 1 and c2 == 1 or c3 >= 0):
+            if c1 == 1 and c2 == 1:
+                return 0
+            return -1 if c3 == 1 else 1
+    lf, lb = math.hypot(fx, fy), math.hypot(bx, by)
+    if math.isnan(lf):
+        lf = np.inf
+    if math.isnan(lb):
+        lb = np.inf
+    if lf < 3 * lb and lb < 3 * lf:
+        return 0
+    return -1 if lf <= lb else 1
+
 
 @njit(cache=True, nogil=True, error_model="numpy")
 def virtual_geometry_kernel(ranges: np.ndarray, cos_a: np.ndarray, sin_a: np.ndarray,
@@ -32,7 +64,7 @@ def virtual_geometry_kernel(ranges: np.ndarray, cos_a: np.ndarray, sin_a: np.nda
     k_n, n = ranges.shape
     q = np.empty((k_n, n, 2))
     normal = np.empty((k_n, n, 2))
-    nan, inf = np.nan, np.inf
+    nan = np.nan
     for k in range(k_n):
         for b in range(n):
             r = ranges[k, b]
@@ -49,14 +81,10 @@ def virtual_geometry_kernel(ranges: np.ndarray, cos_a: np.ndarray, sin_a: np.nda
                 bx, by = q[k, b, 0] - q[k, b - 1, 0], q[k, b, 1] - q[k, b - 1, 1]
             else:
                 bx, by = nan, nan
-            lf, lb = math.hypot(fx, fy), math.hypot(bx, by)
-            if math.isnan(lf):
-                lf = inf
-            if math.isnan(lb):
-                lb = inf
-            if lf < 3 * lb and lb < 3 * lf:      # central difference on smooth stretches
+            side = _sides(fx, fy, bx, by)
+            if side == 0:                       # central difference on smooth stretches
                 tx, ty = fx + bx, fy + by
-            elif lf <= lb:                      # the shorter side across a jump or a corner
+            elif side < 0:                      # the shorter side across a jump or a corner
                 tx, ty = fx, fy
             else:
                 tx, ty = bx, by
