@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 from tfloc.core.laser import LaserSpec
 from tfloc.core.pose import Pose
 from tfloc.maps._raycast import raycast_segments, raycast_segments_bruteforce
+from tfloc.maps.segment_index import MIN_SEGMENTS, NO_INDEX, build_index
 from tfloc.maps.vector import VectorMap
 
 LASERS = [
@@ -33,8 +34,8 @@ def _both(poses, laser, segs):
     poses = np.ascontiguousarray(np.asarray(poses, dtype=float).reshape(-1, 3))
     segs = np.ascontiguousarray(np.asarray(segs, dtype=float).reshape(-1, 4))
     a = np.asarray(laser.angles, dtype=float)
-    return (raycast_segments(poses, a, segs, laser.max_range),
-            raycast_segments_bruteforce(poses, a, segs, laser.max_range))
+    return (raycast_segments(poses, a, segs, laser.max_range, NO_INDEX),
+            raycast_segments_bruteforce(poses, a, segs, laser.max_range, NO_INDEX))
 
 
 @pytest.mark.parametrize("laser", LASERS, ids=lambda s: f"{math.degrees(s.fov):.0f}deg")
@@ -125,8 +126,8 @@ def test_non_uniform_angles_fall_back_to_bruteforce():
     angles = np.sort(rng.uniform(-np.pi, np.pi, 50))
     segs = np.ascontiguousarray(rng.uniform(-5, 5, (30, 4)))
     poses = np.ascontiguousarray(np.column_stack((rng.uniform(-5, 5, (5, 2)), np.zeros(5))))
-    np.testing.assert_array_equal(raycast_segments(poses, angles, segs, 10.0),
-                                  raycast_segments_bruteforce(poses, angles, segs, 10.0))
+    np.testing.assert_array_equal(raycast_segments(poses, angles, segs, 10.0, NO_INDEX),
+                                  raycast_segments_bruteforce(poses, angles, segs, 10.0, NO_INDEX))
 
 
 def test_fast_atan2_error_bound():
@@ -152,6 +153,37 @@ def test_poses_sharing_a_position_give_the_ranges_of_single_casts(laser):
         poses += [[x, y, th + k * math.radians(1.0)] for k in range(-3, 4)]
     poses = np.ascontiguousarray(poses)
     a = np.asarray(laser.angles, dtype=float)
-    batch = raycast_segments(poses, a, segs, laser.max_range)
-    single = np.vstack([raycast_segments(p[None], a, segs, laser.max_range) for p in poses])
+    batch = raycast_segments(poses, a, segs, laser.max_range, NO_INDEX)
+    single = np.vstack([raycast_segments(p[None], a, segs, laser.max_range, NO_INDEX) for p in poses])
     np.testing.assert_array_equal(batch, single)
+
+
+@pytest.mark.parametrize("laser", LASERS[:3], ids=lambda s: f"{math.degrees(s.fov):.0f}deg")
+def test_the_segment_index_gives_the_ranges_of_the_linear_test(laser):
+    """With the map's segments bucketed, a cast tests only the cells within range: the same
+    ranges, bit for bit, for poses inside, at the edge of and outside the indexed area, and the
+    same through the brute force."""
+    rng = np.random.default_rng(15)
+    segs = np.ascontiguousarray(np.vstack((rng.uniform(-40, 40, (MIN_SEGMENTS, 2)),)).repeat(2, axis=1))
+    segs[:, 2:] += rng.normal(0, 1.5, (MIN_SEGMENTS, 2))           # short walls all over
+    segs = np.ascontiguousarray(np.vstack((segs, [[-45.0, -45.0, 45.0, 45.0]])))   # and a long one
+    index = build_index(segs, laser.max_range)
+    assert index[3] > 0 and build_index(segs[:MIN_SEGMENTS - 1], laser.max_range)[3] == 0
+    poses = np.column_stack((rng.uniform(-60, 60, (300, 2)), rng.uniform(-4, 4, 300)))
+    poses = np.ascontiguousarray(np.vstack((poses, np.repeat(poses[:5], 7, axis=0))))
+    a = np.asarray(laser.angles, dtype=float)
+    plain = raycast_segments(poses, a, segs, laser.max_range, NO_INDEX)
+    np.testing.assert_array_equal(raycast_segments(poses, a, segs, laser.max_range, index), plain)
+    np.testing.assert_array_equal(
+        raycast_segments_bruteforce(poses[:40], a, segs, laser.max_range, index), plain[:40])
+    assert np.isfinite(plain).mean() > 0.05                         # the walls are seen
+
+
+def test_a_vector_map_builds_its_index_once_per_range():
+    rng = np.random.default_rng(16)
+    xy = rng.uniform(0, 50, (MIN_SEGMENTS + 10, 2))
+    m = VectorMap.from_segments(np.hstack((xy, xy + rng.normal(0, 1, xy.shape))))
+    assert m.segment_index(10.0) is m.segment_index(10.0)
+    assert m.segment_index(30.0)[2] != m.segment_index(10.0)[2]
+    small = VectorMap.from_segments(np.array([[0.0, 0.0, 1.0, 1.0]]))
+    assert small.segment_index(10.0) is NO_INDEX

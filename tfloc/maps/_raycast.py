@@ -13,6 +13,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .segment_index import candidates
+
 _U_TOL = 1e-9          # hits within this fraction of a segment's length beyond its ends count
 _ANGLE_MARGIN = 1e-4   # radians added on both sides of a segment's arc (≫ the error of _atan2)
 
@@ -38,11 +40,20 @@ def _atan2(y: float, x: float) -> float:
 
 @njit(cache=True, nogil=True)
 def _near_segments(ox: float, oy: float, segs: np.ndarray, max_range: float,
-                   near: np.ndarray, dist: np.ndarray) -> int:
+                   near: np.ndarray, dist: np.ndarray, index: tuple, seen: np.ndarray,
+                   stamp: int) -> int:
     """Indices (into ``near``) and distances (``dist``) of the segments closer than ``max_range``
-    to ``(ox, oy)``; returns their count."""
+    to ``(ox, oy)``; returns their count. With a segment ``index``
+    (:mod:`tfloc.maps.segment_index`; ``nx`` > 0) only the segments of the cells within range
+    are tested (``seen``/``stamp``: see :func:`~tfloc.maps.segment_index.candidates`), else all:
+    the same segments either way, in another order."""
+    if index[3] > 0:
+        n_c = candidates(index, ox, oy, max_range, seen, stamp, near)
+    else:
+        n_c = segs.shape[0]
     k = 0
-    for m in range(segs.shape[0]):
+    for c in range(n_c):
+        m = near[c] if index[3] > 0 else c
         ax, ay = segs[m, 0] - ox, segs[m, 1] - oy
         ex, ey = segs[m, 2] - segs[m, 0], segs[m, 3] - segs[m, 1]
         ll = ex * ex + ey * ey
@@ -79,7 +90,7 @@ def _hit(ox: float, oy: float, dx: float, dy: float, seg: np.ndarray, best: floa
 
 @njit(cache=True, fastmath=False, nogil=True)
 def raycast_segments_bruteforce(poses: np.ndarray, rel_angles: np.ndarray, segs: np.ndarray,
-                                max_range: float) -> np.ndarray:
+                                max_range: float, index: tuple) -> np.ndarray:
     """Reference kernel: every beam against every nearby segment, O(P·(M + B·M_near)).
 
     Same contract as :func:`raycast_segments`; works for any beam angles.
@@ -90,9 +101,10 @@ def raycast_segments_bruteforce(poses: np.ndarray, rel_angles: np.ndarray, segs:
     out = np.full((P, B), np.inf)
     near = np.empty(M, dtype=np.int64)
     dist = np.empty(M)
+    seen = np.zeros(M if index[3] > 0 else 0, dtype=np.int64)
     for p in range(P):
         ox, oy, th = poses[p, 0], poses[p, 1], poses[p, 2]
-        k = _near_segments(ox, oy, segs, max_range, near, dist)
+        k = _near_segments(ox, oy, segs, max_range, near, dist, index, seen, p + 1)
         for b in range(B):
             a = th + rel_angles[b]
             dx, dy = np.cos(a), np.sin(a)
@@ -152,13 +164,14 @@ def _near_first(dist: np.ndarray, k: int, max_range: float) -> np.ndarray:
 def _arcs(ox: float, oy: float, segs: np.ndarray, max_range: float, dev: float,
           near: np.ndarray, dist: np.ndarray, seg_of: np.ndarray, every: np.ndarray,
           start: np.ndarray, width: np.ndarray, margin: np.ndarray, h_safe: np.ndarray,
-          den_min: np.ndarray, ex: np.ndarray, ey: np.ndarray) -> int:
+          den_min: np.ndarray, ex: np.ndarray, ey: np.ndarray, index: tuple, seen: np.ndarray,
+          stamp: int) -> int:
     """What :func:`raycast_segments` needs of the segments seen from ``(ox, oy)``, independent of
     the heading: the segments within ``max_range``, near first (``seg_of``, :func:`_near_first`), whether each must
     be tested against every beam (``every``), else the arc it subtends (``start``, ``width``,
     ``margin``) and its occlusion test (``h_safe``, ``den_min``, ``ex``, ``ey``); returns their count."""
     two_pi = 2.0 * np.pi
-    k = _near_segments(ox, oy, segs, max_range, near, dist)
+    k = _near_segments(ox, oy, segs, max_range, near, dist, index, seen, stamp)
     order = _near_first(dist, k, max_range)
     for jj in range(k):
         j = order[jj]
@@ -184,7 +197,7 @@ def _arcs(ox: float, oy: float, segs: np.ndarray, max_range: float, dev: float,
         every[jj] = False
         # A beam hit (within the u tolerance) lies ≥ h − slack away; with |den| ≥ den_min the
         # computed t is within 1e-9 (relative) of the true one, so a beam whose nearest hit
-        # so far is below h_safe cannot be hit here (segments are visited front to back).
+        # so far is below h_safe cannot be hit here (whatever the order segments are visited in).
         ex[jj], ey[jj] = bx - ax, by - ay
         h_safe[jj] = (h - slack) * (1.0 - 1e-9)
         den_min[jj] = 1e-5 * length * (1.0 + length / h)
@@ -196,10 +209,12 @@ def _arcs(ox: float, oy: float, segs: np.ndarray, max_range: float, dev: float,
 
 @njit(cache=True, fastmath=False, nogil=True)
 def raycast_segments(poses: np.ndarray, rel_angles: np.ndarray, segs: np.ndarray,
-                     max_range: float) -> np.ndarray:
+                     max_range: float, index: tuple) -> np.ndarray:
     """Ranges from each pose ``(P, 3)`` along each beam ``(B,)`` to the nearest of ``segs``
     ``(M, 4)`` = (ax, ay, bx, by). No hit before ``max_range`` gives ``inf``. Metres, radians.
 
+    ``index``: the map's segment buckets (:func:`tfloc.maps.segment_index.build_index`, or
+    :data:`~tfloc.maps.segment_index.NO_INDEX` to test every segment for range).
     ``rel_angles`` (relative to each pose's heading) should be uniformly spaced and increasing,
     as a :class:`~tfloc.core.laser.LaserSpec` gives them; otherwise (deviation above 1e-6 rad) the
     brute-force kernel is used. Segments farther than ``max_range`` are culled; each remaining
@@ -215,7 +230,7 @@ def raycast_segments(poses: np.ndarray, rel_angles: np.ndarray, segs: np.ndarray
     M = segs.shape[0]
     a0, res, dev = _uniform_spacing(rel_angles)
     if res == 0.0 or dev > 1e-6:
-        return raycast_segments_bruteforce(poses, rel_angles, segs, max_range)
+        return raycast_segments_bruteforce(poses, rel_angles, segs, max_range, index)
     two_pi = 2.0 * np.pi
     out = np.full((P, B), np.inf)
     best = np.empty(B)
@@ -232,6 +247,7 @@ def raycast_segments(poses: np.ndarray, rel_angles: np.ndarray, segs: np.ndarray
     den_min = np.empty(M)
     ex = np.empty(M)
     ey = np.empty(M)
+    seen = np.zeros(M if index[3] > 0 else 0, dtype=np.int64)
     k = 0
     wrap_up = two_pi / res <= B - 1.0   # can an arc one turn up reach a beam (360° scanners)?
     for p in range(P):
@@ -242,7 +258,7 @@ def raycast_segments(poses: np.ndarray, rel_angles: np.ndarray, segs: np.ndarray
             best[b] = max_range
         if p == 0 or ox != poses[p - 1, 0] or oy != poses[p - 1, 1]:
             k = _arcs(ox, oy, segs, max_range, dev, near, dist, seg_of, every, start, width,
-                      margin, h_safe, den_min, ex, ey)
+                      margin, h_safe, den_min, ex, ey, index, seen, p + 1)
         for jj in range(k):
             seg = segs[seg_of[jj]]
             if every[jj]:

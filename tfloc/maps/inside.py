@@ -110,11 +110,61 @@ def raster_kernel(segs: np.ndarray, x0: float, y0: float, res: float, nx: int,
 
 
 @njit(cache=True, nogil=True)
-def raster_code(x: float, y: float, codes: np.ndarray, x0: float, y0: float, res: float,
-                segs: np.ndarray, sure: float) -> int:
-    """:func:`inside_kernel`'s answer for one point, from the cell codes of
-    :func:`raster_kernel` where the point's cell is pure (outside the raster: outside), else from
-    :func:`inside_kernel`."""
+def _row_inside(x: float, y: float, segs: np.ndarray, items: np.ndarray, lo: int, hi: int,
+                sure: float) -> int:
+    """:func:`inside_kernel`'s answer for one point from the segments ``items[lo:hi]`` of its
+    raster row (every segment that could cross the point's horizontal or come within ``sure``
+    of it): the same crossings and near tests, for the row's segments only."""
+    s2 = sure * sure
+    inside = False
+    for t in range(lo, hi):
+        m = items[t]
+        x1, y1, x2, y2 = segs[m, 0], segs[m, 1], segs[m, 2], segs[m, 3]
+        ex, ey = x2 - x1, y2 - y1
+        ll = ex * ex + ey * ey
+        u = 0.0
+        if ll > 0.0:
+            u = min(1.0, max(0.0, ((x - x1) * ex + (y - y1) * ey) / ll))
+        dx, dy = x1 + u * ex - x, y1 + u * ey - y
+        if dx * dx + dy * dy <= s2:
+            return -1
+        if (y1 > y) != (y2 > y) and x < x1 + (y - y1) * ex / ey:
+            inside = not inside
+    return 1 if inside else 0
+
+
+@njit(cache=True, nogil=True)
+def row_buckets(segs: np.ndarray, y0: float, res: float, ny: int,
+                sure: float) -> tuple[np.ndarray, np.ndarray]:
+    """For each raster row ``(ny,)`` the segments whose y-range, widened by ``sure``, meets the
+    row: ``start`` ``(ny + 1,)`` and ``items`` (in segment order within a row)."""
+    counts = np.zeros(ny + 1, dtype=np.int64)
+    for m in range(segs.shape[0]):
+        r0 = max(int(math.floor((min(segs[m, 1], segs[m, 3]) - sure - y0) / res)), 0)
+        r1 = min(int(math.floor((max(segs[m, 1], segs[m, 3]) + sure - y0) / res)), ny - 1)
+        for r in range(r0, r1 + 1):
+            counts[r + 1] += 1
+    for r in range(ny):
+        counts[r + 1] += counts[r]
+    items = np.empty(counts[ny], dtype=np.int64)
+    fill = counts[:-1].copy()
+    for m in range(segs.shape[0]):
+        r0 = max(int(math.floor((min(segs[m, 1], segs[m, 3]) - sure - y0) / res)), 0)
+        r1 = min(int(math.floor((max(segs[m, 1], segs[m, 3]) + sure - y0) / res)), ny - 1)
+        for r in range(r0, r1 + 1):
+            items[fill[r]] = m
+            fill[r] += 1
+    return counts, items
+
+
+@njit(cache=True, nogil=True)
+def raster_code(x: float, y: float, rings: tuple, sure: float) -> int:
+    """:func:`inside_kernel`'s answer for one point, from the cell codes of :func:`raster_kernel`
+    where the point's cell is pure (outside the raster: outside), else from the crossings with
+    the segments of its row (:func:`_row_inside`: the same answer, without testing every segment
+    of the map). ``rings`` is :attr:`Rings.kernel` = ``(codes, x0, y0, res, segs, row_start,
+    row_items)``."""
+    codes, x0, y0, res, segs, row_start, row_items = rings
     ny, nx = codes.shape
     fx = math.floor((x - x0) / res)
     fy = math.floor((y - y0) / res)
@@ -123,16 +173,15 @@ def raster_code(x: float, y: float, codes: np.ndarray, x0: float, y0: float, res
     code = codes[int(fy), int(fx)]
     if code >= 0:
         return code
-    return inside_kernel(np.array([x]), np.array([y]), segs, sure)[0]
+    return _row_inside(x, y, segs, row_items, row_start[int(fy)], row_start[int(fy) + 1], sure)
 
 
 @njit(cache=True, nogil=True)
-def raster_inside_kernel(xs: np.ndarray, ys: np.ndarray, codes: np.ndarray, x0: float, y0: float,
-                         res: float, segs: np.ndarray, sure: float) -> np.ndarray:
+def raster_inside_kernel(xs: np.ndarray, ys: np.ndarray, rings: tuple, sure: float) -> np.ndarray:
     """:func:`raster_code` of every point ``(xs[i], ys[i])``."""
     out = np.empty(xs.shape[0], dtype=np.int8)
     for i in range(xs.shape[0]):
-        out[i] = raster_code(xs[i], ys[i], codes, x0, y0, res, segs, sure)
+        out[i] = raster_code(xs[i], ys[i], rings, sure)
     return out
 
 
@@ -148,6 +197,13 @@ class Rings:
     x0: float
     y0: float
     res: float
+    row_start: np.ndarray   # the segments of each raster row (row_buckets): where a row's start
+    row_items: np.ndarray   # ... and the segments' indices
+
+    @property
+    def kernel(self) -> tuple:
+        """What the compiled tests take (:func:`raster_code`)."""
+        return (self.codes, self.x0, self.y0, self.res, self.segs, self.row_start, self.row_items)
 
     @classmethod
     def of(cls, geom: BaseGeometry) -> Rings | None:
@@ -166,14 +222,15 @@ class Rings:
         x0, y0 = x_min - 2 * res, y_min - 2 * res       # two cells beyond the bounds
         nx = int(math.ceil((x_max - x_min) / res)) + 4
         ny = int(math.ceil((y_max - y_min) / res)) + 4
-        return cls(geom, segs, raster_kernel(segs, x0, y0, res, nx, ny), x0, y0, res)
+        start, items = row_buckets(segs, y0, res, ny, SURE)
+        return cls(geom, segs, raster_kernel(segs, x0, y0, res, nx, ny), x0, y0, res, start, items)
 
     def contains(self, xy: np.ndarray, boundary: bool) -> np.ndarray:
         """Which ``(N, 2)`` points lie in the interior (``boundary`` False: ``contains_xy``) or in
         the interior or on the boundary (True: ``intersects_xy``)."""
         x = np.ascontiguousarray(xy[:, 0], dtype=float)
         y = np.ascontiguousarray(xy[:, 1], dtype=float)
-        code = raster_inside_kernel(x, y, self.codes, self.x0, self.y0, self.res, self.segs, SURE)
+        code = raster_inside_kernel(x, y, self.kernel, SURE)
         out = code == 1
         unsure = code < 0
         if unsure.any():

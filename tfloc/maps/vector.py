@@ -15,6 +15,7 @@ from tfloc.core.pose import Pose
 
 from ._raycast import raycast_segments
 from .inside import Rings
+from .segment_index import build_index
 
 
 def _segments_of(geom: BaseGeometry) -> np.ndarray:
@@ -67,6 +68,15 @@ class VectorMap:
         keep = np.hypot(segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1]) > 1e-12
         return np.ascontiguousarray(segs[keep])
 
+    def segment_index(self, max_range: float) -> tuple:
+        """The segments' buckets for casts of ``max_range`` metres
+        (:func:`tfloc.maps.segment_index.build_index`; built once per range; ``NO_INDEX`` on a
+        small map)."""
+        key = ("segment-index", round(float(max_range), 9))
+        if key not in self._free_cache:
+            self._free_cache[key] = build_index(self.segments, max_range)
+        return self._free_cache[key]
+
     @cached_property
     def area(self) -> BaseGeometry:
         """The mapped area: ``outline``, else ``region``, else the convex hull of all geometry."""
@@ -88,7 +98,8 @@ class VectorMap:
         """
         arr, single = as_pose_array(poses)
         r = raycast_segments(np.ascontiguousarray(arr), np.asarray(laser.angles, dtype=float),
-                             self.segments, float(laser.max_range))
+                             self.segments, float(laser.max_range),
+                             self.segment_index(float(laser.max_range)))
         return r[0] if single else r
 
     def _free_space(self, clearance: float) -> BaseGeometry:

@@ -78,14 +78,16 @@ def scan_errors(scans: np.ndarray, directions: np.ndarray, max_range: float, spa
 
 @njit(cache=True, nogil=True)
 def function1_kernel(x: float, y: float, theta_v: float, offsets: np.ndarray, rings: tuple,
-                     sure: float, rel_angles: np.ndarray, segs: np.ndarray, directions: np.ndarray,
+                     sure: float, rel_angles: np.ndarray, segs: np.ndarray, index: tuple,
+                     directions: np.ndarray,
                      max_range: float, spacing: float, window: int, t: float,
                      line_threshold: float, close_through_origin: bool, along_path: bool,
                      l1: bool, real_breaks: np.ndarray, real_angles: np.ndarray,
                      penalty: float) -> tuple[int, float, float, float]:
-    """Alg. 5's Function1 at ``(x, y)`` on a vector map (segments ``segs``), in one call: whether
+    """Alg. 5's Function1 at ``(x, y)`` on a vector map (segments ``segs``, their buckets
+    ``index``), in one call: whether
     the position is free (:func:`tfloc.maps.inside.raster_code` on the free space's ``rings`` =
-    ``(codes, x0, y0, res, segments)`` of :class:`~tfloc.maps.inside.Rings`; ``sure`` < 0 skips
+    ``Rings.kernel`` of :class:`~tfloc.maps.inside.Rings`; ``sure`` < 0 skips
     the test, the caller having made it), the virtual scans of the headings
     ``theta_v + offsets`` (:func:`tfloc.maps._raycast.raycast_segments`), their Err and rotation
     offsets (:func:`scan_errors`) and the best of them (the first lowest Err, as ``np.argmin``).
@@ -93,15 +95,14 @@ def function1_kernel(x: float, y: float, theta_v: float, offsets: np.ndarray, ri
     Returns ``(code, Err, heading, rotation)``: code 1 answered, 0 not free (the rest unset),
     -1 too near the free space's boundary to say (ask shapely, then call again with ``sure`` < 0)."""
     if sure >= 0.0:
-        codes, x0, y0, res, ring_segs = rings
-        code = raster_code(x, y, codes, x0, y0, res, ring_segs, sure)
+        code = raster_code(x, y, rings, sure)
         if code != 1:
             return np.int64(code), penalty, theta_v + offsets[0], 0.0
     n = offsets.shape[0]
     poses = np.empty((n, 3))
     for k in range(n):
         poses[k, 0], poses[k, 1], poses[k, 2] = x, y, theta_v + offsets[k]
-    scans = raycast_segments(poses, rel_angles, segs, max_range)
+    scans = raycast_segments(poses, rel_angles, segs, max_range, index)
     err, rot = scan_errors(scans, directions, max_range, spacing, window, t, line_threshold,
                            close_through_origin, along_path, l1, real_breaks, real_angles, penalty)
     b = 0

@@ -180,21 +180,22 @@ class _Cost:
         if _FUSED and isinstance(m, VectorMap):   # Function1 in one compiled call
             r = m.free_rings(build=True)            # hundreds of free tests per scan
             if r is not None:                       # (else shapely's geometry: the Python path)
-                self._vector = (self._offsets, (r.codes, r.x0, r.y0, r.res, r.segs), SURE,
-                                np.asarray(laser.angles, dtype=float), m.segments)
+                self._vector = (self._offsets, r.kernel, SURE,
+                                np.asarray(laser.angles, dtype=float), m.segments,
+                                m.segment_index(float(laser.max_range)))
 
     def _function1_vector(self, x: float, y: float, theta_v: float) -> tuple[float, float, float]:
         """:meth:`function1`'s evaluation on a vector map: one compiled call
         (:func:`tfloc.paper.kernels.function1_kernel`), shapely only near the free space's
         boundary; the same values as the general path."""
-        offsets, rings, sure, angles, segs = self._vector
+        offsets, rings, sure, angles, segs, index = self._vector
         code, err, heading, rot = function1_kernel(x, y, theta_v, offsets, rings, sure, angles,
-                                                   segs, *self._kernel_args)
+                                                   segs, index, *self._kernel_args)
         if code < 0:
             if not self.problem.map.is_free(np.array([[x, y]]))[0]:
                 return float(self.config.penalty), float(theta_v + offsets[0]), 0.0
             code, err, heading, rot = function1_kernel(x, y, theta_v, offsets, rings, -1.0, angles,
-                                                       segs, *self._kernel_args)
+                                                       segs, index, *self._kernel_args)
         return float(err), float(heading), float(rot)
 
     def _scan_errors(self, scans: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

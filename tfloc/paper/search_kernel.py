@@ -55,10 +55,10 @@ def _f(cache, x: float, y: float, theta_v: float, args) -> tuple[int, float]:
     key = (x, y)
     if key in cache:
         return 1, cache[key][0]
-    (offsets, rings, sure, rel_angles, segs, directions, max_range, spacing, window, t,
+    (offsets, rings, sure, rel_angles, segs, index, directions, max_range, spacing, window, t,
      line_threshold, close_through_origin, along_path, l1, real_breaks, real_angles,
      penalty) = args
-    code, e, h, r = function1_kernel(x, y, theta_v, offsets, rings, sure, rel_angles, segs,
+    code, e, h, r = function1_kernel(x, y, theta_v, offsets, rings, sure, rel_angles, segs, index,
                                      directions, max_range, spacing, window, t, line_threshold,
                                      close_through_origin, along_path, l1, real_breaks,
                                      real_angles, penalty)

@@ -45,9 +45,8 @@ def lattice(map_: Map, field: MapView, centre: np.ndarray, radius: float, step: 
             corner = field.origin
             positions, decided = lattice_kernel(
                 float(centre[0]), float(centre[1]), offsets, field.table, float(corner[0]),
-                float(corner[1]), field.resolution, field.table.dtype.type(clearance), area.codes,
-                area.x0, area.y0, area.res, area.segs, free.codes, free.x0, free.y0, free.res,
-                free.segs, SURE)
+                float(corner[1]), field.resolution, field.table.dtype.type(clearance),
+                area.kernel, free.kernel, SURE)
             if decided:
                 return positions
     if isinstance(map_, GridMap):

@@ -68,7 +68,8 @@ def _compiled_cost(map_: VectorMap | GridMap, laser: LaserSpec, ranges: np.ndarr
     if isinstance(map_, GridMap):
         return grid_cost_kernel(*args, map_.occupied, float(map_.origin[0]),
                                 float(map_.origin[1]), float(map_.resolution), c, beam_check)
-    return vector_cost_kernel(*args, map_.segments, c, beam_check)
+    return vector_cost_kernel(*args, map_.segments, map_.segment_index(float(laser.max_range)), c,
+                              beam_check)
 
 
 def scan_cost_steps(map_: Map, laser: LaserSpec, ranges: np.ndarray, poses: np.ndarray,

@@ -89,14 +89,14 @@ def _row_means(pen: np.ndarray) -> np.ndarray:
 def vector_cost_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, resolution: float,
                        map_points: np.ndarray, map_normals: np.ndarray, ranges: np.ndarray,
                        directions: np.ndarray, angles: np.ndarray, max_range: float,
-                       poses: np.ndarray, segs: np.ndarray, c: float,
+                       poses: np.ndarray, segs: np.ndarray, index: tuple, c: float,
                        beam_check: bool) -> np.ndarray:
     """The selection cost ``(K,)`` (metres²) at ``poses`` ``(K, 3)`` on a vector map (segments
-    ``segs``): see the module docstring."""
+    ``segs``, their buckets ``index``): see the module docstring."""
     pen = residual_pen_kernel(nearest, origin_x, origin_y, resolution, map_points, map_normals,
                               ranges, directions, max_range, poses, c)
     if beam_check:
-        virtual = raycast_segments(poses, angles, segs, max_range)
+        virtual = raycast_segments(poses, angles, segs, max_range, index)
         vector_see_through_kernel(pen, ranges, virtual, max_range, c)
     return _row_means(pen)
 

@@ -508,15 +508,12 @@ def see_through_kernel(occ: np.ndarray, origin_x: float, origin_y: float, resolu
 @njit(cache=True, nogil=True)
 def lattice_kernel(centre_x: float, centre_y: float, offsets: np.ndarray, table: np.ndarray,
                    corner_x: float, corner_y: float, resolution: float, clearance: float,
-                   area_codes: np.ndarray, area_x0: float, area_y0: float, area_res: float,
-                   area_segs: np.ndarray, free_codes: np.ndarray, free_x0: float, free_y0: float,
-                   free_res: float, free_segs: np.ndarray,
-                   sure: float) -> tuple[np.ndarray, bool]:
+                   area: tuple, free: tuple, sure: float) -> tuple[np.ndarray, bool]:
     """:func:`tfloc.tfplus.coarse.lattice`'s positions on a vector map, in one call: of the
     points ``centre + offsets`` ``(N, 2)``, those where the distance field (``table``, cells of
     ``resolution`` from the corner) is at least ``clearance`` (of the table's dtype), in the
     mapped area and in free space (:func:`tfloc.maps.inside.raster_code` on the area's and the
-    free space's rings), in order. Returns them ``(K, 2)`` and whether every point was decided
+    free space's rings, ``Rings.kernel``), in order. Returns them ``(K, 2)`` and whether every point was decided
     (False: one lay too near a boundary for the compiled test; ask the map)."""
     h, w = table.shape
     flat = table.ravel()
@@ -528,12 +525,12 @@ def lattice_kernel(centre_x: float, centre_y: float, offsets: np.ndarray, table:
         iy = min(max(np.int64(math.floor((y - corner_y) / resolution)), 0), h - 1)
         if not flat[iy * w + ix] >= clearance:
             continue
-        code = raster_code(x, y, area_codes, area_x0, area_y0, area_res, area_segs, sure)
+        code = raster_code(x, y, area, sure)
         if code < 0:
             return out[:0], False
         if code == 0:
             continue
-        code = raster_code(x, y, free_codes, free_x0, free_y0, free_res, free_segs, sure)
+        code = raster_code(x, y, free, sure)
         if code < 0:
             return out[:0], False
         if code == 1:

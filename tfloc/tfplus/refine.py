@@ -202,7 +202,8 @@ def _refine_vector(map_: VectorMap, laser: LaserSpec, points: np.ndarray, poses:
     cos_a, sin_a = _beam_trig(laser)
     return refine_vector_kernel(poses, points, laser.angles, cos_a, sin_a,
                                 float(laser.angle_min), float(laser.resolution), map_.segments,
-                                float(laser.max_range), gates, cfg.inner, cfg.window,
+                                map_.segment_index(float(laser.max_range)), float(laser.max_range),
+                                gates, cfg.inner, cfg.window,
                                 cfg.damping, cfg.prune_after, cfg.keep, cfg.inlier_distance)
 
 

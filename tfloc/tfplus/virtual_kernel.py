@@ -97,10 +97,11 @@ def virtual_geometry_kernel(ranges: np.ndarray, cos_a: np.ndarray, sin_a: np.nda
 @njit(cache=True, nogil=True)
 def refine_virtual_kernel(poses: np.ndarray, points: np.ndarray, rel_angles: np.ndarray,
                           cos_a: np.ndarray, sin_a: np.ndarray, angle_min: float,
-                          resolution: float, segs: np.ndarray, max_range: float,
+                          resolution: float, segs: np.ndarray, index: tuple, max_range: float,
                           gates: np.ndarray, inner: int, window: int,
                           damping: float) -> tuple[np.ndarray, np.ndarray]:
-    """Iterations of :func:`tfloc.tfplus.refine.refine` on a vector map (segments ``segs``), one
+    """Iterations of :func:`tfloc.tfplus.refine.refine` on a vector map (segments ``segs``, their
+    buckets ``index``), one
     per gate of ``gates``: the refined poses ``(K, 3)`` and the signed residuals ``(K, M)`` of
     the last Gauss–Newton step of the last iteration (NaN: unpaired), which the pruning ranks
     by. ``rel_angles`` are the beam angles (radians, relative to the heading), ``cos_a``/
@@ -111,7 +112,7 @@ def refine_virtual_kernel(poses: np.ndarray, points: np.ndarray, rel_angles: np.
     r = np.full((k_n, m), np.nan)
     eye = np.eye(3)
     for it in range(gates.shape[0]):
-        virtual = raycast_segments(poses, rel_angles, segs, max_range)
+        virtual = raycast_segments(poses, rel_angles, segs, max_range, index)
         q, normal = virtual_geometry_kernel(virtual, cos_a, sin_a, max_range)
         delta = np.zeros_like(poses)
         for _ in range(inner):
@@ -174,7 +175,7 @@ def prune_index_kernel(poses: np.ndarray, cost: np.ndarray, keep: int, same: flo
 @njit(cache=True, nogil=True)
 def refine_vector_kernel(poses: np.ndarray, points: np.ndarray, rel_angles: np.ndarray,
                          cos_a: np.ndarray, sin_a: np.ndarray, angle_min: float,
-                         resolution: float, segs: np.ndarray, max_range: float,
+                         resolution: float, segs: np.ndarray, index: tuple, max_range: float,
                          gates: np.ndarray, inner: int, window: int, damping: float,
                          prune_after: int, keep: int, inlier_distance: float) -> np.ndarray:
     """The whole of :func:`tfloc.tfplus.refine.refine` on a vector map in one call: the
@@ -185,13 +186,13 @@ def refine_vector_kernel(poses: np.ndarray, points: np.ndarray, rel_angles: np.n
     cut = prune_after if prune_at else n_it
     if cut > 0:
         poses, r = refine_virtual_kernel(poses, points, rel_angles, cos_a, sin_a, angle_min,
-                                         resolution, segs, max_range, gates[:cut], inner, window,
+                                         resolution, segs, index, max_range, gates[:cut], inner, window,
                                          damping)
         if prune_at and poses.shape[0] > keep:
             cost = truncated_cost_kernel(r, inlier_distance)
             poses = poses[prune_index_kernel(poses, cost, keep, 0.05)]
     if cut < n_it:
         poses, _ = refine_virtual_kernel(poses, points, rel_angles, cos_a, sin_a, angle_min,
-                                         resolution, segs, max_range, gates[cut:], inner, window,
+                                         resolution, segs, index, max_range, gates[cut:], inner, window,
                                          damping)
     return poses
