@@ -54,9 +54,10 @@ import numpy as np
 import pandas as pd
 
 from tfloc.core.laser import LaserSpec
-from tfloc.core.matcher import available_matchers, get_matcher
+from tfloc.core.matcher import available_matchers, get_matcher, solves_global
 from tfloc.core.pose import Pose, angdiff
 from tfloc.core.problem import Problem
+from tfloc.core.tracker import has_single_scan_mode
 from tfloc.datasets.noise import NoiseModel
 from tfloc.datasets.protocol import strata
 from tfloc.datasets.synthetic import sample_pose_pair
@@ -355,21 +356,34 @@ def run_level(lv: Level, matchers: dict[str, object], log: Callable[[str], None]
     return rows, prep
 
 
-def build_matchers(names: Sequence[str], log: Callable[[str], None]) -> dict[str, object]:
-    """Every named matcher with its defaults; one whose library is missing is left out (logged)."""
+def build_matchers(names: Sequence[str] | None, log: Callable[[str], None]) -> dict[str, object]:
+    """Every named matcher with its defaults (default: every registered single-scan local
+    matcher); one whose library is missing is left out (logged).
+
+    By default a tracker without a single-scan mode (amcl, odometry, tf-plus-recover: no
+    ``localize`` of one scan from a guess) and a global matcher (tf-global, bnb-global) are left
+    out: the study's problems are local ones, and a global matcher's cost against the area is
+    its own axis, measured per 100 m² of free space in ``results/global`` (issue 24). Named on
+    the command line, they run (a global matcher then answers the local problem its own way)."""
+    chosen = names is not None
     out = {}
-    for name in names:
+    for name in names if chosen else available_matchers():
         try:
-            out[name] = get_matcher(name)
+            m = get_matcher(name)
         except LibraryMissingError as exc:
             log(f"left out: {exc}")
+            continue
+        if not chosen and (solves_global(m) or not has_single_scan_mode(m)):
+            log(f"left out: {name} ({'a global matcher' if solves_global(m) else 'no single-scan mode'})")
+            continue
+        out[name] = m
     return out
 
 
 def run_study(cfg: StudyConfig, log: Callable[[str], None] = print) -> dict:
     """Run every level of the study; returns the rows, preparation rows, skips and provenance."""
     tile = read_vector_map(ROOT / cfg.map_path if not Path(cfg.map_path).is_absolute() else cfg.map_path)
-    matchers = build_matchers(cfg.matchers or available_matchers(), log)
+    matchers = build_matchers(cfg.matchers or None, log)
     gc.freeze()  # the libraries' objects: every later gc.collect (memory probes) skips them
     try:
         return _run_levels(cfg, tile, matchers, log)
@@ -467,7 +481,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="the make-bench subsample (StudyConfig.quick)")
     ap.add_argument("--out", type=Path, default=None, help="results folder (default results/scaling[-quick])")
-    ap.add_argument("--matchers", nargs="*", default=None, help="matcher names (default: all registered)")
+    ap.add_argument("--matchers", nargs="*", default=None,
+                    help="matcher names (default: every registered single-scan local matcher)")
     ap.add_argument("--axes", nargs="*", default=None, choices=("area", "beams", "offset"))
     ap.add_argument("--scans", type=int, default=None, help="scans per level (area and beam axes)")
     ap.add_argument("--render", action="store_true",

@@ -166,3 +166,19 @@ def test_tiling_needs_a_closed_tile():
     bare = VectorMap.from_segments(np.array([[0.0, 0.0, 5.0, 0.0]]))
     with pytest.raises(ConfigError, match="outline or a region"):
         tile_vector_map(bare, Tiling(2, 2, 6.0, 1.0))
+
+
+def test_default_matchers_are_the_single_scan_local_ones():
+    from tfloc.core.matcher import solves_global
+    from tfloc.core.tracker import has_single_scan_mode
+
+    study = _study()
+    logged: list[str] = []
+    chosen = study.build_matchers(None, logged.append)
+    assert "tf-plus" in chosen and "tf" in chosen
+    assert not any(solves_global(m) or not has_single_scan_mode(m) for m in chosen.values())
+    left_out = " ".join(logged)
+    assert "tf-global" in left_out and "a global matcher" in left_out
+    assert "amcl" in left_out and "no single-scan mode" in left_out
+    named = study.build_matchers(["tf-global"], logged.append)
+    assert list(named) == ["tf-global"]  # named on the command line, it runs
