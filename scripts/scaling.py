@@ -316,7 +316,8 @@ def run_level(lv: Level, matchers: dict[str, object], log: Callable[[str], None]
         try:
             probe = prepare_timed(matchers[name], problems[name][0])
             p0 = problems[name][0]
-            matchers[name].score(p0, p0.initial)  # untimed warm-up: kernels, lazy structures
+            if hasattr(matchers[name], "score"):  # odometry has no objective
+                matchers[name].score(p0, p0.initial)  # untimed warm-up: kernels, lazy structures
             for p in problems[name][:warmup]:
                 matchers[name].localize(p)
         except Exception as exc:  # noqa: BLE001 - reported in prep.csv, the others go on
@@ -360,9 +361,9 @@ def build_matchers(names: Sequence[str] | None, log: Callable[[str], None]) -> d
     """Every named matcher with its defaults (default: every registered single-scan local
     matcher); one whose library is missing is left out (logged).
 
-    By default a tracker without a single-scan mode (amcl, odometry, tf-plus-recover: no
-    ``localize`` of one scan from a guess) and a global matcher (tf-global, bnb-global) are left
-    out: the study's problems are local ones, and a global matcher's cost against the area is
+    By default a tracker without a single-scan mode (amcl, tf-plus-recover: no ``localize`` of
+    one scan from a guess), ``odometry`` (no objective: it answers its guess at no cost) and a
+    global matcher (tf-global, bnb-global) are left out: the study's problems are local ones, and a global matcher's cost against the area is
     its own axis, measured per 100 m² of free space in ``results/global`` (issue 24). Named on
     the command line, they run (a global matcher then answers the local problem its own way)."""
     chosen = names is not None
@@ -373,8 +374,10 @@ def build_matchers(names: Sequence[str] | None, log: Callable[[str], None]) -> d
         except LibraryMissingError as exc:
             log(f"left out: {exc}")
             continue
-        if not chosen and (solves_global(m) or not has_single_scan_mode(m)):
-            log(f"left out: {name} ({'a global matcher' if solves_global(m) else 'no single-scan mode'})")
+        why = ("a global matcher" if solves_global(m) else "no single-scan mode" if not has_single_scan_mode(m)
+               else "no objective: it answers its guess" if not hasattr(m, "score") else "")
+        if not chosen and why:
+            log(f"left out: {name} ({why})")
             continue
         out[name] = m
     return out

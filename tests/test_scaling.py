@@ -179,6 +179,7 @@ def test_default_matchers_are_the_single_scan_local_ones():
     assert not any(solves_global(m) or not has_single_scan_mode(m) for m in chosen.values())
     left_out = " ".join(logged)
     assert "tf-global" in left_out and "a global matcher" in left_out
-    assert "amcl" in left_out and "no single-scan mode" in left_out
+    assert "amcl" in left_out and "no single-scan mode" in left_out and "odometry" in left_out
     named = study.build_matchers(["tf-global"], logged.append)
     assert list(named) == ["tf-global"]  # named on the command line, it runs
+    assert list(study.build_matchers(["odometry"], logged.append)) == ["odometry"]
