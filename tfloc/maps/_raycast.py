@@ -207,6 +207,47 @@ def _arcs(ox: float, oy: float, segs: np.ndarray, max_range: float, dev: float,
     return k
 
 
+_SWEEP = 8  # poses at one position whose beam directions a later pose there may reuse
+
+
+@njit(cache=True, nogil=True)
+def _directions(th: float, rel_angles: np.ndarray, res: float, headings: np.ndarray, group: int,
+                p: int, shift: np.ndarray, angle: np.ndarray, dx_of: np.ndarray,
+                dy_of: np.ndarray, src_pose: np.ndarray, src_beam: np.ndarray) -> None:
+    """Beam ``b``'s angle ``th + rel_angles[b]`` of pose ``p`` and its direction (cos, sin) into
+    row ``(p − group) mod _SWEEP`` of ``angle``, ``dx_of``, ``dy_of``.
+
+    Poses ``group … p−1`` stand at the same position (a heading sweep, e.g. Alg. 5's seven
+    orientations one beam apart). Where pose ``p``'s heading lies a whole number of beams ``s``
+    from that of one of the last ``_SWEEP − 1`` of them, pose ``j`` (``shift``), its beam ``b``
+    is often *exactly* (to the last bit) pose ``j``'s beam ``b + s``, and then its cos and sin are
+    copied from there instead of computed again: the same values (the same libm call on the
+    same number gave them). In a seven-heading sweep about two thirds of the angles repeat.
+    The source of beam ``b`` goes to ``src_pose[b]``, ``src_beam[b]`` (−1: computed here): the
+    same origin and the same direction to the last bit, so the same range."""
+    B = rel_angles.shape[0]
+    first = max(group, p - _SWEEP + 1)
+    for j in range(first, p):
+        q = (th - headings[j]) / res
+        s = np.floor(q + 0.5)
+        ok = abs(q - s) < 1e-6 and abs(s) < B
+        shift[(j - group) % _SWEEP] = np.int64(s) if ok else B  # B: no candidate beam
+    row = (p - group) % _SWEEP
+    for b in range(B):
+        a = th + rel_angles[b]
+        angle[row, b] = a
+        src_pose[b] = -1
+        for j in range(p - 1, first - 1, -1):
+            r = (j - group) % _SWEEP
+            c = b + shift[r]
+            if 0 <= c < B and angle[r, c] == a:
+                dx_of[row, b], dy_of[row, b] = dx_of[r, c], dy_of[r, c]
+                src_pose[b], src_beam[b] = j, c
+                break
+        if src_pose[b] < 0:
+            dx_of[row, b], dy_of[row, b] = np.cos(a), np.sin(a)
+
+
 @njit(cache=True, fastmath=False, nogil=True)
 def raycast_segments(poses: np.ndarray, rel_angles: np.ndarray, segs: np.ndarray,
                      max_range: float, index: tuple) -> np.ndarray:
@@ -223,7 +264,9 @@ def raycast_segments(poses: np.ndarray, rel_angles: np.ndarray, segs: np.ndarray
     with every beam, so the answer never depends on the arc computation. Segments are visited
     nearest first (by distance bins, :func:`_near_first`), and a beam whose hit so far is nearer than a segment's distance skips it
     (only when the skip provably agrees with the brute force's test). Consecutive poses at the
-    same position (e.g. several headings) share the heading-independent work (:func:`_arcs`).
+    same position (e.g. several headings) share the heading-independent work (:func:`_arcs`),
+    and a ray that one of them already cast (the same direction to the last bit,
+    :func:`_directions`) is not cast again.
     """
     P = poses.shape[0]
     B = rel_angles.shape[0]
@@ -234,8 +277,14 @@ def raycast_segments(poses: np.ndarray, rel_angles: np.ndarray, segs: np.ndarray
     two_pi = 2.0 * np.pi
     out = np.full((P, B), np.inf)
     best = np.empty(B)
-    dxs = np.empty(B)
-    dys = np.empty(B)
+    angle = np.empty((_SWEEP, B))     # the beam angles and directions of the last poses
+    dx_of = np.empty((_SWEEP, B))     # at this position (rows: pose − group, mod _SWEEP)
+    dy_of = np.empty((_SWEEP, B))
+    shift = np.zeros(_SWEEP, dtype=np.int64)
+    src_pose = np.empty(B, dtype=np.int64)  # a beam's ray cast before: pose, beam (else −1)
+    src_beam = np.empty(B, dtype=np.int64)
+    next_cast = np.empty(B + 1, dtype=np.int64)  # the first beam ≥ b not cast before (B: none)
+    group = 0                         # the first pose at the current position
     near = np.empty(M, dtype=np.int64)
     dist = np.empty(M)
     seg_of = np.empty(M, dtype=np.int64)
@@ -252,18 +301,26 @@ def raycast_segments(poses: np.ndarray, rel_angles: np.ndarray, segs: np.ndarray
     wrap_up = two_pi / res <= B - 1.0   # can an arc one turn up reach a beam (360° scanners)?
     for p in range(P):
         ox, oy, th = poses[p, 0], poses[p, 1], poses[p, 2]
-        for b in range(B):
-            a = th + rel_angles[b]
-            dxs[b], dys[b] = np.cos(a), np.sin(a)
+        moved = p == 0 or ox != poses[p - 1, 0] or oy != poses[p - 1, 1]
+        if moved:
+            group = p
+        _directions(th, rel_angles, res, poses[:, 2], group, p, shift, angle, dx_of, dy_of,
+                    src_pose, src_beam)
+        dxs, dys = dx_of[(p - group) % _SWEEP], dy_of[(p - group) % _SWEEP]
+        next_cast[B] = B            # a ray cast before is not cast again: the beam loops
+        for b in range(B - 1, -1, -1):  # below step from one beam to cast to the next
             best[b] = max_range
-        if p == 0 or ox != poses[p - 1, 0] or oy != poses[p - 1, 1]:
+            next_cast[b] = b if src_pose[b] < 0 else next_cast[b + 1]
+        if moved:
             k = _arcs(ox, oy, segs, max_range, dev, near, dist, seg_of, every, start, width,
                       margin, h_safe, den_min, ex, ey, index, seen, p + 1)
         for jj in range(k):
             seg = segs[seg_of[jj]]
             if every[jj]:
-                for b in range(B):
+                b = next_cast[0]
+                while b < B:
                     best[b] = _hit(ox, oy, dxs[b], dys[b], seg, best[b])
+                    b = next_cast[b + 1]
                 continue
             rel = start[jj] - th - a0 - margin[jj]
             rel = rel - two_pi * np.floor(rel / two_pi)        # in [0, 2π)
@@ -276,12 +333,16 @@ def raycast_segments(poses: np.ndarray, rel_angles: np.ndarray, segs: np.ndarray
                 if hi_f < 0.0 or lo_f > B - 1.0:
                     continue
                 lo, hi = int(max(lo_f, 0.0)), int(min(hi_f, B - 1.0))
-                for b in range(lo, hi + 1):
-                    if best[b] <= h_safe[jj]:  # occluded: t ≥ h > best, unless t is ill-conditioned
-                        if abs(dxs[b] * ey[jj] - dys[b] * ex[jj]) >= den_min[jj]:
-                            continue
-                    best[b] = _hit(ox, oy, dxs[b], dys[b], seg, best[b])
+                b = next_cast[lo]
+                while b <= hi:
+                    # occluded: t ≥ h > best, unless t is ill-conditioned
+                    if not (best[b] <= h_safe[jj]
+                            and abs(dxs[b] * ey[jj] - dys[b] * ex[jj]) >= den_min[jj]):
+                        best[b] = _hit(ox, oy, dxs[b], dys[b], seg, best[b])
+                    b = next_cast[b + 1]
         for b in range(B):
-            if best[b] < max_range:
+            if src_pose[b] >= 0:
+                out[p, b] = out[src_pose[b], src_beam[b]]
+            elif best[b] < max_range:
                 out[p, b] = best[b]
     return out

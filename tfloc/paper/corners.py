@@ -122,16 +122,12 @@ def _walk(points: np.ndarray, spacing: float, along_path: bool) -> np.ndarray:
     n = points.shape[0]
     if n == 0:
         return np.empty((0, 2))
-    path = 0.0                 # M ≤ path/spacing + 2 per input point (each emission walks S)
-    for i in range(1, n):
-        dx, dy = points[i, 0] - points[i - 1, 0], points[i, 1] - points[i - 1, 1]
-        path += np.sqrt(dx * dx + dy * dy)
-    cap = (2 if along_path else 3) * n + 16
-    if np.isfinite(path) and path / spacing < 1e9:
-        cap += int(path / spacing)
-    out = np.empty((cap, 2))
+    # M ≤ path/spacing + 2 per input point (each emission walks S); a scan's path is rarely
+    # longer than n·spacing, so room for 4n + 16 points (no pass for the path length) nearly
+    # always suffices, and where it does not, the points are counted exactly and walked again.
+    out = np.empty((4 * n + 16, 2))
     m = _walk_into(points, spacing, along_path, out)
-    if m < 0:                  # not expected; count exactly and redo
+    if m < 0:                  # the path is longer than about 2n·spacing: count exactly, redo
         out = np.empty((_walk_into(points, spacing, along_path, np.empty((0, 2))), 2))
         m = _walk_into(points, spacing, along_path, out)
     return out[:m]

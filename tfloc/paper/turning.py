@@ -63,13 +63,21 @@ def _block_sum(a: np.ndarray, lo: int, n: int) -> float:
         for i in range(n):
             res += a[lo + i]
         return res
-    r = a[lo:lo + 8].copy()
+    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]     # the eight accumulators
+    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
     i = 8
     while i < n - (n % 8):
-        for j in range(8):
-            r[j] += a[lo + i + j]
+        q = lo + i
+        r0 += a[q]
+        r1 += a[q + 1]
+        r2 += a[q + 2]
+        r3 += a[q + 3]
+        r4 += a[q + 4]
+        r5 += a[q + 5]
+        r6 += a[q + 6]
+        r7 += a[q + 7]
         i += 8
-    res = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]))
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
     while i < n:
         res += a[lo + i]
         i += 1
@@ -80,7 +88,9 @@ def _block_sum(a: np.ndarray, lo: int, n: int) -> float:
 def _pairwise_sum(a: np.ndarray) -> float:
     """``a.sum()`` in numpy's order (pairwise halves of ≤ 128-element blocks), so the kernels
     reproduce the numpy formulas bit for bit. Iterative (cached recursive numba functions are
-    unreliable)."""
+    unreliable); an array of at most 128 is one leaf."""
+    if a.shape[0] <= 128:
+        return _block_sum(a, 0, a.shape[0])
     f_lo = np.empty(64, dtype=np.int64)
     f_n = np.empty(64, dtype=np.int64)
     f_stage = np.empty(64, dtype=np.int64)
@@ -200,6 +210,28 @@ def _dot(a: np.ndarray, b: np.ndarray, n: int) -> float:
 
 
 @njit(cache=True, nogil=True)
+def _dot_squares(a: np.ndarray, b: np.ndarray, n: int) -> float:
+    """``a[:n]·(b[:n]·b[:n])`` as :func:`_dot` of ``a`` and the rounded squares ``b * b`` (numpy's
+    ``d2``), without the array of squares."""
+    acc0, acc1 = 0.0, 0.0
+    i = 0
+    while n - i >= 8:
+        t0, t1 = acc0, acc1
+        for q in range(3, -1, -1):
+            b0, b1 = b[i + 2 * q], b[i + 2 * q + 1]
+            t0 = a[i + 2 * q] * (b0 * b0) + t0
+            t1 = a[i + 2 * q + 1] * (b1 * b1) + t1
+        acc0, acc1 = t0, t1
+        i += 8
+    while i < n:
+        acc0 = a[i] * (b[i] * b[i]) + acc0
+        if i + 1 < n:
+            acc1 = a[i + 1] * (b[i + 1] * b[i + 1]) + acc1
+        i += 2
+    return acc0 + acc1
+
+
+@njit(cache=True, nogil=True)
 def _mod1(x: float) -> float:
     """``x % 1.0`` (Python's float modulo), without the library call for ``-1 < x < 1``."""
     if 0.0 < x < 1.0:
@@ -285,7 +317,6 @@ def _best_shift(rb: np.ndarray, ra: np.ndarray, vb: np.ndarray, va: np.ndarray,
     grid = np.empty(g_n)
     width = np.empty(g_n - 1)
     d = np.empty(g_n - 1)
-    d2 = np.empty(0 if l1 else g_n - 1)
     best_err, best_rot, best_k = np.inf, 0.0, 0
     for k in range(n_v):
         _pieces(rb, ra, vb, va, k, moved, grid, width, d)
@@ -295,10 +326,8 @@ def _best_shift(rb: np.ndarray, ra: np.ndarray, vb: np.ndarray, va: np.ndarray,
             for g in range(g_n - 1):
                 err += width[g] * abs(d[g] - rot)
         else:
-            for g in range(g_n - 1):
-                d2[g] = d[g] * d[g]
             rot = _dot(width, d, g_n - 1)
-            err = _dot(width, d2, g_n - 1) - rot * rot
+            err = _dot_squares(width, d, g_n - 1) - rot * rot
         if err < best_err:
             best_err, best_rot, best_k = err, rot, k
     return best_err, best_rot, best_k
