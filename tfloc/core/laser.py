@@ -19,6 +19,15 @@ def _returns_to_points(ranges: np.ndarray, directions: np.ndarray, max_range: fl
         if np.isfinite(r) and r > 0.0 and r < max_range:
             n += 1
     out = np.empty((n, 2))
+    _returns_to_points_into(ranges, directions, max_range, out)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _returns_to_points_into(ranges: np.ndarray, directions: np.ndarray, max_range: float,
+                            out: np.ndarray) -> int:
+    """:func:`_returns_to_points` into the first rows of ``out`` (``len(ranges)`` rows or as
+    many as there are returns); returns their number."""
     k = 0
     for i in range(ranges.shape[0]):
         r = ranges[i]
@@ -26,7 +35,7 @@ def _returns_to_points(ranges: np.ndarray, directions: np.ndarray, max_range: fl
             out[k, 0] = directions[i, 0] * r
             out[k, 1] = directions[i, 1] * r
             k += 1
-    return out
+    return k
 
 
 @dataclass(frozen=True)

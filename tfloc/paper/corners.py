@@ -167,8 +167,16 @@ def straws(points: np.ndarray, window: int = 1) -> np.ndarray:
 @njit(cache=True, nogil=True)
 def _median(values: np.ndarray) -> float:
     """``np.median`` of a 1-D array (the mean of the two middle values when the size is even)."""
-    v = np.sort(values)
-    n = v.shape[0]
+    return _median_into(values, np.empty(values.shape[0]))
+
+
+@njit(cache=True, nogil=True)
+def _median_into(values: np.ndarray, scratch: np.ndarray) -> float:
+    """:func:`_median`, sorting a copy in ``scratch`` (at least as long as ``values``)."""
+    n = values.shape[0]
+    v = scratch[:n]
+    v[:] = values
+    v.sort()
     h = n // 2
     if n % 2 == 1:
         return v[h]
@@ -178,15 +186,25 @@ def _median(values: np.ndarray) -> float:
 @njit(cache=True, nogil=True)
 def _candidates(points: np.ndarray, window: int, t: float) -> np.ndarray:
     """Algorithm 2 for ``len(points) > 2·window`` (see :func:`corner_candidates`)."""
+    m = points.shape[0] - 2 * window
+    out = np.empty(m + 2, dtype=np.int64)
+    k = _candidates_into(points, window, t, np.empty(m), np.empty(m), out)
+    return out[:k].copy()
+
+
+@njit(cache=True, nogil=True)
+def _candidates_into(points: np.ndarray, window: int, t: float, s: np.ndarray,
+                     scratch: np.ndarray, out: np.ndarray) -> int:
+    """:func:`_candidates` into ``out`` (``len(points) − 2·window + 2`` or more), with the
+    straws in ``s`` and the median's sort in ``scratch`` (``len(points) − 2·window`` or more each);
+    returns the number of candidates."""
     n = points.shape[0]
     m = n - 2 * window
-    s = np.empty(m)
     for i in range(m):
         dx = points[i + 2 * window, 0] - points[i, 0]
         dy = points[i + 2 * window, 1] - points[i, 1]
         s[i] = dx * dx + dy * dy
-    cut = _median(s) * t
-    out = np.empty(m + 2, dtype=np.int64)
+    cut = _median_into(s[:m], scratch) * t
     out[0] = 0
     k = 1
     for i in range(m):
@@ -194,7 +212,7 @@ def _candidates(points: np.ndarray, window: int, t: float) -> np.ndarray:
             out[k] = i + window
             k += 1
     out[k] = n - 1
-    return out[:k + 1].copy()
+    return k + 1
 
 
 def corner_candidates(points: np.ndarray, window: int = 1, t: float = 0.99) -> np.ndarray:
@@ -214,15 +232,25 @@ def merge_lines(points: np.ndarray, corners: np.ndarray, threshold: float = 0.95
     One pass: the last kept corner, the pending middle corner and the next candidate form the
     triple; a dropped middle is replaced by the next candidate (the same triples, in the same
     order, as removing it from the list and testing again)."""
-    n = points.shape[0]
-    cum = np.zeros(n)
-    for i in range(1, n):
-        dx, dy = points[i, 0] - points[i - 1, 0], points[i, 1] - points[i - 1, 1]
-        cum[i] = cum[i - 1] + np.sqrt(dx * dx + dy * dy)
     k = corners.shape[0]
     if k < 3:
         return corners.astype(np.int64)
     keep = np.empty(k, dtype=np.int64)
+    m = _merge_lines_into(points, corners, threshold, np.empty(points.shape[0]), keep)
+    return keep[:m].copy()
+
+
+@njit(cache=True, nogil=True)
+def _merge_lines_into(points: np.ndarray, corners: np.ndarray, threshold: float, cum: np.ndarray,
+                      keep: np.ndarray) -> int:
+    """:func:`merge_lines` into ``keep`` (as long as ``corners`` or more; at least 3 corners),
+    with the path lengths in ``cum`` (as long as ``points`` or more); returns the number kept."""
+    n = points.shape[0]
+    cum[0] = 0.0
+    for i in range(1, n):
+        dx, dy = points[i, 0] - points[i - 1, 0], points[i, 1] - points[i - 1, 1]
+        cum[i] = cum[i - 1] + np.sqrt(dx * dx + dy * dy)
+    k = corners.shape[0]
     keep[0] = corners[0]
     m = 1
     mid = corners[1]
@@ -235,7 +263,7 @@ def merge_lines(points: np.ndarray, corners: np.ndarray, threshold: float = 0.95
             m += 1
         mid = b
     keep[m] = mid
-    return keep[:m + 1].copy()
+    return m + 1
 
 
 @njit(cache=True, nogil=True)
@@ -253,6 +281,51 @@ def _shortstraw(points: np.ndarray, spacing: float, window: int, t: float,
     for i in range(keep.shape[0]):
         out[i, 0], out[i, 1] = res[keep[i], 0], res[keep[i], 1]
     return out
+
+
+@njit(cache=True, nogil=True)
+def shortstraw_workspace(n_points: int) -> tuple:
+    """Buffers for :func:`_shortstraw_into` on up to ``n_points`` input points: the walk
+    ``(4n + 16, 2)``, straws, sort scratch, candidates, path lengths, kept corners."""
+    cap = 4 * n_points + 16
+    return (np.empty((cap, 2)), np.empty(cap), np.empty(cap), np.empty(cap + 2, dtype=np.int64),
+            np.empty(cap), np.empty(cap + 2, dtype=np.int64))
+
+
+@njit(cache=True, nogil=True)
+def _shortstraw_into(points: np.ndarray, spacing: float, window: int, t: float,
+                     line_threshold: float, along_path: bool, ws: tuple, out: np.ndarray,
+                     offset: int) -> int:
+    """:func:`_shortstraw` without allocations: the corners into rows ``offset …`` of ``out``
+    (``offset + 4n + 18`` rows or more), the work in ``ws`` (:func:`shortstraw_workspace` of
+    at least ``len(points)`` points); returns the number of corners, or −1 when the walk does
+    not fit (a path longer than about ``2n·spacing``; then call :func:`_shortstraw`). The same
+    steps and arithmetic as :func:`_shortstraw`."""
+    walk, straws, scratch, cand, cum, keep = ws
+    if points.shape[0] == 0:
+        return 0
+    n = _walk_into(points, spacing, along_path, walk)
+    if n < 0:
+        return -1
+    res = walk[:n]
+    if n <= 2 * window:
+        kc = n if n < 2 else 2
+        if n < 2:
+            for i in range(n):
+                cand[i] = i
+        else:
+            cand[0], cand[1] = 0, n - 1
+    else:
+        kc = _candidates_into(res, window, t, straws, scratch, cand)
+    if kc < 3:
+        kk = kc
+        for i in range(kc):
+            keep[i] = cand[i]
+    else:
+        kk = _merge_lines_into(res, cand[:kc], line_threshold, cum, keep)
+    for i in range(kk):
+        out[offset + i, 0], out[offset + i, 1] = res[keep[i], 0], res[keep[i], 1]
+    return kk
 
 
 def is_line(points: np.ndarray, a: int, b: int, threshold: float = 0.95) -> bool:

@@ -14,12 +14,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from tfloc.core.laser import _returns_to_points
+from tfloc.core.laser import _returns_to_points, _returns_to_points_into
 from tfloc.maps._raycast import raycast_segments
 from tfloc.maps.inside import raster_code
 
-from .corners import _shortstraw
-from .turning import TWO_PI, _match, _match_l1, _turning
+from .corners import _shortstraw, _shortstraw_into, shortstraw_workspace
+from .turning import TWO_PI, _best_shift_into, _turning, _turning_into
 
 
 @njit(cache=True, nogil=True)
@@ -43,6 +43,44 @@ def scan_turning(ranges: np.ndarray, directions: np.ndarray, max_range: float, s
 
 
 @njit(cache=True, nogil=True)
+def turning_workspace(n_beams: int, n_real: int) -> tuple:
+    """Buffers for :func:`_scan_turning_into` on scans of ``n_beams`` beams and the match
+    against a real turning function of ``n_real`` edges: the points, ShortStraw's
+    (:func:`~tfloc.paper.corners.shortstraw_workspace`), the polygon, the turning function's,
+    the match's."""
+    rows = 4 * n_beams + 19         # the polygon: the origin and at most 4n + 18 corners
+    return (np.empty((n_beams, 2)), shortstraw_workspace(n_beams), np.empty((rows, 2)),
+            np.empty(rows), np.empty(rows), np.empty(rows), np.empty(rows), np.empty(rows + 1),
+            np.empty(rows), np.empty(n_real + 1 + rows), np.empty(n_real + rows),
+            np.empty(n_real + rows))
+
+
+@njit(cache=True, nogil=True)
+def _scan_turning_into(ranges: np.ndarray, directions: np.ndarray, max_range: float,
+                       spacing: float, window: int, t: float, line_threshold: float,
+                       close_through_origin: bool, along_path: bool, ws: tuple) -> int:
+    """:func:`scan_turning` in the buffers ``ws`` (:func:`turning_workspace`): returns the number
+    of edges ``k`` (the function is ``ws[7][:k + 1]``, ``ws[6][:k]``; none when ``k`` < 3), or −1
+    when ShortStraw's walk did not fit (then :func:`scan_turning` gives it). The same steps and
+    arithmetic as :func:`scan_turning`, without its allocations."""
+    pts_buf, sws, poly, ex, ey, length, angles, breaks = ws[:8]
+    n = _returns_to_points_into(ranges, directions, max_range, pts_buf)
+    off = 1 if close_through_origin else 0
+    if n < 2:
+        nc = n
+        for i in range(n):
+            poly[off + i, 0], poly[off + i, 1] = pts_buf[i, 0], pts_buf[i, 1]
+    else:
+        nc = _shortstraw_into(pts_buf[:n], spacing, window, t, line_threshold, along_path, sws,
+                              poly, off)
+        if nc < 0:
+            return -1
+    if close_through_origin:
+        poly[0, 0], poly[0, 1] = 0.0, 0.0
+    return _turning_into(poly[:nc + off], ex, ey, length, angles, breaks)
+
+
+@njit(cache=True, nogil=True)
 def wrap_rotation(rot: float) -> float:
     """``(rot + π) % 2π − π``: numba's float ``%`` is CPython's (``fmod``, then the sign fix), so
     this equals :func:`tfloc.core.pose.wrap_angle` bit for bit."""
@@ -61,17 +99,25 @@ def scan_errors(scans: np.ndarray, directions: np.ndarray, max_range: float, spa
     n = scans.shape[0]
     err = np.full(n, penalty)
     rot = np.zeros(n)
+    ws = turning_workspace(scans.shape[1], real_angles.shape[0])
+    moved, grid, width, d = ws[8], ws[9], ws[10], ws[11]
     for p in range(n):
-        vb, va = scan_turning(scans[p], directions, max_range, spacing, window, t, line_threshold,
-                              close_through_origin, along_path)
+        k = _scan_turning_into(scans[p], directions, max_range, spacing, window, t,
+                               line_threshold, close_through_origin, along_path, ws)
+        if k < 0:                   # a walk too long for the buffers: the allocating path
+            vb, va = scan_turning(scans[p], directions, max_range, spacing, window, t,
+                                  line_threshold, close_through_origin, along_path)
+        elif k < 3:
+            continue
+        else:
+            vb, va = ws[7][:k + 1], ws[6][:k]
         if va.shape[0] < 3:
             continue
-        if l1:
-            e, r, _ = _match_l1(real_breaks, real_angles, vb, va)
-            err[p] = e
-        else:
-            e2, r, _ = _match(real_breaks, real_angles, vb, va)
-            err[p] = np.sqrt(max(e2, 0.0))
+        if va.shape[0] > moved.shape[0]:    # (only after the allocating path)
+            moved, grid = np.empty(va.shape[0]), np.empty(real_angles.shape[0] + 1 + va.shape[0])
+            width, d = np.empty(grid.shape[0]), np.empty(grid.shape[0])
+        e, r, _ = _best_shift_into(real_breaks, real_angles, vb, va, l1, moved, grid, width, d)
+        err[p] = e if l1 else np.sqrt(max(e, 0.0))
         rot[p] = wrap_rotation(r)
     return err, rot
 

@@ -126,9 +126,20 @@ def _pairwise_sum(a: np.ndarray) -> float:
 def _turning(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Breaks and angles of :func:`turning_function` (empty when fewer than 3 edges remain)."""
     n = v.shape[0]
-    ex = np.empty(n)
-    ey = np.empty(n)
-    length = np.empty(n)
+    angles, breaks = np.empty(n), np.empty(n + 1)
+    k = _turning_into(v, np.empty(n), np.empty(n), np.empty(n), angles, breaks)
+    if k < 3:
+        return np.empty(0), np.empty(0)
+    return breaks[:k + 1], angles[:k]
+
+
+@njit(cache=True, nogil=True)
+def _turning_into(v: np.ndarray, ex: np.ndarray, ey: np.ndarray, length: np.ndarray,
+                  angles: np.ndarray, breaks: np.ndarray) -> int:
+    """:func:`_turning` into ``angles[:k]`` and ``breaks[:k + 1]`` (the edges' vectors and
+    lengths in ``ex``, ``ey``, ``length``; each ``len(v)`` long or more, ``breaks`` one more);
+    returns the number of edges ``k`` (nothing written after the edges when ``k`` < 3)."""
+    n = v.shape[0]
     k = 0
     for i in range(n):
         j = i + 1 if i + 1 < n else 0
@@ -138,8 +149,7 @@ def _turning(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             ex[k], ey[k], length[k] = x, y, h
             k += 1
     if k < 3:
-        return np.empty(0), np.empty(0)
-    angles = np.empty(k)
+        return k
     acc = np.arctan2(ey[0], ex[0])
     angles[0] = acc
     for i in range(1, k):
@@ -147,14 +157,13 @@ def _turning(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         acc += np.arctan2(px * ey[i] - py * ex[i], px * ex[i] + py * ey[i])
         angles[i] = acc
     total = _pairwise_sum(length[:k])
-    breaks = np.empty(k + 1)
     breaks[0] = 0.0
     c = 0.0
     for i in range(k):
         c += length[i]
         breaks[i + 1] = c / total
     breaks[k] = 1.0
-    return breaks, angles
+    return k
 
 
 def turning_function(vertices: np.ndarray) -> TurningFunction:
@@ -313,15 +322,23 @@ def _best_shift(rb: np.ndarray, ra: np.ndarray, vb: np.ndarray, va: np.ndarray,
     :func:`match_l1` (the weighted median). One merge sweep per shift."""
     n_r, n_v = ra.shape[0], va.shape[0]
     g_n = n_r + 1 + n_v
-    moved = np.empty(n_v)
-    grid = np.empty(g_n)
-    width = np.empty(g_n - 1)
-    d = np.empty(g_n - 1)
+    return _best_shift_into(rb, ra, vb, va, l1, np.empty(n_v), np.empty(g_n), np.empty(g_n - 1),
+                            np.empty(g_n - 1))
+
+
+@njit(cache=True, nogil=True)
+def _best_shift_into(rb: np.ndarray, ra: np.ndarray, vb: np.ndarray, va: np.ndarray, l1: bool,
+                     moved: np.ndarray, grid: np.ndarray, width: np.ndarray,
+                     d: np.ndarray) -> tuple[float, float, int]:
+    """:func:`_best_shift` with its work in ``moved`` (``n_v`` or more), ``grid``
+    (``n_r + 1 + n_v`` or more), ``width`` and ``d`` (``n_r + n_v`` or more)."""
+    n_r, n_v = ra.shape[0], va.shape[0]
+    g_n = n_r + 1 + n_v
     best_err, best_rot, best_k = np.inf, 0.0, 0
     for k in range(n_v):
         _pieces(rb, ra, vb, va, k, moved, grid, width, d)
         if l1:
-            rot = _weighted_median(d, width)
+            rot = _weighted_median(d[:g_n - 1], width[:g_n - 1])
             err = 0.0
             for g in range(g_n - 1):
                 err += width[g] * abs(d[g] - rot)
