@@ -111,3 +111,15 @@ def test_quick_is_a_stratified_subset_into_its_own_directory():
     assert c.name == "paper-protocol-quick"
     c = config_from_args(_bench_args("--quick", "--limit-per-group", "5", "--out", "x"))
     assert c.limit_per_group == 5 and c.out == Path("x")
+
+
+def test_timing_md_names_the_code_it_timed_against_the_runs():
+    from tfloc.report.timing import _code_line
+
+    same = {"git": {"commit": "a" * 40, "dirty": False}, "run_git": {"commit": "a" * 40, "dirty": False}}
+    assert _code_line(same) == "- Code timed: `aaaaaaa`, the run's own."
+    later = {"git": {"commit": "b" * 40, "dirty": True}, "run_git": {"commit": "a" * 40, "dirty": False}}
+    line = _code_line(later)
+    assert "`bbbbbbb` with uncommitted changes" in line and "made by `aaaaaaa`" in line
+    assert _code_line({}) == "- Code timed: not recorded."
+    assert "made by unknown" in _code_line({"git": {"commit": "c" * 40}, "run_git": {}})

@@ -35,7 +35,7 @@ import pandas as pd
 from tfloc.errors import ConfigError
 from tfloc.io.rundir import RunDir, RunInfo
 
-from .runner import load_average
+from .runner import environment, load_average
 from .threads import limit_threads
 from .workspace import load_dataset, load_matcher, problem_of, timed_localize, warm
 
@@ -109,7 +109,8 @@ def run_timing(run_dir: Path, per_stratum: int = 4, seed: int = SEED, cores: Seq
             os.sched_setaffinity(0, before)
     info = {"cores": pinned, "per_stratum": per_stratum, "seed": seed, "warmup": warmup,
             "scans": len(sample), "strata": int(sample.groupby(["dataset", "group"]).ngroups),
-            "loadavg_start": load_start, "loadavg_end": load_average(), "started": started}
+            "loadavg_start": load_start, "loadavg_end": load_average(), "started": started,
+            "git": environment()["git"], "run_git": info_run.doc.get("git", {})}
     return rows, info
 
 

@@ -13,6 +13,25 @@ def _load(v: list | None) -> str:
     return num(v[0], 2) if v else "?"
 
 
+def _commit(git: dict | None) -> str:
+    """``abc1234`` (``+ uncommitted changes`` when the tree was dirty), or ``unknown``."""
+    c = (git or {}).get("commit")
+    if not c:
+        return "unknown"
+    return f"`{c[:7]}`" + (" with uncommitted changes" if (git or {}).get("dirty") else "")
+
+
+def _code_line(info: dict) -> str:
+    """Which code was timed, against the code that made the run's estimates."""
+    if "git" not in info:
+        return "- Code timed: not recorded."
+    timed, run = _commit(info.get("git")), _commit(info.get("run_git"))
+    if timed == run:
+        return f"- Code timed: {timed}, the run's own."
+    return (f"- Code timed: {timed}; the run's estimates were made by {run} (the timing pass "
+            "re-times the matchers as they are now; their answers are not compared here).")
+
+
 def timing_markdown(run_name: str, summary: pd.DataFrame, reference: str, info: dict) -> str:
     """The markdown of a timing pass: how it was made, then one row per matcher."""
     has_run = summary["run_cpu_median_ms"].notna().any()
@@ -41,6 +60,7 @@ def timing_markdown(run_name: str, summary: pd.DataFrame, reference: str, info: 
         f"(medians: resampling times; ratios: resampling scans, paired).\n",
         f"- Started {info.get('started', '?')}; load average (1 min) at the start {_load(info.get('loadavg_start'))}, "
         f"at the end {_load(info.get('loadavg_end'))}.",
+        _code_line(info),
         f"- Reference matcher for the ratios: `{reference}`.",
         "- `run / quiet`: the run's own median CPU time on the same scans over this pass's; near 1 "
         "when the run's CPU times can be trusted." if has_run else
