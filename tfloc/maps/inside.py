@@ -33,25 +33,9 @@ def inside_kernel(xs: np.ndarray, ys: np.ndarray, segs: np.ndarray, sure: float)
     """Per point ``(xs[i], ys[i])``: 1 inside, 0 outside, -1 within ``sure`` metres of a segment
     of ``segs`` ``(M, 4)`` (the rings' edges), by the crossing parity of a ray towards +x."""
     out = np.empty(xs.shape[0], dtype=np.int8)
-    s2 = sure * sure
+    every = np.arange(segs.shape[0])
     for i in range(xs.shape[0]):
-        x, y = xs[i], ys[i]
-        inside = False
-        near = False
-        for m in range(segs.shape[0]):
-            x1, y1, x2, y2 = segs[m, 0], segs[m, 1], segs[m, 2], segs[m, 3]
-            ex, ey = x2 - x1, y2 - y1
-            ll = ex * ex + ey * ey
-            u = 0.0
-            if ll > 0.0:
-                u = min(1.0, max(0.0, ((x - x1) * ex + (y - y1) * ey) / ll))
-            dx, dy = x1 + u * ex - x, y1 + u * ey - y
-            if dx * dx + dy * dy <= s2:
-                near = True
-                break
-            if (y1 > y) != (y2 > y) and x < x1 + (y - y1) * ex / ey:
-                inside = not inside
-        out[i] = -1 if near else (1 if inside else 0)
+        out[i] = _point_code(xs[i], ys[i], segs, every, 0, segs.shape[0], sure)
     return out
 
 
@@ -110,11 +94,12 @@ def raster_kernel(segs: np.ndarray, x0: float, y0: float, res: float, nx: int,
 
 
 @njit(cache=True, nogil=True)
-def _row_inside(x: float, y: float, segs: np.ndarray, items: np.ndarray, lo: int, hi: int,
+def _point_code(x: float, y: float, segs: np.ndarray, items: np.ndarray, lo: int, hi: int,
                 sure: float) -> int:
-    """:func:`inside_kernel`'s answer for one point from the segments ``items[lo:hi]`` of its
-    raster row (every segment that could cross the point's horizontal or come within ``sure``
-    of it): the same crossings and near tests, for the row's segments only."""
+    """1 inside, 0 outside, -1 within ``sure`` of a segment, for one point from the segments
+    ``items[lo:hi]`` (all of them for :func:`inside_kernel`; those of its raster row, every
+    segment that could cross the point's horizontal or come within ``sure`` of it, for
+    :func:`raster_code`)."""
     s2 = sure * sure
     inside = False
     for t in range(lo, hi):
@@ -161,7 +146,7 @@ def row_buckets(segs: np.ndarray, y0: float, res: float, ny: int,
 def raster_code(x: float, y: float, rings: tuple, sure: float) -> int:
     """:func:`inside_kernel`'s answer for one point, from the cell codes of :func:`raster_kernel`
     where the point's cell is pure (outside the raster: outside), else from the crossings with
-    the segments of its row (:func:`_row_inside`: the same answer, without testing every segment
+    the segments of its row (:func:`_point_code`: the same answer, without testing every segment
     of the map). ``rings`` is :attr:`Rings.kernel` = ``(codes, x0, y0, res, segs, row_start,
     row_items)``."""
     codes, x0, y0, res, segs, row_start, row_items = rings
@@ -173,7 +158,7 @@ def raster_code(x: float, y: float, rings: tuple, sure: float) -> int:
     code = codes[int(fy), int(fx)]
     if code >= 0:
         return code
-    return _row_inside(x, y, segs, row_items, row_start[int(fy)], row_start[int(fy) + 1], sure)
+    return _point_code(x, y, segs, row_items, row_start[int(fy)], row_start[int(fy) + 1], sure)
 
 
 @njit(cache=True, nogil=True)
