@@ -165,3 +165,25 @@ def test_merge_lines_handles_short_corner_lists():
     for corners in ([0], [0, 3], [0, 1, 2, 3], [0, 2, 3]):
         c = np.array(corners, dtype=np.int64)
         np.testing.assert_array_equal(merge_lines(pts, c), merge_lines_ref(pts, c))
+
+
+def test_a_walk_longer_than_the_first_buffers_is_walked_again_in_exact_ones():
+    """Zigzags 9 m long at 0.1 m spacing walk ~90 points per input point, far beyond the 4n + 16
+    the buffers first hold: the retry sized from the exact count gives the reference's corners,
+    and scan_turning's retry the turning function of those corners."""
+    from tfloc.paper.corners import _walk_into
+    from tfloc.paper.kernels import scan_turning
+    from tfloc.paper.turning import _turning
+
+    n = 21
+    pts = np.column_stack((np.where(np.arange(n) % 2 == 0, 0.5, 9.5), np.linspace(0.0, 4.0, n)))
+    assert _walk_into(pts, 0.1, False, np.empty((0, 2))) > 4 * n + 16
+    np.testing.assert_array_equal(shortstraw(pts, 0.1, 1), shortstraw_ref(pts, 0.1, 1))
+    ranges = np.hypot(pts[:, 0], pts[:, 1])
+    directions = pts / ranges[:, None]
+    vb, va = scan_turning(ranges, directions, 20.0, 0.1, 1, 0.99, 0.95, True, False)
+    poly = np.vstack((np.zeros((1, 2)), shortstraw_ref(directions * ranges[:, None], 0.1, 1)))
+    rb, ra = _turning(poly)
+    assert len(va) >= 3
+    np.testing.assert_array_equal(vb, rb)
+    np.testing.assert_array_equal(va, ra)

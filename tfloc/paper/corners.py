@@ -269,38 +269,37 @@ def _merge_lines_into(points: np.ndarray, corners: np.ndarray, threshold: float,
 @njit(cache=True, nogil=True)
 def _shortstraw(points: np.ndarray, spacing: float, window: int, t: float,
                 line_threshold: float, along_path: bool = False) -> np.ndarray:
-    """Algs. 1–3 in one compiled call (see :func:`shortstraw`)."""
-    res = _walk(points, spacing, along_path)
-    n = res.shape[0]
-    if n <= 2 * window:
-        cand = np.arange(n) if n < 2 else np.array([0, n - 1], dtype=np.int64)
-    else:
-        cand = _candidates(res, window, t)
-    keep = merge_lines(res, cand, line_threshold)
-    out = np.empty((keep.shape[0], 2))
-    for i in range(keep.shape[0]):
-        out[i, 0], out[i, 1] = res[keep[i], 0], res[keep[i], 1]
-    return out
+    """Algs. 1–3 in one compiled call (see :func:`shortstraw`): :func:`_shortstraw_into` with
+    buffers of its own, room for a walk of ``4n + 16`` points first and, for a longer walk,
+    exactly as many as it has."""
+    rows = 4 * points.shape[0] + 16
+    out = np.empty((rows + 2, 2))
+    k = _shortstraw_into(points, spacing, window, t, line_threshold, along_path,
+                         shortstraw_workspace(rows), out, 0)
+    if k < 0:
+        rows = _walk_into(points, spacing, along_path, np.empty((0, 2)))
+        out = np.empty((rows + 2, 2))
+        k = _shortstraw_into(points, spacing, window, t, line_threshold, along_path,
+                             shortstraw_workspace(rows), out, 0)
+    return out[:k].copy()
 
 
 @njit(cache=True, nogil=True)
-def shortstraw_workspace(n_points: int) -> tuple:
-    """Buffers for :func:`_shortstraw_into` on up to ``n_points`` input points: the walk
-    ``(4n + 16, 2)``, straws, sort scratch, candidates, path lengths, kept corners."""
-    cap = 4 * n_points + 16
-    return (np.empty((cap, 2)), np.empty(cap), np.empty(cap), np.empty(cap + 2, dtype=np.int64),
-            np.empty(cap), np.empty(cap + 2, dtype=np.int64))
+def shortstraw_workspace(rows: int) -> tuple:
+    """Buffers for :func:`_shortstraw_into` on a walk (Alg. 1) of up to ``rows`` points: the
+    walk ``(rows, 2)``, straws, sort scratch, candidates, path lengths, kept corners."""
+    return (np.empty((rows, 2)), np.empty(rows), np.empty(rows), np.empty(rows + 2, dtype=np.int64),
+            np.empty(rows), np.empty(rows + 2, dtype=np.int64))
 
 
 @njit(cache=True, nogil=True)
 def _shortstraw_into(points: np.ndarray, spacing: float, window: int, t: float,
                      line_threshold: float, along_path: bool, ws: tuple, out: np.ndarray,
                      offset: int) -> int:
-    """:func:`_shortstraw` without allocations: the corners into rows ``offset …`` of ``out``
-    (``offset + 4n + 18`` rows or more), the work in ``ws`` (:func:`shortstraw_workspace` of
-    at least ``len(points)`` points); returns the number of corners, or −1 when the walk does
-    not fit (a path longer than about ``2n·spacing``; then call :func:`_shortstraw`). The same
-    steps and arithmetic as :func:`_shortstraw`."""
+    """Algs. 1–3 without allocations: the corners into rows ``offset …`` of ``out``
+    (``offset + rows + 2`` rows or more), the work in ``ws`` (:func:`shortstraw_workspace` of
+    ``rows`` walk points); returns the number of corners, or −1 when the walk does not fit
+    in ``rows`` points (:func:`_shortstraw` then sizes the buffers for it)."""
     walk, straws, scratch, cand, cum, keep = ws
     if points.shape[0] == 0:
         return 0

@@ -18,8 +18,8 @@ from tfloc.core.laser import _returns_to_points, _returns_to_points_into
 from tfloc.maps._raycast import raycast_segments
 from tfloc.maps.inside import raster_code
 
-from .corners import _shortstraw, _shortstraw_into, shortstraw_workspace
-from .turning import TWO_PI, _best_shift_into, _turning, _turning_into
+from .corners import _shortstraw_into, _walk_into, shortstraw_workspace
+from .turning import TWO_PI, _best_shift_into, _turning_into
 
 
 @njit(cache=True, nogil=True)
@@ -29,27 +29,32 @@ def scan_turning(ranges: np.ndarray, directions: np.ndarray, max_range: float, s
     """Breaks and angles of a scan's turning function (empty when its polygon has < 3 edges).
 
     ``ranges`` (metres) of beams with unit ``directions`` ``(n_beams, 2)``; the other arguments
-    are those of :class:`tfloc.paper.matcher.TfConfig`."""
-    pts = _returns_to_points(ranges, directions, max_range)
-    if pts.shape[0] < 2:
-        corners = pts.copy()
-    else:
-        corners = _shortstraw(pts, spacing, window, t, line_threshold, along_path)
-    if close_through_origin:
-        poly = np.zeros((corners.shape[0] + 1, 2))
-        poly[1:] = corners
-        return _turning(poly)
-    return _turning(corners)
+    are those of :class:`tfloc.paper.matcher.TfConfig`. :func:`_scan_turning_into` with buffers
+    of its own: room for a walk of ``4n + 16`` points first and, for a longer walk, exactly as
+    many as it has."""
+    n_beams = ranges.shape[0]
+    ws = turning_workspace(n_beams, 0, 4 * n_beams + 16)
+    k = _scan_turning_into(ranges, directions, max_range, spacing, window, t, line_threshold,
+                           close_through_origin, along_path, ws)
+    if k < 0:
+        rows = _walk_into(_returns_to_points(ranges, directions, max_range), spacing, along_path,
+                          np.empty((0, 2)))
+        ws = turning_workspace(n_beams, 0, rows)
+        k = _scan_turning_into(ranges, directions, max_range, spacing, window, t,
+                               line_threshold, close_through_origin, along_path, ws)
+    if k < 3:
+        return np.empty(0), np.empty(0)
+    return ws[7][:k + 1].copy(), ws[6][:k].copy()
 
 
 @njit(cache=True, nogil=True)
-def turning_workspace(n_beams: int, n_real: int) -> tuple:
-    """Buffers for :func:`_scan_turning_into` on scans of ``n_beams`` beams and the match
-    against a real turning function of ``n_real`` edges: the points, ShortStraw's
-    (:func:`~tfloc.paper.corners.shortstraw_workspace`), the polygon, the turning function's,
-    the match's."""
-    rows = 4 * n_beams + 19         # the polygon: the origin and at most 4n + 18 corners
-    return (np.empty((n_beams, 2)), shortstraw_workspace(n_beams), np.empty((rows, 2)),
+def turning_workspace(n_beams: int, n_real: int, walk_rows: int) -> tuple:
+    """Buffers for :func:`_scan_turning_into` on scans of ``n_beams`` beams whose ShortStraw
+    walk has up to ``walk_rows`` points, and the match against a real turning function of
+    ``n_real`` edges: the points, ShortStraw's (:func:`~tfloc.paper.corners.shortstraw_workspace`),
+    the polygon, the turning function's, the match's."""
+    rows = walk_rows + 3            # the polygon: the origin and at most walk_rows + 2 corners
+    return (np.empty((n_beams, 2)), shortstraw_workspace(walk_rows), np.empty((rows, 2)),
             np.empty(rows), np.empty(rows), np.empty(rows), np.empty(rows), np.empty(rows + 1),
             np.empty(rows), np.empty(n_real + 1 + rows), np.empty(n_real + rows),
             np.empty(n_real + rows))
@@ -61,8 +66,8 @@ def _scan_turning_into(ranges: np.ndarray, directions: np.ndarray, max_range: fl
                        close_through_origin: bool, along_path: bool, ws: tuple) -> int:
     """:func:`scan_turning` in the buffers ``ws`` (:func:`turning_workspace`): returns the number
     of edges ``k`` (the function is ``ws[7][:k + 1]``, ``ws[6][:k]``; none when ``k`` < 3), or −1
-    when ShortStraw's walk did not fit (then :func:`scan_turning` gives it). The same steps and
-    arithmetic as :func:`scan_turning`, without its allocations."""
+    when ShortStraw's walk did not fit (then :func:`scan_turning` gives it): the points (Eq. 4),
+    ShortStraw's corners (Algs. 1–3), the closed polygon, its turning function (Alg. 4)."""
     pts_buf, sws, poly, ex, ey, length, angles, breaks = ws[:8]
     n = _returns_to_points_into(ranges, directions, max_range, pts_buf)
     off = 1 if close_through_origin else 0
@@ -99,7 +104,7 @@ def scan_errors(scans: np.ndarray, directions: np.ndarray, max_range: float, spa
     n = scans.shape[0]
     err = np.full(n, penalty)
     rot = np.zeros(n)
-    ws = turning_workspace(scans.shape[1], real_angles.shape[0])
+    ws = turning_workspace(scans.shape[1], real_angles.shape[0], 4 * scans.shape[1] + 16)
     moved, grid, width, d = ws[8], ws[9], ws[10], ws[11]
     for p in range(n):
         k = _scan_turning_into(scans[p], directions, max_range, spacing, window, t,
