@@ -95,6 +95,18 @@ def load_average() -> list[float] | None:
         return None
 
 
+def git_state() -> dict:
+    """``{"commit", "dirty"}`` of the working tree (``None`` each where git cannot say)."""
+    try:
+        commit = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
+                                timeout=10).stdout.strip() or None
+        dirty = bool(subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
+                                    capture_output=True, text=True, timeout=10).stdout.strip())
+    except (OSError, subprocess.SubprocessError):
+        commit, dirty = None, None
+    return {"commit": commit, "dirty": dirty}
+
+
 def environment() -> dict:
     """Package versions, git commit and machine, for ``run.json``."""
     versions = {}
@@ -103,14 +115,7 @@ def environment() -> dict:
             versions[pkg] = metadata.version(pkg)
         except metadata.PackageNotFoundError:
             versions[pkg] = None
-    try:
-        commit = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
-                                timeout=10).stdout.strip() or None
-        dirty = bool(subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
-                                    capture_output=True, text=True, timeout=10).stdout.strip())
-    except (OSError, subprocess.SubprocessError):
-        commit, dirty = None, None
-    return {"versions": versions, "git": {"commit": commit, "dirty": dirty},
+    return {"versions": versions, "git": git_state(),
             "machine": {"platform": platform.platform(), "processor": platform.processor(),
                         "cpu_count": os.cpu_count(), "python": sys.version.split()[0],
                         "node": platform.node()}}

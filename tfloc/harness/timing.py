@@ -35,7 +35,7 @@ import pandas as pd
 from tfloc.errors import ConfigError
 from tfloc.io.rundir import RunDir, RunInfo
 
-from .runner import environment, load_average
+from .runner import git_state, load_average
 from .threads import limit_threads
 from .workspace import load_dataset, load_matcher, problem_of, timed_localize, warm
 
@@ -110,7 +110,7 @@ def run_timing(run_dir: Path, per_stratum: int = 4, seed: int = SEED, cores: Seq
     info = {"cores": pinned, "per_stratum": per_stratum, "seed": seed, "warmup": warmup,
             "scans": len(sample), "strata": int(sample.groupby(["dataset", "group"]).ngroups),
             "loadavg_start": load_start, "loadavg_end": load_average(), "started": started,
-            "git": environment()["git"], "run_git": info_run.doc.get("git", {})}
+            "git": git_state(), "run_git": info_run.doc.get("git", {})}
     return rows, info
 
 
