@@ -8,6 +8,15 @@ code with old code), and a cached caller of a changed callee can crash. So, unle
 chose a directory (``NUMBA_CACHE_DIR``), the cache lives in
 ``$XDG_CACHE_HOME/tfloc/numba/<hash of every tfloc module's source>`` (``~/.cache`` when unset): any change of the source
 starts a fresh cache, and each version's cache stays valid. The last few versions are kept.
+
+The directory is also put in the environment (``NUMBA_CACHE_DIR``). numba reads its settings from
+the environment again whenever the environment has changed (``numba.core.config.reload_config``,
+called by :func:`tfloc.harness.threads.limit_threads` and by numba's compiler): a directory set
+in ``numba.config`` alone was then dropped, and every kernel module imported after a thread limit
+was cached in its own ``__pycache__``, per source file, where a caller kept its callees' old code
+(the harness's timing pass measured `tf` with a ray caster two commits old). A child process
+inherits the variable; ``TFLOC_NUMBA_CACHE_DIR`` marks it as tfloc's own, so the child still
+picks the directory of its own source version, and a directory the user chose is left alone.
 """
 
 from __future__ import annotations
@@ -19,6 +28,7 @@ import shutil
 from pathlib import Path
 
 KEEP = 4  # cache directories of other source versions kept (most recently used)
+_MARK = "TFLOC_NUMBA_CACHE_DIR"  # NUMBA_CACHE_DIR as tfloc set it (not the user's choice)
 
 
 def source_hash(roots: list[Path]) -> str:
@@ -53,7 +63,9 @@ def configure() -> str | None:
     directory can be made (numba then keeps its own default, ``__pycache__``)."""
     import numba
 
-    if os.environ.get("NUMBA_CACHE_DIR") or numba.config.CACHE_DIR:
+    chosen = os.environ.get("NUMBA_CACHE_DIR")
+    ours = chosen is not None and chosen == os.environ.get(_MARK)
+    if (chosen and not ours) or (not chosen and numba.config.CACHE_DIR):
         return None
     base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "tfloc" / "numba"
     here = base / source_hash(_roots())
@@ -61,8 +73,12 @@ def configure() -> str | None:
         here.mkdir(parents=True, exist_ok=True)
         os.utime(here)
     except OSError:
+        if ours:  # not a parent's directory of perhaps another source version
+            del os.environ["NUMBA_CACHE_DIR"], os.environ[_MARK]
+            numba.config.CACHE_DIR = ""
         return None
     numba.config.CACHE_DIR = str(here)
+    os.environ["NUMBA_CACHE_DIR"] = os.environ[_MARK] = str(here)  # kept when numba re-reads
     _prune(base, here)
     return str(here)
 
