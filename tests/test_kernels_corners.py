@@ -167,10 +167,37 @@ def test_merge_lines_handles_short_corner_lists():
         np.testing.assert_array_equal(merge_lines(pts, c), merge_lines_ref(pts, c))
 
 
-def test_a_walk_longer_than_the_first_buffers_is_walked_again_in_exact_ones():
+def test_walk_room_holds_every_walk() -> None:
+    """The room the allocating walks take (walk_room: path / S + 2n + 16) is never short, for
+    either walk, on random walks, zigzags with steps far below and far above S, and points
+    scattered at random; the old 4n + 16 is short here."""
+    from tfloc.paper.corners import _walk_into, walk_room
+
+    rng = np.random.default_rng(26)
+    short_at_4n = False
+    for trial in range(240):
+        n = int(rng.integers(2, 80))
+        kind = trial % 3
+        if kind == 0:
+            pts = np.cumsum(rng.normal(scale=rng.uniform(0.01, 2.0), size=(n, 2)), axis=0)
+        elif kind == 1:
+            pts = np.column_stack((np.arange(n) * rng.uniform(0.001, 0.5),
+                                   (np.arange(n) % 2) * rng.uniform(0.01, 3.0)))
+        else:
+            pts = rng.uniform(-5.0, 5.0, size=(n, 2))
+        for spacing in (0.05, 0.3, 1.0):
+            room = walk_room(pts, spacing)
+            for along in (False, True):
+                m = _walk_into(pts, spacing, along, np.empty((0, 2)))
+                assert m <= room, (trial, spacing, along, m, room)
+                short_at_4n |= m > 4 * n + 16
+    assert short_at_4n
+
+
+def test_a_walk_longer_than_4n_points_gives_the_references_corners():
     """Zigzags 9 m long at 0.1 m spacing walk ~90 points per input point, far beyond the 4n + 16
-    the buffers first hold: the retry sized from the exact count gives the reference's corners,
-    and scan_turning's retry the turning function of those corners."""
+    the buffers held until walk_room sized them: the corners are the reference's, and
+    scan_turning gives the turning function of those corners."""
     from tfloc.paper.corners import _walk_into
     from tfloc.paper.kernels import scan_turning
     from tfloc.paper.turning import _turning

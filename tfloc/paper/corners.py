@@ -116,16 +116,32 @@ def _walk_into(points: np.ndarray, spacing: float, along_path: bool, out: np.nda
 
 
 @njit(cache=True, nogil=True)
+def walk_room(points: np.ndarray, spacing: float) -> int:
+    """Room for Algorithm 1's walk of ``points`` ``(N, 2)`` at ``spacing`` metres, either walk:
+    ``path length / spacing + 2N + 16`` points. The chord walk starts towards input point *i*
+    from within S of point *i − 1* and steps S towards it while farther than S, so point *i*
+    gives at most ``|P(i) − P(i−1)| / S + 1`` points; the path walk emits one per S of path; the
+    first and last points add two. (The walks still check their room, and the callers count
+    exactly and walk again should rounding ever exceed it.)
+
+    Until issue 26 the allocating walks took room for ``4N + 16`` points, which holds a walk at
+    ``tf``'s S = 1 m but never one at ``tf-plus``'s 5 cm (a 40 m scan path is 800 points for 181
+    beams): they walked part of the way, counted, and walked again, for every scan."""
+    path = 0.0
+    for i in range(1, points.shape[0]):
+        dx, dy = points[i, 0] - points[i - 1, 0], points[i, 1] - points[i - 1, 1]
+        path += np.sqrt(dx * dx + dy * dy)
+    return int(path / spacing) + 2 * points.shape[0] + 16
+
+
+@njit(cache=True, nogil=True)
 def _walk(points: np.ndarray, spacing: float, along_path: bool) -> np.ndarray:
     """Algorithm 1's walk (chords, or along the path if ``along_path``) into an array sized from
-    the path length: ``(M, 2)``."""
+    the path length (:func:`walk_room`): ``(M, 2)``."""
     n = points.shape[0]
     if n == 0:
         return np.empty((0, 2))
-    # M ≤ path/spacing + 2 per input point (each emission walks S); a scan's path is rarely
-    # longer than n·spacing, so room for 4n + 16 points (no pass for the path length) nearly
-    # always suffices, and where it does not, the points are counted exactly and walked again.
-    out = np.empty((4 * n + 16, 2))
+    out = np.empty((walk_room(points, spacing), 2))
     m = _walk_into(points, spacing, along_path, out)
     if m < 0:                  # the path is longer than about 2n·spacing: count exactly, redo
         out = np.empty((_walk_into(points, spacing, along_path, np.empty((0, 2))), 2))
@@ -270,9 +286,9 @@ def _merge_lines_into(points: np.ndarray, corners: np.ndarray, threshold: float,
 def _shortstraw(points: np.ndarray, spacing: float, window: int, t: float,
                 line_threshold: float, along_path: bool = False) -> np.ndarray:
     """Algs. 1–3 in one compiled call (see :func:`shortstraw`): :func:`_shortstraw_into` with
-    buffers of its own, room for a walk of ``4n + 16`` points first and, for a longer walk,
-    exactly as many as it has."""
-    rows = 4 * points.shape[0] + 16
+    buffers of its own, room for the walk as :func:`walk_room` bounds it and, should a walk ever
+    be longer, exactly as many points as it has."""
+    rows = walk_room(points, spacing)
     out = np.empty((rows + 2, 2))
     k = _shortstraw_into(points, spacing, window, t, line_threshold, along_path,
                          shortstraw_workspace(rows), out, 0)

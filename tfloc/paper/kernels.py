@@ -18,7 +18,7 @@ from tfloc.core.laser import _returns_to_points, _returns_to_points_into
 from tfloc.maps._raycast import raycast_segments
 from tfloc.maps.inside import raster_code
 
-from .corners import _shortstraw_into, _walk_into, shortstraw_workspace
+from .corners import _shortstraw_into, _walk_into, shortstraw_workspace, walk_room
 from .turning import TWO_PI, _best_shift_into, _turning_into
 
 
@@ -30,10 +30,11 @@ def scan_turning(ranges: np.ndarray, directions: np.ndarray, max_range: float, s
 
     ``ranges`` (metres) of beams with unit ``directions`` ``(n_beams, 2)``; the other arguments
     are those of :class:`tfloc.paper.matcher.TfConfig`. :func:`_scan_turning_into` with buffers
-    of its own: room for a walk of ``4n + 16`` points first and, for a longer walk, exactly as
-    many as it has."""
+    of its own: room for the walk as :func:`~tfloc.paper.corners.walk_room` bounds it and,
+    should a walk ever be longer, exactly as many points as it has."""
     n_beams = ranges.shape[0]
-    ws = turning_workspace(n_beams, 0, 4 * n_beams + 16)
+    rows = walk_room(_returns_to_points(ranges, directions, max_range), spacing)
+    ws = turning_workspace(n_beams, 0, rows)
     k = _scan_turning_into(ranges, directions, max_range, spacing, window, t, line_threshold,
                            close_through_origin, along_path, ws)
     if k < 0:
