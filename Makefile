@@ -28,7 +28,7 @@ quick: $(STAMP)
 
 ## The main job: every registered matcher on the bundled scenarios, a side-by-side timing pass
 ## of each run (timing.md), and the reports; then the reading study of the paper's method and the
-## tf-plus ablation. About an hour on 2 cores (README).
+## tf-plus ablation. About 80 min on 2 cores (README).
 bench: $(STAMP)
 	$(BIN)/tfloc bench benchmarks/paper-protocol.toml --jobs $(JOBS) --regenerate
 	$(BIN)/tfloc timing results/paper-protocol
