@@ -143,7 +143,7 @@ def _walk(points: np.ndarray, spacing: float, along_path: bool) -> np.ndarray:
         return np.empty((0, 2))
     out = np.empty((walk_room(points, spacing), 2))
     m = _walk_into(points, spacing, along_path, out)
-    if m < 0:                  # the path is longer than about 2n·spacing: count exactly, redo
+    if m < 0:                  # longer than walk_room's bound (rounding): count exactly, redo
         out = np.empty((_walk_into(points, spacing, along_path, np.empty((0, 2))), 2))
         m = _walk_into(points, spacing, along_path, out)
     return out[:m]

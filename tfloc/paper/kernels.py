@@ -33,14 +33,12 @@ def scan_turning(ranges: np.ndarray, directions: np.ndarray, max_range: float, s
     of its own: room for the walk as :func:`~tfloc.paper.corners.walk_room` bounds it and,
     should a walk ever be longer, exactly as many points as it has."""
     n_beams = ranges.shape[0]
-    rows = walk_room(_returns_to_points(ranges, directions, max_range), spacing)
-    ws = turning_workspace(n_beams, 0, rows)
+    pts = _returns_to_points(ranges, directions, max_range)
+    ws = turning_workspace(n_beams, 0, walk_room(pts, spacing))
     k = _scan_turning_into(ranges, directions, max_range, spacing, window, t, line_threshold,
                            close_through_origin, along_path, ws)
     if k < 0:
-        rows = _walk_into(_returns_to_points(ranges, directions, max_range), spacing, along_path,
-                          np.empty((0, 2)))
-        ws = turning_workspace(n_beams, 0, rows)
+        ws = turning_workspace(n_beams, 0, _walk_into(pts, spacing, along_path, np.empty((0, 2))))
         k = _scan_turning_into(ranges, directions, max_range, spacing, window, t,
                                line_threshold, close_through_origin, along_path, ws)
     if k < 3:
@@ -105,6 +103,10 @@ def scan_errors(scans: np.ndarray, directions: np.ndarray, max_range: float, spa
     n = scans.shape[0]
     err = np.full(n, penalty)
     rot = np.zeros(n)
+    # room for a walk of 4n + 16 points, without a pass for each scan's path length (this runs
+    # for every Function1): by walk_room's bound it holds every path up to (2n + 14)·S, 376 m
+    # at tf's S = 1 m for 181 beams (37.6 m at tf-best's 0.1 m); a longer walk goes to
+    # scan_turning, which sizes its buffers from the path
     ws = turning_workspace(scans.shape[1], real_angles.shape[0], 4 * scans.shape[1] + 16)
     moved, grid, width, d = ws[8], ws[9], ws[10], ws[11]
     for p in range(n):
