@@ -34,6 +34,10 @@ needs ~1800 cost evaluations per scan). Stages:
    within ``tie_tolerance`` of the best (the scan sees the same geometry from both places, e.g.
    a bare corner) are a tie, broken in favour of the one nearest the VP.
 
+In the default configuration on vector and grid maps the stages run in one compiled call per
+scan (:mod:`tfloc.tfplus.pipeline`: the same kernels and answers, without the Python between
+them).
+
 Each stage can be switched off or put back as it was before the real logs (``tf_seed``,
 ``heading_sweep``, ``grid``, ``coarse_bound``, ``refine``, ``refine_to="virtual"``,
 ``select="virtual"``, ``beam_check``, ``tie_tolerance=0``) for the ablations in
@@ -61,6 +65,7 @@ from tfloc.maps.vector import VectorMap
 from tfloc.paper.shape import ShapeConfig, scan_turning_function
 from tfloc.paper.turning import match
 
+from . import pipeline
 from .coarse import candidates, lattice, pose_scores
 from .cost import scan_cost
 from .headings import scan_rotations
@@ -228,13 +233,46 @@ class TurningFunctionPlusMatcher(Configured):
         xy = problem.initial.xy[None, :]
         problem.map.in_bounds(xy)
         problem.map.is_free(xy)
+        pipeline.plan_for(problem, self.config)  # the one-call pipeline's plan, if it applies
 
     def localize(self, problem: Problem) -> Estimate:
+        """The stages of the module docstring: in one compiled call where the configuration and
+        the map allow (:mod:`tfloc.tfplus.pipeline`, the same answers), else stage by stage."""
+        cfg = self.config
+        vp = problem.initial
+        plan = pipeline.plan_for(problem, cfg)
+        found = None
+        if plan is not None:
+            status, returns, cands, cost, rots, seeded, evaluations = pipeline.run(
+                plan, problem.ranges, vp.x, vp.y, vp.theta)
+            if status == pipeline.TOO_FEW:
+                return self._no_answer(problem, returns)
+            if status == pipeline.OK:
+                info = {"tf_rotations": rots.tolist()} if seeded else {}
+                found = cands, cost, info, evaluations
+        if found is None:
+            found = self._staged(problem)
+            if found is None:
+                return self._no_answer(problem, len(problem.points))
+        cands, cost, info, evaluations = found
+        b = pick(cost, cands, vp, cfg.tie_tolerance)
+        pose = Pose.from_array(cands[b])
+        info.update({"status": "ok", "candidates": len(cands), "cost": float(cost[b])})
+        return Estimate(pose, True, 1, int(evaluations), info)
+
+    def _no_answer(self, problem: Problem, returns: int) -> Estimate:
+        """The answer to a scan with too few returns: the VP, not converged."""
+        return Estimate(problem.initial, False, 0, 0, {
+            "status": "no-answer", "reason": f"{returns} returns (< {self.config.min_returns})"})
+
+    def _staged(self, problem: Problem) -> tuple[np.ndarray, np.ndarray, dict, int] | None:
+        """The stages one call each: the refined candidates ``(K, 3)``, their selection cost
+        ``(K,)``, what the turning function said and the evaluations; ``None`` with too few
+        returns."""
         cfg = self.config
         points = problem.points
         if len(points) < cfg.min_returns:
-            return Estimate(problem.initial, False, 0, 0, {
-                "status": "no-answer", "reason": f"{len(points)} returns (< {cfg.min_returns})"})
+            return None
         heads, info = heading_seeds(problem, cfg)
         vp = problem.initial
         if cfg.grid:
@@ -266,10 +304,7 @@ class TurningFunctionPlusMatcher(Configured):
             cost = tf_errs(problem, cands, cfg)
         else:
             cost = self._cost(problem, cands)
-        b = pick(cost, cands, vp, cfg.tie_tolerance)
-        pose = Pose.from_array(cands[b])
-        info.update({"status": "ok", "candidates": len(cands), "cost": float(cost[b])})
-        return Estimate(pose, True, 1, int(evaluations), info)
+        return cands, cost, info, evaluations
 
     def score(self, problem: Problem, pose: Pose) -> float:
         """The selection objective at ``pose`` (:func:`tfloc.tfplus.cost.scan_cost`), as its root

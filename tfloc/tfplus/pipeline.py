@@ -1,0 +1,312 @@
+"""``tf-plus``'s default configuration in one compiled call per scan, on vector and grid maps.
+
+:meth:`~tfloc.tfplus.matcher.TurningFunctionPlusMatcher.localize` runs its stages
+(:mod:`~tfloc.tfplus.headings`, :mod:`~tfloc.tfplus.coarse`, :mod:`~tfloc.tfplus.refine`,
+:mod:`~tfloc.tfplus.cost`) as a dozen compiled kernels glued by Python: map-view look-ups,
+property reads, argument conversions, small arrays. Measured on the paper protocol (issue 26)
+that glue was ~0.15 ms of a 1.2 ms call with warm caches and ~0.4 ms of 1.7 ms once other
+matchers had run in between (as in the timing pass): the interpreter's own objects are then cold.
+Here the same kernels run in one compiled call, fed by a :class:`Plan` of everything that depends
+on the map, the laser and the configuration alone (built once per map), so per scan there is
+one dispatch from Python and the answer's assembly.
+
+Same arithmetic, same order, same kernels: the poses and costs are those of the staged path bit
+for bit (``tests/test_tfplus_pipeline.py`` runs both). The plan covers the default stage
+switches only (turning-function seeds and the heading sweep, the coarse grid, the refinement
+``refine_to="auto"`` or its map's own kind, ``select="residual"``); every other configuration,
+another kind of map, or a vector map whose free-space tests are not built, goes the staged way
+(:func:`plan_for` returns ``None``), and so does a scan whose lattice the compiled free-space
+test cannot decide (status :data:`UNDECIDED`).
+"""
+
+from __future__ import annotations
+
+import weakref
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numba import njit
+
+from tfloc.core.laser import LaserSpec, _returns_to_points
+from tfloc.maps._gridcast import raycast_grid
+from tfloc.maps._raycast import raycast_segments
+from tfloc.maps.cache import cached
+from tfloc.maps.grid import GridMap
+from tfloc.maps.inside import SURE
+from tfloc.maps.vector import VectorMap
+
+from . import refine as refine_module
+from .coarse import _offsets
+from .cost_kernel import grid_cost_kernel, vector_cost_kernel
+from .headings import _pair_kernel, _scan_rotations
+from .kernels import (
+    candidates_kernel,
+    field_pairs_kernel,
+    grid_lattice_kernel,
+    lattice_kernel,
+    refine_field_kernel,
+)
+from .virtual_kernel import prune_index_kernel, refine_vector_kernel, truncated_cost_kernel
+
+if TYPE_CHECKING:
+    from tfloc.core.problem import Problem
+
+    from .matcher import TfPlusConfig
+
+OK, TOO_FEW, UNDECIDED = 0, 1, 2  #: statuses of the pipeline kernels
+
+_BINS = 720                       # the heading histograms' bins and smoothing (radians), as
+_SMOOTHING = float(np.radians(1.0))  # :func:`tfloc.tfplus.headings.scan_rotations` defaults them
+
+
+@dataclass(frozen=True, eq=False)
+class Plan:
+    """What :func:`run` passes to its kernel besides the scan: ``kind`` ``"vector"`` or
+    ``"grid"``, and the kernel's static arguments (arrays and numbers of the map's views, the
+    laser and the configuration; metres, radians)."""
+
+    kind: str
+    args: tuple
+
+
+_last: tuple | None = None  # (map, laser, configuration, plan) of the last plan_for, weakly
+
+
+def plan_for(problem: Problem, cfg: TfPlusConfig) -> Plan | None:
+    """The plan of ``problem``'s map and laser under ``cfg`` (built once per map, laser and
+    configuration), or ``None`` where the staged path must serve (see the module docstring)."""
+    global _last
+    if not refine_module._FUSED:             # tests turn the compiled paths off
+        return None
+    last = _last
+    if (last is not None and last[1] is problem.laser and last[2] is cfg
+            and last[0]() is problem.map):
+        plan = last[3]()
+        if plan is not None:
+            return plan
+    plan = _plan_of(problem.map, problem.laser, cfg)
+    if plan is not None:
+        try:
+            _last = (weakref.ref(problem.map), problem.laser, cfg, weakref.ref(plan))
+        except TypeError:                      # a map that cannot be weakly referenced
+            _last = None
+    return plan
+
+
+def _plan_of(map_: object, laser: LaserSpec, cfg: TfPlusConfig) -> Plan | None:
+    """:func:`plan_for` without its memo of the last call."""
+    if not (cfg.tf_seed and cfg.heading_sweep and cfg.grid and cfg.refine
+            and cfg.select == "residual"):
+        return None
+    if isinstance(map_, VectorMap):
+        if cfg.refine_to not in ("auto", "virtual"):
+            return None
+        if map_.area_rings() is None or map_.free_rings() is None:
+            return None                      # not built (a map used once): the staged path
+        kind = "vector"
+    elif isinstance(map_, GridMap):
+        if cfg.refine_to not in ("auto", "field"):
+            return None
+        kind = "grid"
+    else:
+        return None
+    return cached(map_, ("tf-plus-plan", laser, cfg), lambda: _build(map_, laser, cfg, kind))
+
+
+def _build(map_: VectorMap | GridMap, laser: LaserSpec, cfg: TfPlusConfig, kind: str) -> Plan:
+    """The :class:`Plan`: the same values the staged path computes per call."""
+    from .matcher import _coarse_field, _field, _heading_offsets, _sweep  # (it imports this)
+
+
+    field, pooled = _field(map_, cfg), _coarse_field(map_, cfg)
+    cos_a, sin_a = refine_module._beam_trig(laser)
+    max_range = float(laser.max_range)
+    beams = (np.asarray(laser.angles, dtype=float), laser.directions, cos_a, sin_a,
+             float(laser.angle_min), float(laser.resolution), max_range)
+    shape = cfg.shape
+    width = 2 * np.pi / _BINS
+    rotation = (float(shape.spacing), int(shape.window), float(shape.straw_t),
+                float(shape.line_threshold), bool(shape.close_through_origin),
+                shape.resampling == "path", _BINS, True, _pair_kernel(_BINS, _SMOOTHING),
+                int(np.floor(cfg.max_rotation / width)), int(cfg.rotation_seeds))
+    headings = (_sweep(cfg.heading_span, cfg.heading_step), _heading_offsets(cfg.heading_offsets))
+    corner = field.origin
+    lattice = (_offsets(float(cfg.search_radius), float(cfg.grid_step)), field.table,
+               float(corner[0]), float(corner[1]), field.resolution,
+               field.table.dtype.type(cfg.clearance))
+    coarse = (pooled.table, float(pooled.origin[0]), float(pooled.origin[1]), pooled.resolution,
+              int(cfg.coarse_points), int(cfg.scan_stride), int(cfg.shortlist),
+              int(cfg.candidates), float(cfg.separation), float(cfg.grid_step))
+    r = cfg.refinement
+    gates = refine_module._gates(r)
+    view = (field.nearest, float(field.origin[0]), float(field.origin[1]), field.resolution,
+            field.points, field.normals)
+    common = (beams, rotation, headings, lattice, coarse, view, int(cfg.min_returns),
+              int(r.iterations), float(r.inlier_distance), bool(cfg.beam_check))
+    if kind == "vector":
+        refine = (gates, int(r.inner), int(r.window), float(r.damping), int(r.prune_after),
+                  int(r.keep))
+        free = (map_.area_rings().kernel, map_.free_rings().kernel, SURE)
+        return Plan(kind, common + (refine, free, map_.segments, map_.segment_index(max_range)))
+    refine = (gates, int(r.inner), float(r.damping), int(r.prune_after), int(r.keep),
+              bool(r.faces and field.faces), bool(field.faces), field.face_plus, field.face_minus,
+              float(r.offset_gate), float(r.face_weight), float(r.cell_weight),
+              float(r.offset_weight), float(r.offset_prior), float(r.max_depth))
+    grid = (map_.occupied, float(map_.origin[0]), float(map_.origin[1]), float(map_.resolution),
+            map_.free, map_.distance)
+    return Plan(kind, common + (refine, grid))
+
+
+def run(plan: Plan, ranges: np.ndarray, x: float, y: float, theta: float) -> tuple:
+    """The pipeline on one scan (``ranges``, metres) from the initial guess ``(x, y, theta)``:
+    ``(status, returns, poses (K, 3), cost (K,), rotations, seeded, evaluations)`` — the refined
+    candidates and their selection cost (metres²), the turning-function rotations (radians;
+    ``seeded`` false: no turning function) and the evaluations counted as the staged path counts
+    them. Status :data:`TOO_FEW`: fewer than ``min_returns`` returns; :data:`UNDECIDED`: the
+    lattice needs the map's own free-space test (nothing else is computed then)."""
+    kernel = vector_pipeline_kernel if plan.kind == "vector" else grid_pipeline_kernel
+    return kernel(ranges, x, y, theta, *plan.args)
+
+
+@njit(cache=True, nogil=True)
+def _headings(theta: float, sweep: np.ndarray, offsets: np.ndarray, rotations: np.ndarray,
+              seeded: bool) -> np.ndarray:
+    """:func:`tfloc.tfplus.matcher.heading_seeds`'s headings: ``θ + sweep``, then
+    ``(θ − rotation) + offset`` for each rotation × offset (radians)."""
+    n_s, n_o = sweep.shape[0], offsets.shape[0]
+    n_r = rotations.shape[0] if seeded else 0
+    out = np.empty(n_s + n_r * n_o)
+    for i in range(n_s):
+        out[i] = theta + sweep[i]
+    k = n_s
+    for r in range(n_r):
+        base = theta - rotations[r]
+        for o in range(n_o):
+            out[k] = base + offsets[o]
+            k += 1
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _seeded_headings(ranges: np.ndarray, virtual: np.ndarray, theta: float, beams: tuple,
+                     rotation: tuple, headings: tuple) -> tuple[np.ndarray, np.ndarray, bool]:
+    """The turning-function rotations of the real scan against the virtual one at the VP
+    (:func:`tfloc.tfplus.headings._scan_rotations`) and the coarse search's headings."""
+    spacing, window, straw_t, line_threshold, close, along, bins, skip, g2, k_max, count = rotation
+    rots, seeded = _scan_rotations(ranges, virtual, beams[1], beams[6], spacing, window, straw_t,
+                                   line_threshold, close, along, bins, skip, g2, k_max, count)
+    return rots, _headings(theta, headings[0], headings[1], rots, seeded), seeded
+
+
+@njit(cache=True, nogil=True)
+def _coarse(points: np.ndarray, positions: np.ndarray, x: float, y: float, heads: np.ndarray,
+            coarse: tuple) -> tuple[np.ndarray, int]:
+    """The coarse search (:func:`tfloc.tfplus.coarse.candidates`): the candidates and the
+    evaluations it counts (positions × headings + the shortlist)."""
+    table, ox, oy, res, coarse_points, scan_stride, shortlist, count, separation, step = coarse
+    if positions.shape[0] == 0:
+        positions = np.empty((1, 2))
+        positions[0, 0], positions[0, 1] = x, y
+    stride = max(1, points.shape[0] // coarse_points) if coarse_points else scan_stride
+    cands, _, rescored = candidates_kernel(table, ox, oy, res, points, stride, positions, heads,
+                                           shortlist, count, separation, step)
+    return cands, positions.shape[0] * heads.shape[0] + rescored
+
+
+@njit(cache=True, nogil=True)
+def vector_pipeline_kernel(ranges: np.ndarray, x: float, y: float, theta: float, beams: tuple,
+                           rotation: tuple, headings: tuple, lattice: tuple, coarse: tuple,
+                           view: tuple, min_returns: int, iterations: int, inlier: float,
+                           beam_check: bool, refine: tuple, free: tuple, segs: np.ndarray,
+                           index: tuple) -> tuple:
+    """:func:`run` on a vector map (``Plan.args``; see :func:`_build`)."""
+    angles, directions, cos_a, sin_a, angle_min, resolution, max_range = beams
+    points = _returns_to_points(ranges, directions, max_range)
+    nothing = np.empty((0, 3))
+    if points.shape[0] < min_returns:
+        return TOO_FEW, points.shape[0], nothing, np.empty(0), np.empty(0), False, 0
+    vp = np.empty((1, 3))
+    vp[0, 0], vp[0, 1], vp[0, 2] = x, y, theta
+    virtual = raycast_segments(vp, angles, segs, max_range, index)[0]
+    rots, heads, seeded = _seeded_headings(ranges, virtual, theta, beams, rotation, headings)
+    offsets, table, corner_x, corner_y, res, clearance = lattice
+    positions, decided = lattice_kernel(x, y, offsets, table, corner_x, corner_y, res, clearance,
+                                        free[0], free[1], free[2])
+    if not decided:
+        return UNDECIDED, points.shape[0], nothing, np.empty(0), rots, seeded, 0
+    cands, evaluations = _coarse(points, positions, x, y, heads, coarse)
+    gates, inner, window, damping, prune_after, keep = refine
+    cands = refine_vector_kernel(cands, points, angles, cos_a, sin_a, angle_min, resolution,
+                                 segs, index, max_range, gates, inner, window, damping,
+                                 prune_after, keep, inlier)
+    evaluations += cands.shape[0] * iterations
+    nearest, fx, fy, fres, map_points, map_normals = view
+    cost = vector_cost_kernel(nearest, fx, fy, fres, map_points, map_normals, ranges, directions,
+                              angles, max_range, cands, segs, index, inlier, beam_check)
+    return OK, points.shape[0], cands, cost, rots, seeded, evaluations
+
+
+@njit(cache=True, nogil=True)
+def _refine_to_field(view: tuple, points: np.ndarray, poses: np.ndarray, iterations: int,
+                     inlier: float, refine: tuple) -> np.ndarray:
+    """:func:`tfloc.tfplus.refine.refine_to_field`, step for step: the iterations up to
+    ``prune_after`` (:func:`~tfloc.tfplus.kernels.refine_field_kernel`), the pruning to the
+    ``keep`` best by truncated residual (:func:`~tfloc.tfplus.refine.field_pairs` at the last
+    gate), the rest of the iterations."""
+    nearest, fx, fy, fres, map_points, map_normals = view
+    (gates, inner, damping, prune_after, keep, faces, field_faces, face_plus, face_minus,
+     offset_gate, face_weight, cell_weight, offset_weight, offset_prior, max_depth) = refine
+    poses = poses.copy()
+    offsets = np.full(poses.shape[0], offset_prior)
+    cut = prune_after if 0 < prune_after < iterations else iterations
+    started = False
+    for part_no in range(2):
+        part = gates[:cut] if part_no == 0 else gates[cut:]
+        if part.shape[0] == 0:
+            continue
+        started = refine_field_kernel(nearest, fx, fy, fres, map_points, map_normals, face_plus,
+                                      face_minus, points, poses, offsets,
+                                      np.ascontiguousarray(part), inner, offset_gate, faces,
+                                      face_weight, cell_weight, damping, offset_weight,
+                                      offset_prior, max_depth, started)
+        if part_no == 0 and cut < iterations and poses.shape[0] > keep:
+            late = faces and part[-1] <= offset_gate
+            fw = face_weight if late else 0.0
+            cw = cell_weight if late else 1.0
+            with_faces = field_faces and fw > 0
+            _, _, r, _ = field_pairs_kernel(nearest, fx, fy, fres, map_points, map_normals,
+                                            face_plus, face_minus, points, poses, offsets,
+                                            part[-1], fres, cw if with_faces else 1.0,
+                                            fw if with_faces else 0.0)
+            kept = prune_index_kernel(poses, truncated_cost_kernel(r, inlier), keep, 0.05)
+            poses, offsets = poses[kept], offsets[kept]
+    return poses
+
+
+@njit(cache=True, nogil=True)
+def grid_pipeline_kernel(ranges: np.ndarray, x: float, y: float, theta: float, beams: tuple,
+                         rotation: tuple, headings: tuple, lattice: tuple, coarse: tuple,
+                         view: tuple, min_returns: int, iterations: int, inlier: float,
+                         beam_check: bool, refine: tuple, grid: tuple) -> tuple:
+    """:func:`run` on a grid map (``Plan.args``; see :func:`_build`)."""
+    angles, directions, cos_a, sin_a, angle_min, resolution, max_range = beams
+    occupied, gx, gy, cell, free, distance = grid
+    points = _returns_to_points(ranges, directions, max_range)
+    nothing = np.empty((0, 3))
+    if points.shape[0] < min_returns:
+        return TOO_FEW, points.shape[0], nothing, np.empty(0), np.empty(0), False, 0
+    vp = np.empty((1, 3))
+    vp[0, 0], vp[0, 1], vp[0, 2] = x, y, theta
+    virtual = raycast_grid(vp, angles, occupied, gx, gy, cell, max_range)[0]
+    rots, heads, seeded = _seeded_headings(ranges, virtual, theta, beams, rotation, headings)
+    offsets, table, corner_x, corner_y, res, clearance = lattice
+    positions = grid_lattice_kernel(x, y, offsets, table, corner_x, corner_y, res, clearance,
+                                    gx, gy, cell, free, distance, 0.5 * cell)
+    cands, evaluations = _coarse(points, positions, x, y, heads, coarse)
+    cands = _refine_to_field(view, points, cands, iterations, inlier, refine)
+    evaluations += cands.shape[0] * iterations
+    nearest, fx, fy, fres, map_points, map_normals = view
+    cost = grid_cost_kernel(nearest, fx, fy, fres, map_points, map_normals, ranges, directions,
+                            angles, max_range, cands, occupied, gx, gy, cell, inlier, beam_check)
+    return OK, points.shape[0], cands, cost, rots, seeded, evaluations
