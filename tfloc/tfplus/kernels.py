@@ -246,6 +246,9 @@ def pairs_kernel(points: np.ndarray, delta: np.ndarray, q: np.ndarray, normal: n
             else:
                 vx[j], vy[j] = q[k, j, 0], q[k, j, 1]
         c, s = math.cos(delta[k, 2]), math.sin(delta[k, 2])
+        # the sums in registers, each in point order as it was in hh/gg (H is symmetric exactly:
+        # a·b and b·a are the same float)
+        h00 = h01 = h02 = h11 = h12 = h22 = g0 = g1 = g2 = 0.0
         for i in range(m):
             rx = c * points[i, 0] - s * points[i, 1]
             ry = s * points[i, 0] + c * points[i, 1]
@@ -288,18 +291,19 @@ def pairs_kernel(points: np.ndarray, delta: np.ndarray, q: np.ndarray, normal: n
             r = nx * (x - q[k, bj, 0]) + ny * (y - q[k, bj, 1])
             res[k, i] = r
             j0_, j1_, j2_ = nx, ny, -nx * ry + ny * rx
-            gg[k, 0] += j0_ * r
-            gg[k, 1] += j1_ * r
-            gg[k, 2] += j2_ * r
-            hh[k, 0, 0] += j0_ * j0_
-            hh[k, 0, 1] += j0_ * j1_
-            hh[k, 0, 2] += j0_ * j2_
-            hh[k, 1, 0] += j1_ * j0_
-            hh[k, 1, 1] += j1_ * j1_
-            hh[k, 1, 2] += j1_ * j2_
-            hh[k, 2, 0] += j2_ * j0_
-            hh[k, 2, 1] += j2_ * j1_
-            hh[k, 2, 2] += j2_ * j2_
+            g0 += j0_ * r
+            g1 += j1_ * r
+            g2 += j2_ * r
+            h00 += j0_ * j0_
+            h01 += j0_ * j1_
+            h02 += j0_ * j2_
+            h11 += j1_ * j1_
+            h12 += j1_ * j2_
+            h22 += j2_ * j2_
+        gg[k, 0], gg[k, 1], gg[k, 2] = g0, g1, g2
+        hh[k, 0, 0], hh[k, 0, 1], hh[k, 0, 2] = h00, h01, h02
+        hh[k, 1, 0], hh[k, 1, 1], hh[k, 1, 2] = h01, h11, h12
+        hh[k, 2, 0], hh[k, 2, 1], hh[k, 2, 2] = h02, h12, h22
     return hh, gg, res
 
 
@@ -355,10 +359,17 @@ def field_pairs_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, re
     res = np.full((k_n, m), np.nan)
     rank = np.empty((k_n, m))
     field = (nearest, origin_x, origin_y, 1.0 / resolution, map_points)
-    jac = np.zeros(4)
+    faces = face_weight > 0.0
+    cw, fw = cell_weight, face_weight
     for k in range(k_n):
         px, py = poses[k, 0], poses[k, 1]
         c, s = math.cos(poses[k, 2]), math.sin(poses[k, 2])
+        offset = offsets[k]
+        # the sums in registers, each in point order (cell term, then face term) as it was in
+        # hh/gg; a weighted product (w·a)·b is not (w·b)·a, so all 16 of H
+        h00 = h01 = h02 = h03 = h10 = h11 = h12 = h13 = 0.0
+        h20 = h21 = h22 = h23 = h30 = h31 = h32 = h33 = 0.0
+        g0 = g1 = g2 = g3 = 0.0
         for i in range(m):
             ox, oy, j, dx, dy = _to_nearest(field, px, py, c, s, points[i, 0], points[i, 1])
             if j < 0:
@@ -371,22 +382,53 @@ def field_pairs_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, re
             if dist > gate:
                 continue
             res[k, i] = r
-            jac[0], jac[1], jac[2], jac[3] = nxj, nyj, -nxj * oy + nyj * ox, 0.0
-            for a in range(3):
-                gg[k, a] += cell_weight * jac[a] * r
-                for b in range(3):
-                    hh[k, a, b] += cell_weight * jac[a] * jac[b]
-            if face_weight > 0.0:
+            a0, a1, a2 = nxj, nyj, -nxj * oy + nyj * ox          # the Jacobian (x, y, θ)
+            w0, w1, w2 = cw * a0, cw * a1, cw * a2
+            g0 += w0 * r
+            g1 += w1 * r
+            g2 += w2 * r
+            h00 += w0 * a0
+            h01 += w0 * a1
+            h02 += w0 * a2
+            h10 += w1 * a0
+            h11 += w1 * a1
+            h12 += w1 * a2
+            h20 += w2 * a0
+            h21 += w2 * a1
+            h22 += w2 * a2
+            if faces:
                 if nxj * ox + nyj * oy > 0.0:          # the normal faces away from the sensor
                     nxj, nyj, rf = -nxj, -nyj, -r - face_minus[j]
                 else:
                     rf = r - face_plus[j]
-                rf += offsets[k]
-                jac[0], jac[1], jac[2], jac[3] = nxj, nyj, -nxj * oy + nyj * ox, 1.0
-                for a in range(4):
-                    gg[k, a] += face_weight * jac[a] * rf
-                    for b in range(4):
-                        hh[k, a, b] += face_weight * jac[a] * jac[b]
+                rf += offset
+                a0, a1, a2, a3 = nxj, nyj, -nxj * oy + nyj * ox, 1.0   # (x, y, θ, offset)
+                w0, w1, w2, w3 = fw * a0, fw * a1, fw * a2, fw * a3
+                g0 += w0 * rf
+                g1 += w1 * rf
+                g2 += w2 * rf
+                g3 += w3 * rf
+                h00 += w0 * a0
+                h01 += w0 * a1
+                h02 += w0 * a2
+                h03 += w0 * a3
+                h10 += w1 * a0
+                h11 += w1 * a1
+                h12 += w1 * a2
+                h13 += w1 * a3
+                h20 += w2 * a0
+                h21 += w2 * a1
+                h22 += w2 * a2
+                h23 += w2 * a3
+                h30 += w3 * a0
+                h31 += w3 * a1
+                h32 += w3 * a2
+                h33 += w3 * a3
+        hh[k, 0, 0], hh[k, 0, 1], hh[k, 0, 2], hh[k, 0, 3] = h00, h01, h02, h03
+        hh[k, 1, 0], hh[k, 1, 1], hh[k, 1, 2], hh[k, 1, 3] = h10, h11, h12, h13
+        hh[k, 2, 0], hh[k, 2, 1], hh[k, 2, 2], hh[k, 2, 3] = h20, h21, h22, h23
+        hh[k, 3, 0], hh[k, 3, 1], hh[k, 3, 2], hh[k, 3, 3] = h30, h31, h32, h33
+        gg[k, 0], gg[k, 1], gg[k, 2], gg[k, 3] = g0, g1, g2, g3
     return hh, gg, res, rank
 
 
@@ -428,6 +470,7 @@ def refine_field_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, r
     × ``inner``, on ``poses`` ``(K, 3)`` and ``offsets`` ``(K,)`` in place (see there and
     :func:`field_pairs_kernel`). Returns whether the depth offsets have been started."""
     k_n = poses.shape[0]
+    eye = np.eye(4)
     for it in range(gates.shape[0]):
         gate = gates[it]
         late = faces and gate <= offset_gate
@@ -445,9 +488,13 @@ def refine_field_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, r
                                             map_normals, face_plus, face_minus, points, poses,
                                             offsets, gate, resolution, cw, fw)
             for k in range(k_n):
-                if np.sum(~np.isnan(r[k])) < 3:
+                paired = 0
+                for i in range(r.shape[1]):
+                    if not math.isnan(r[k, i]):
+                        paired += 1
+                if paired < 3:
                     continue
-                hk = h[k] + damping * np.eye(4)
+                hk = h[k] + damping * eye
                 gk = g[k].copy()
                 hk[3, 3] += offset_weight
                 gk[3] += offset_weight * (offsets[k] - offset_prior)
