@@ -202,15 +202,14 @@ def separated_kernel(poses: np.ndarray, count: int, separation: float) -> np.nda
 
 
 @njit(cache=True, nogil=True)
-def _bearing_index(x: float, y: float, angle_min: float, resolution: float) -> tuple[int, float]:
+def _beam_of(x: float, y: float, v: float, angle_min: float, resolution: float) -> int:
     """``round((atan2(y, x) − angle_min) / resolution)``, the beam nearest the bearing of
-    ``(x, y)``: from the cheap :func:`~tfloc.maps._raycast._atan2` (error below 1e-5 rad), and
-    from ``math.atan2`` where the two could round differently (within 1e-4 rad of a half step);
-    and the bearing in beams from the cheap one (error below 1e-5 rad / ``resolution``)."""
-    v = (_atan2(y, x) - angle_min) / resolution
+    ``(x, y)``, given ``v``, that bearing in beams from the cheap
+    :func:`~tfloc.maps._raycast._atan2` (error below 1e-5 rad): from ``v`` itself, and from
+    ``math.atan2`` where the two could round differently (within 1e-4 rad of a half step)."""
     if abs(v - math.floor(v) - 0.5) > 1e-4 / resolution:
-        return int(math.floor(v + 0.5)), v
-    return int(round((math.atan2(y, x) - angle_min) / resolution)), v
+        return int(math.floor(v + 0.5))
+    return int(round((math.atan2(y, x) - angle_min) / resolution))
 
 
 _SHRINK = 1.0 - 1e-9  # a line's squared distance, less 1e-9 of it and 1e-18 m² for rounding, bounds a pair's
@@ -239,6 +238,9 @@ def pairs_kernel(points: np.ndarray, delta: np.ndarray, q: np.ndarray, normal: n
     vx = np.empty(n)          # a candidate's virtual points, +inf where there is none (never
     vy = np.empty(n)          # nearer than the gate: the same pairs as skipping them)
     stops = (window + 1.0) * resolution < 0.5 * math.pi - 0.01   # the lines' distances grow
+    place = np.empty((m, 4))     # a point rotated (x, y), then moved (x, y)
+    bearing = np.empty(m)        # its bearing in beams (cheap), and its beam
+    beam = np.empty(m, dtype=np.int64)
     for k in range(k_n):
         for j in range(n):
             if math.isnan(q[k, j, 0]) or math.isnan(normal[k, j, 0]):
@@ -246,14 +248,22 @@ def pairs_kernel(points: np.ndarray, delta: np.ndarray, q: np.ndarray, normal: n
             else:
                 vx[j], vy[j] = q[k, j, 0], q[k, j, 1]
         c, s = math.cos(delta[k, 2]), math.sin(delta[k, 2])
+        # first every point's place and bearing (the cheap bearing, then its beam), so that the
+        # search's branches below do not wait on a bearing's long chain of arithmetic
+        for i in range(m):
+            rx = c * points[i, 0] - s * points[i, 1]
+            ry = s * points[i, 0] + c * points[i, 1]
+            place[i, 0], place[i, 1] = rx, ry
+            place[i, 2], place[i, 3] = rx + delta[k, 0], ry + delta[k, 1]
+            bearing[i] = (_atan2(place[i, 3], place[i, 2]) - angle_min) / resolution
+        for i in range(m):
+            beam[i] = _beam_of(place[i, 2], place[i, 3], bearing[i], angle_min, resolution)
         # the sums in registers, each in point order as it was in hh/gg (H is symmetric exactly:
         # a·b and b·a are the same float)
         h00 = h01 = h02 = h11 = h12 = h22 = g0 = g1 = g2 = 0.0
         for i in range(m):
-            rx = c * points[i, 0] - s * points[i, 1]
-            ry = s * points[i, 0] + c * points[i, 1]
-            x, y = rx + delta[k, 0], ry + delta[k, 1]
-            j0, v = _bearing_index(x, y, angle_min, resolution)
+            rx, ry, x, y = place[i, 0], place[i, 1], place[i, 2], place[i, 3]
+            j0, v = beam[i], bearing[i]
             lo, hi = max(j0 - window, 0), min(j0 + window, n - 1)
             if lo > hi:
                 continue
@@ -359,6 +369,8 @@ def field_pairs_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, re
     res = np.full((k_n, m), np.nan)
     rank = np.empty((k_n, m))
     field = (nearest, origin_x, origin_y, 1.0 / resolution, map_points)
+    near = np.empty(m, dtype=np.int64)     # each point's nearest map point (-1: none) ...
+    geo = np.empty((m, 4))                 # ... its offset from the sensor and from that point
     faces = face_weight > 0.0
     cw, fw = cell_weight, face_weight
     for k in range(k_n):
@@ -370,8 +382,15 @@ def field_pairs_kernel(nearest: np.ndarray, origin_x: float, origin_y: float, re
         h00 = h01 = h02 = h03 = h10 = h11 = h12 = h13 = 0.0
         h20 = h21 = h22 = h23 = h30 = h31 = h32 = h33 = 0.0
         g0 = g1 = g2 = g3 = 0.0
+        # first every point's nearest map point (independent look-ups the processor overlaps),
+        # then the pairs, whose branches would otherwise wait on two dependent look-ups each
         for i in range(m):
             ox, oy, j, dx, dy = _to_nearest(field, px, py, c, s, points[i, 0], points[i, 1])
+            near[i] = j
+            geo[i, 0], geo[i, 1], geo[i, 2], geo[i, 3] = ox, oy, dx, dy
+        for i in range(m):
+            j = near[i]
+            ox, oy, dx, dy = geo[i, 0], geo[i, 1], geo[i, 2], geo[i, 3]
             if j < 0:
                 rank[k, i] = np.inf
                 continue
