@@ -50,109 +50,27 @@ there), and never the true pose.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from functools import lru_cache
-from typing import ClassVar
 
 import numpy as np
 
-from tfloc.core.map import Map
 from tfloc.core.params import Configured
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
 from tfloc.maps.grid import GridMap
 from tfloc.maps.vector import VectorMap
-from tfloc.paper.shape import ShapeConfig, scan_turning_function
+from tfloc.paper.shape import scan_turning_function
 from tfloc.paper.turning import match
 
 from . import pipeline
 from .coarse import candidates, lattice, pose_scores
+from .config import TfPlusConfig
+from .config import coarse_view as _coarse_field
+from .config import field_view as _field
+from .config import heading_offsets as _heading_offsets
+from .config import sweep as _sweep
 from .cost import scan_cost
 from .headings import scan_rotations
-from .refine import RefineConfig, refine, refine_to_field
-from .view import MapView, map_view
-
-
-@dataclass(frozen=True)
-class TfPlusConfig:
-    """Parameters of ``tf-plus`` (metres, radians).
-
-    Attributes:
-        refine_to: what the refinement fits the scan to: ``"field"``, the map itself (each
-            scan point's nearest map point; on a grid map also the walls' surfaces and the
-            returns' depth behind them, :func:`tfloc.tfplus.refine.refine_to_field`); ``"virtual"``,
-            ray-cast virtual scans (:func:`tfloc.tfplus.refine.refine`: exact on a vector map, whose
-            walls have no thickness, and biased short on a grid whose walls are drawn several
-            cells thick); ``"auto"``: ``"field"`` on a grid map, ``"virtual"`` on any other.
-        select: how the final answer is picked among refined candidates: ``"residual"``
-            (truncated point-to-line residual to the map's points), ``"virtual"`` (the same to
-            the virtual scans) or ``"tf"`` (turning-function Err, Eq. 13).
-        wall_thickness: on a grid map, walls are followed this far (metres) across to find their
-            surfaces (:mod:`tfloc.maps.walls`).
-        scan_stride: every ``scan_stride``-th real point is used by the first coarse level
-            (if ``coarse_points`` is 0; else about ``coarse_points`` points, evenly spread,
-            whatever the scanner's beam count).
-        coarse_bound: score the coarse search on the distance field pooled over ± half a
-            lattice step (a lower bound over each lattice cell), so that the cell holding the
-            true pose is not outscored because its lattice point is a few cm off a wall.
-        tie_tolerance: candidates whose cost is within this fraction of the best are a tie
-            (the scan sees the same geometry from both, e.g. a bare corner), broken by
-            distance to the VP (0: no tie-break).
-        shape: the scan-shape parameters (ShortStraw, polygon closure) of the turning-function
-            seed and of the ``select="tf"`` Err; the resampling distance is 5 cm (the paper's
-            S = 1 m gives edges too coarse for their directions to be a heading estimate).
-    """
-
-    RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params)
-        "> 0": ("grid_step", "heading_step", "field_resolution", "field_truncation"),
-        ">= 0": ("search_radius", "clearance", "rotation_seeds", "max_rotation", "heading_span",
-                 "separation", "tie_tolerance", "wall_thickness", "coarse_points"),
-        ">= 1": ("scan_stride", "shortlist", "candidates", "min_returns"),
-        "finite": ("heading_offsets",),
-        ("residual", "virtual", "tf"): ("select",),
-        ("auto", "field", "virtual"): ("refine_to",)}
-
-    tf_seed: bool = True  #: add headings seeded by the turning-function rotation estimates
-    heading_sweep: bool = True  #: sweep the headings θ_VP ± heading_span
-    grid: bool = True  #: coarse grid search over positions (else only the VP's position)
-    refine: bool = True  #: run the point-to-line refinement
-    refine_to: str = "auto"
-    select: str = "residual"
-    search_radius: float = 3.3  #: radius of the coarse search around the VP (metres)
-    grid_step: float = 0.2  #: lattice spacing of the coarse search (metres)
-    clearance: float = 0.1  #: least distance of a lattice position from walls (metres)
-    #: headings tried around each seed (radians)
-    heading_offsets: tuple[float, ...] = tuple(math.radians(d) for d in (-1.0, 0.0, 1.0))
-    rotation_seeds: int = 3  #: rotations from the edge-direction histograms (.headings) ...
-    max_rotation: float = math.radians(20.0)  #: ... within ± this of θ_VP (radians)
-    heading_span: float = math.radians(17.0)  #: the sweep covers θ_VP ± this (radians) ...
-    heading_step: float = math.radians(3.0)  #: ... at this spacing (radians)
-    field_resolution: float = 0.05  #: cell size of the distance field (metres)
-    field_truncation: float = 0.3  #: truncation of the distance field (metres)
-    wall_thickness: float = 0.3
-    scan_stride: int = 9
-    coarse_points: int = 20  #: about this many points on the first coarse level (see scan_stride)
-    coarse_bound: bool = True
-    shortlist: int = 64  #: the first level's best poses rescored on all points
-    candidates: int = 4  #: candidates refined
-    separation: float = 0.3  #: least distance between candidates (metres)
-    min_returns: int = 10  #: fewer valid returns than this is a no-answer
-    tie_tolerance: float = 0.1
-    beam_check: bool = True  #: count see-through beams in the selection cost (.cost)
-    refinement: RefineConfig = RefineConfig()  #: the point-to-line refinement's parameters
-    shape: ShapeConfig = ShapeConfig(spacing=0.05)
-
-
-def _field(map_: Map, cfg: TfPlusConfig) -> MapView:
-    """The map's view (:mod:`tfloc.tfplus.view`), built once per map and configuration."""
-    return map_view(map_, cfg.field_resolution, cfg.field_truncation, cfg.wall_thickness)
-
-
-def _coarse_field(map_: Map, cfg: TfPlusConfig) -> MapView:
-    """The view the coarse search scores on: pooled over ± half a lattice step
-    (``coarse_bound``), else the view itself."""
-    return map_view(map_, cfg.field_resolution, cfg.field_truncation, cfg.wall_thickness,
-                    cfg.grid_step / 2.0 if cfg.coarse_bound else 0.0)
+from .refine import refine, refine_to_field
 
 
 def heading_seeds(problem: Problem, cfg: TfPlusConfig) -> tuple[np.ndarray, dict]:
@@ -171,23 +89,6 @@ def heading_seeds(problem: Problem, cfg: TfPlusConfig) -> tuple[np.ndarray, dict
             heads.append(((th0 - rots)[:, None] + offsets[None, :]).ravel())
             info = {"tf_rotations": rots.tolist()}
     return np.concatenate(heads), info
-
-
-@lru_cache(maxsize=16)
-def _sweep(span: float, step: float) -> np.ndarray:
-    """The sweep's offsets ``k·step`` for ``|k| ≤ round(span / step)`` (radians; read-only)."""
-    k = int(round(span / step))
-    out = np.arange(-k, k + 1) * step
-    out.setflags(write=False)
-    return out
-
-
-@lru_cache(maxsize=16)
-def _heading_offsets(offsets: tuple[float, ...]) -> np.ndarray:
-    """``offsets`` as a read-only array (radians)."""
-    out = np.asarray(offsets, dtype=float)
-    out.setflags(write=False)
-    return out
 
 
 def tf_errs(problem: Problem, poses: np.ndarray, cfg: TfPlusConfig) -> np.ndarray:
@@ -317,3 +218,6 @@ class TurningFunctionPlusMatcher(Configured):
         field = _field(problem.map, cfg) if cfg.select != "virtual" else None
         return scan_cost(problem.map, problem.laser, problem.ranges, poses, cfg.refinement.window,
                          cfg.refinement.inlier_distance, cfg.beam_check, field)
+
+
+__all__ = ["TfPlusConfig", "TurningFunctionPlusMatcher", "heading_seeds", "pick", "tf_errs"]

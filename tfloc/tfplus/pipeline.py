@@ -38,6 +38,7 @@ from tfloc.maps.vector import VectorMap
 
 from . import refine as refine_module
 from .coarse import _offsets
+from .config import TfPlusConfig, coarse_view, field_view, heading_offsets, sweep
 from .cost_kernel import grid_cost_kernel, vector_cost_kernel
 from .headings import _pair_kernel, _scan_rotations
 from .kernels import (
@@ -51,8 +52,6 @@ from .virtual_kernel import prune_index_kernel, refine_vector_kernel, truncated_
 
 if TYPE_CHECKING:
     from tfloc.core.problem import Problem
-
-    from .matcher import TfPlusConfig
 
 OK, TOO_FEW, UNDECIDED = 0, 1, 2  #: statuses of the pipeline kernels
 
@@ -116,10 +115,8 @@ def _plan_of(map_: object, laser: LaserSpec, cfg: TfPlusConfig) -> Plan | None:
 
 def _build(map_: VectorMap | GridMap, laser: LaserSpec, cfg: TfPlusConfig, kind: str) -> Plan:
     """The :class:`Plan`: the same values the staged path computes per call."""
-    from .matcher import _coarse_field, _field, _heading_offsets, _sweep  # (it imports this)
 
-
-    field, pooled = _field(map_, cfg), _coarse_field(map_, cfg)
+    field, pooled = field_view(map_, cfg), coarse_view(map_, cfg)
     cos_a, sin_a = refine_module._beam_trig(laser)
     max_range = float(laser.max_range)
     beams = (np.asarray(laser.angles, dtype=float), laser.directions, cos_a, sin_a,
@@ -130,7 +127,7 @@ def _build(map_: VectorMap | GridMap, laser: LaserSpec, cfg: TfPlusConfig, kind:
                 float(shape.line_threshold), bool(shape.close_through_origin),
                 shape.resampling == "path", _BINS, True, _pair_kernel(_BINS, _SMOOTHING),
                 int(np.floor(cfg.max_rotation / width)), int(cfg.rotation_seeds))
-    headings = (_sweep(cfg.heading_span, cfg.heading_step), _heading_offsets(cfg.heading_offsets))
+    headings = (sweep(cfg.heading_span, cfg.heading_step), heading_offsets(cfg.heading_offsets))
     corner = field.origin
     lattice = (_offsets(float(cfg.search_radius), float(cfg.grid_step)), field.table,
                float(corner[0]), float(corner[1]), field.resolution,
