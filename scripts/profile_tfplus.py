@@ -24,6 +24,7 @@ from _sample import PAPER, add_sample_args, one_core, sample  # noqa: E402
 def staged(matcher, problem) -> dict[str, float]:
     """CPU seconds per stage of one localize call (default configuration)."""
     from tfloc.tfplus import matcher as mm
+    from tfloc.tfplus.coarse import candidates
 
     cfg = matcher.config
     t: dict[str, float] = {}
@@ -44,8 +45,8 @@ def staged(matcher, problem) -> dict[str, float]:
     t["lattice (free positions)"] = clock() - c0
     c0 = clock()
     stride = max(1, len(points) // cfg.coarse_points)
-    cands, _, _ = mm.candidates(coarse_field, points, positions, heads, stride, cfg.shortlist,
-                                cfg.candidates, cfg.separation, cfg.grid_step)
+    cands, _, _ = candidates(coarse_field, points, positions, heads, stride, cfg.shortlist,
+                             cfg.candidates, cfg.separation, cfg.grid_step)
     t["coarse search + candidates"] = clock() - c0
     c0 = clock()
     if isinstance(problem.map, mm.GridMap):

@@ -115,3 +115,13 @@ def heading_offsets(offsets: tuple[float, ...]) -> np.ndarray:
     out = np.asarray(offsets, dtype=float)
     out.setflags(write=False)
     return out
+
+
+def coarse_search(map_: Map, cfg: TfPlusConfig) -> tuple:
+    """What :func:`~tfloc.tfplus.kernels.coarse_kernel` takes of ``cfg`` and of the view it
+    scores on (:func:`coarse_view`): the table, its corner and cell size, the points' count or
+    stride, the shortlist, the candidates, their separation and the lattice step."""
+    pooled = coarse_view(map_, cfg)
+    return (pooled.table, float(pooled.origin[0]), float(pooled.origin[1]), pooled.resolution,
+            int(cfg.coarse_points), int(cfg.scan_stride), int(cfg.shortlist), int(cfg.candidates),
+            float(cfg.separation), float(cfg.grid_step))

@@ -663,3 +663,22 @@ def grid_lattice_kernel(centre_x: float, centre_y: float, offsets: np.ndarray, t
             out[k, 0], out[k, 1] = x, y
             k += 1
     return out[:k].copy()
+
+
+@njit(cache=True, nogil=True)
+def coarse_kernel(points: np.ndarray, positions: np.ndarray, x: float, y: float, heads: np.ndarray,
+                  coarse: tuple) -> tuple[np.ndarray, int]:
+    """``tf-plus``'s coarse search from the lattice ``positions`` ``(N, 2)`` (the initial guess
+    ``(x, y)`` alone if there are none) × ``heads``: :func:`candidates_kernel` on every
+    ``stride``-th of ``points``, the stride giving about ``coarse_points`` of them (or
+    ``scan_stride`` if that is 0). ``coarse`` is :func:`tfloc.tfplus.config.coarse_search`'s
+    tuple. Returns the candidates and the evaluations counted (positions × headings + the
+    shortlist)."""
+    table, ox, oy, res, coarse_points, scan_stride, shortlist, count, separation, step = coarse
+    if positions.shape[0] == 0:
+        positions = np.empty((1, 2))
+        positions[0, 0], positions[0, 1] = x, y
+    stride = max(1, points.shape[0] // coarse_points) if coarse_points else scan_stride
+    cands, _, rescored = candidates_kernel(table, ox, oy, res, points, stride, positions, heads,
+                                           shortlist, count, separation, step)
+    return cands, positions.shape[0] * heads.shape[0] + rescored

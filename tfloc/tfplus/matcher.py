@@ -62,14 +62,15 @@ from tfloc.paper.shape import scan_turning_function
 from tfloc.paper.turning import match
 
 from . import pipeline
-from .coarse import candidates, lattice, pose_scores
-from .config import TfPlusConfig
+from .coarse import lattice, pose_scores
+from .config import TfPlusConfig, coarse_search
 from .config import coarse_view as _coarse_field
 from .config import field_view as _field
 from .config import heading_offsets as _heading_offsets
 from .config import sweep as _sweep
 from .cost import scan_cost
 from .headings import scan_rotations
+from .kernels import coarse_kernel
 from .refine import refine, refine_to_field
 
 
@@ -180,13 +181,10 @@ class TurningFunctionPlusMatcher(Configured):
             field = _field(problem.map, cfg)
             positions = lattice(problem.map, field, vp.xy, cfg.search_radius, cfg.grid_step,
                                 cfg.clearance)
-            if len(positions) == 0:
-                positions = vp.xy[None, :]
-            stride = max(1, len(points) // cfg.coarse_points) if cfg.coarse_points else cfg.scan_stride
-            cands, _, rescored = candidates(_coarse_field(problem.map, cfg), points, positions, heads,
-                                            stride, cfg.shortlist, cfg.candidates, cfg.separation,
-                                            cfg.grid_step)
-            evaluations = len(positions) * len(heads) + rescored
+            cands, evaluations = coarse_kernel(np.ascontiguousarray(points, dtype=float),
+                                               np.ascontiguousarray(positions, dtype=float),
+                                               vp.x, vp.y, np.ascontiguousarray(heads, dtype=float),
+                                               coarse_search(problem.map, cfg))
         else:
             cands = np.column_stack((np.full(len(heads), vp.x), np.full(len(heads), vp.y), heads))
             if not cfg.refine:

@@ -38,17 +38,12 @@ from tfloc.maps.vector import VectorMap
 
 from . import refine as refine_module
 from .coarse import _offsets
-from .config import TfPlusConfig, coarse_view, field_view, heading_offsets, sweep
+from .config import TfPlusConfig, coarse_search, field_view, heading_offsets, sweep
 from .cost_kernel import grid_cost_kernel, vector_cost_kernel
+from .field_kernel import refine_to_field_kernel
 from .headings import _pair_kernel, _scan_rotations
-from .kernels import (
-    candidates_kernel,
-    field_pairs_kernel,
-    grid_lattice_kernel,
-    lattice_kernel,
-    refine_field_kernel,
-)
-from .virtual_kernel import prune_index_kernel, refine_vector_kernel, truncated_cost_kernel
+from .kernels import coarse_kernel, grid_lattice_kernel, lattice_kernel
+from .virtual_kernel import refine_vector_kernel
 
 if TYPE_CHECKING:
     from tfloc.core.problem import Problem
@@ -116,7 +111,7 @@ def _plan_of(map_: object, laser: LaserSpec, cfg: TfPlusConfig) -> Plan | None:
 def _build(map_: VectorMap | GridMap, laser: LaserSpec, cfg: TfPlusConfig, kind: str) -> Plan:
     """The :class:`Plan`: the same values the staged path computes per call."""
 
-    field, pooled = field_view(map_, cfg), coarse_view(map_, cfg)
+    field = field_view(map_, cfg)
     cos_a, sin_a = refine_module._beam_trig(laser)
     max_range = float(laser.max_range)
     beams = (np.asarray(laser.angles, dtype=float), laser.directions, cos_a, sin_a,
@@ -132,9 +127,7 @@ def _build(map_: VectorMap | GridMap, laser: LaserSpec, cfg: TfPlusConfig, kind:
     lattice = (_offsets(float(cfg.search_radius), float(cfg.grid_step)), field.table,
                float(corner[0]), float(corner[1]), field.resolution,
                field.table.dtype.type(cfg.clearance))
-    coarse = (pooled.table, float(pooled.origin[0]), float(pooled.origin[1]), pooled.resolution,
-              int(cfg.coarse_points), int(cfg.scan_stride), int(cfg.shortlist),
-              int(cfg.candidates), float(cfg.separation), float(cfg.grid_step))
+    coarse = coarse_search(map_, cfg)
     r = cfg.refinement
     gates = refine_module._gates(r)
     view = (field.nearest, float(field.origin[0]), float(field.origin[1]), field.resolution,
@@ -146,10 +139,7 @@ def _build(map_: VectorMap | GridMap, laser: LaserSpec, cfg: TfPlusConfig, kind:
                   int(r.keep))
         free = (map_.area_rings().kernel, map_.free_rings().kernel, SURE)
         return Plan(kind, common + (refine, free, map_.segments, map_.segment_index(max_range)))
-    refine = (gates, int(r.inner), float(r.damping), int(r.prune_after), int(r.keep),
-              bool(r.faces and field.faces), bool(field.faces), field.face_plus, field.face_minus,
-              float(r.offset_gate), float(r.face_weight), float(r.cell_weight),
-              float(r.offset_weight), float(r.offset_prior), float(r.max_depth))
+    refine = refine_module.field_refinement(field, r)
     grid = (map_.occupied, float(map_.origin[0]), float(map_.origin[1]), float(map_.resolution),
             map_.free, map_.distance)
     return Plan(kind, common + (refine, grid))
@@ -197,21 +187,6 @@ def _seeded_headings(ranges: np.ndarray, virtual: np.ndarray, theta: float, beam
 
 
 @njit(cache=True, nogil=True)
-def _coarse(points: np.ndarray, positions: np.ndarray, x: float, y: float, heads: np.ndarray,
-            coarse: tuple) -> tuple[np.ndarray, int]:
-    """The coarse search (:func:`tfloc.tfplus.coarse.candidates`): the candidates and the
-    evaluations it counts (positions × headings + the shortlist)."""
-    table, ox, oy, res, coarse_points, scan_stride, shortlist, count, separation, step = coarse
-    if positions.shape[0] == 0:
-        positions = np.empty((1, 2))
-        positions[0, 0], positions[0, 1] = x, y
-    stride = max(1, points.shape[0] // coarse_points) if coarse_points else scan_stride
-    cands, _, rescored = candidates_kernel(table, ox, oy, res, points, stride, positions, heads,
-                                           shortlist, count, separation, step)
-    return cands, positions.shape[0] * heads.shape[0] + rescored
-
-
-@njit(cache=True, nogil=True)
 def vector_pipeline_kernel(ranges: np.ndarray, x: float, y: float, theta: float, beams: tuple,
                            rotation: tuple, headings: tuple, lattice: tuple, coarse: tuple,
                            view: tuple, min_returns: int, iterations: int, inlier: float,
@@ -232,7 +207,7 @@ def vector_pipeline_kernel(ranges: np.ndarray, x: float, y: float, theta: float,
                                         free[0], free[1], free[2])
     if not decided:
         return UNDECIDED, points.shape[0], nothing, np.empty(0), rots, seeded, 0
-    cands, evaluations = _coarse(points, positions, x, y, heads, coarse)
+    cands, evaluations = coarse_kernel(points, positions, x, y, heads, coarse)
     gates, inner, window, damping, prune_after, keep = refine
     cands = refine_vector_kernel(cands, points, angles, cos_a, sin_a, angle_min, resolution,
                                  segs, index, max_range, gates, inner, window, damping,
@@ -242,43 +217,6 @@ def vector_pipeline_kernel(ranges: np.ndarray, x: float, y: float, theta: float,
     cost = vector_cost_kernel(nearest, fx, fy, fres, map_points, map_normals, ranges, directions,
                               angles, max_range, cands, segs, index, inlier, beam_check)
     return OK, points.shape[0], cands, cost, rots, seeded, evaluations
-
-
-@njit(cache=True, nogil=True)
-def _refine_to_field(view: tuple, points: np.ndarray, poses: np.ndarray, iterations: int,
-                     inlier: float, refine: tuple) -> np.ndarray:
-    """:func:`tfloc.tfplus.refine.refine_to_field`, step for step: the iterations up to
-    ``prune_after`` (:func:`~tfloc.tfplus.kernels.refine_field_kernel`), the pruning to the
-    ``keep`` best by truncated residual (:func:`~tfloc.tfplus.refine.field_pairs` at the last
-    gate), the rest of the iterations."""
-    nearest, fx, fy, fres, map_points, map_normals = view
-    (gates, inner, damping, prune_after, keep, faces, field_faces, face_plus, face_minus,
-     offset_gate, face_weight, cell_weight, offset_weight, offset_prior, max_depth) = refine
-    poses = poses.copy()
-    offsets = np.full(poses.shape[0], offset_prior)
-    cut = prune_after if 0 < prune_after < iterations else iterations
-    started = False
-    for part_no in range(2):
-        part = gates[:cut] if part_no == 0 else gates[cut:]
-        if part.shape[0] == 0:
-            continue
-        started = refine_field_kernel(nearest, fx, fy, fres, map_points, map_normals, face_plus,
-                                      face_minus, points, poses, offsets,
-                                      np.ascontiguousarray(part), inner, offset_gate, faces,
-                                      face_weight, cell_weight, damping, offset_weight,
-                                      offset_prior, max_depth, started)
-        if part_no == 0 and cut < iterations and poses.shape[0] > keep:
-            late = faces and part[-1] <= offset_gate
-            fw = face_weight if late else 0.0
-            cw = cell_weight if late else 1.0
-            with_faces = field_faces and fw > 0
-            _, _, r, _ = field_pairs_kernel(nearest, fx, fy, fres, map_points, map_normals,
-                                            face_plus, face_minus, points, poses, offsets,
-                                            part[-1], fres, cw if with_faces else 1.0,
-                                            fw if with_faces else 0.0)
-            kept = prune_index_kernel(poses, truncated_cost_kernel(r, inlier), keep, 0.05)
-            poses, offsets = poses[kept], offsets[kept]
-    return poses
 
 
 @njit(cache=True, nogil=True)
@@ -300,8 +238,8 @@ def grid_pipeline_kernel(ranges: np.ndarray, x: float, y: float, theta: float, b
     offsets, table, corner_x, corner_y, res, clearance = lattice
     positions = grid_lattice_kernel(x, y, offsets, table, corner_x, corner_y, res, clearance,
                                     gx, gy, cell, free, distance, 0.5 * cell)
-    cands, evaluations = _coarse(points, positions, x, y, heads, coarse)
-    cands = _refine_to_field(view, points, cands, iterations, inlier, refine)
+    cands, evaluations = coarse_kernel(points, positions, x, y, heads, coarse)
+    cands = refine_to_field_kernel(view, points, cands, inlier, refine)
     evaluations += cands.shape[0] * iterations
     nearest, fx, fy, fres, map_points, map_normals = view
     cost = grid_cost_kernel(nearest, fx, fy, fres, map_points, map_normals, ranges, directions,

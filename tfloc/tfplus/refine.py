@@ -57,7 +57,8 @@ from tfloc.core.map import Map
 from tfloc.core.pose import wrap_angle
 from tfloc.maps.vector import VectorMap
 
-from .kernels import face_depths_kernel, field_pairs_kernel, pairs_kernel, refine_field_kernel
+from .field_kernel import refine_to_field_kernel
+from .kernels import face_depths_kernel, field_pairs_kernel, pairs_kernel
 from .view import MapView
 from .virtual_kernel import refine_vector_kernel
 
@@ -265,32 +266,25 @@ def face_depths(field: MapView, points: np.ndarray, poses: np.ndarray,
                               np.ascontiguousarray(np.reshape(poses, (-1, 3)), dtype=float), gate)
 
 
+def field_refinement(field: MapView, cfg: RefineConfig) -> tuple:
+    """What :func:`~tfloc.tfplus.field_kernel.refine_to_field_kernel` takes of ``cfg`` and of the
+    map's view besides the view's look-up arrays: the gates, the Gauss–Newton and pruning
+    parameters, whether the walls' surfaces are used, the surfaces' distances and the depth's
+    weights and bounds."""
+    return (_gates(cfg), int(cfg.inner), float(cfg.damping), int(cfg.prune_after), int(cfg.keep),
+            bool(cfg.faces and field.faces), bool(field.faces), field.face_plus, field.face_minus,
+            float(cfg.offset_gate), float(cfg.face_weight), float(cfg.cell_weight),
+            float(cfg.offset_weight), float(cfg.offset_prior), float(cfg.max_depth))
+
+
 def refine_to_field(field: MapView, points: np.ndarray, poses: np.ndarray,
                     config: RefineConfig = RefineConfig()) -> np.ndarray:
     """Refine ``(K, 3)`` world poses so the scan ``points`` ``(M, 2)`` (sensor frame) lie on the
     map (see the module docstring). Returns all ``K`` refined poses, or the ``keep`` best if
-    pruning is on (see :class:`RefineConfig`)."""
-    poses = np.array(poses, dtype=float).reshape(-1, 3)
-    points = np.ascontiguousarray(points, dtype=float)
-    cfg = config
-    faces = bool(cfg.faces and field.faces)
-    offsets = np.full(len(poses), cfg.offset_prior)
-    gates = _gates(cfg)
-    cut = cfg.prune_after if 0 < cfg.prune_after < cfg.iterations else cfg.iterations
-    started = False
-    for first, part in ((True, gates[:cut]), (False, gates[cut:])):
-        if len(part) == 0:
-            continue
-        started = refine_field_kernel(
-            field.nearest, float(field.origin[0]), float(field.origin[1]), field.resolution,
-            field.points, field.normals, field.face_plus, field.face_minus, points, poses, offsets,
-            np.ascontiguousarray(part), cfg.inner, cfg.offset_gate, faces, cfg.face_weight,
-            cfg.cell_weight, cfg.damping, cfg.offset_weight, cfg.offset_prior, cfg.max_depth,
-            started)
-        if first and cut < cfg.iterations and len(poses) > cfg.keep:
-            late = faces and part[-1] <= cfg.offset_gate
-            _, _, r, _ = field_pairs(field, points, poses, part[-1], offsets,
-                                     cfg.face_weight if late else 0.0, cfg.cell_weight if late else 1.0)
-            keep = _prune_index(poses, truncated_cost(np.abs(r), cfg.inlier_distance), cfg.keep)
-            poses, offsets = poses[keep], offsets[keep]
-    return poses
+    pruning is on (see :class:`RefineConfig`). One compiled call
+    (:func:`~tfloc.tfplus.field_kernel.refine_to_field_kernel`)."""
+    view = (field.nearest, float(field.origin[0]), float(field.origin[1]), field.resolution,
+            field.points, field.normals)
+    return refine_to_field_kernel(view, np.ascontiguousarray(points, dtype=float),
+                                  np.array(poses, dtype=float).reshape(-1, 3),
+                                  float(config.inlier_distance), field_refinement(field, config))
