@@ -1,19 +1,31 @@
 # tfloc: the commands of the README are `make quick`, `make bench` and `make test`.
-# Each creates .venv on first use and (re)install the package when pyproject.toml changes.
+# Each creates .venv on first use and (re)installs when pyproject.toml or requirements.lock changes:
+# the exact versions of requirements.lock (hash-checked), then tfloc itself without dependencies.
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.tfloc-installed
 JOBS   ?= 2
+LOCK   := requirements.lock
+UV_VERSION := 0.13.9
 
-.PHONY: install quick bench global-full global-offices robustness robustness-full scaling scaling-quick ablation-real test test-unit timing lint clean-venv real-data fuzz chaos
+.PHONY: install lock quick bench global-full global-offices robustness robustness-full scaling scaling-quick ablation-real test test-cpu test-unit timing lint clean-venv real-data fuzz chaos
 
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml $(LOCK)
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	$(BIN)/python -m pip install --quiet --require-hashes -r $(LOCK)
+	$(BIN)/python -m pip install --quiet --no-deps --no-build-isolation -e .
 	@$(BIN)/python -c 'import sys; v = sys.version_info[:2]; v < (3, 12) or print("note: matcher karto left out: karto-scanmatcher has wheels for Python 3.8-3.11 only, this is Python %d.%d" % v)'
 	@touch $(STAMP)
+
+## Refresh the lock deliberately: resolve pyproject.toml's bounds (every extra) anew, exact versions
+## with the hashes of every file of each, for every Python ≥ 3.11 (uv's universal resolution, in a
+## throwaway environment). Commit the new requirements.lock with the results it makes.
+lock:
+	@d=$$(mktemp -d) && $(PYTHON) -m venv $$d && $$d/bin/python -m pip install --quiet 'uv==$(UV_VERSION)' && \
+	printf 'pip\nsetuptools>=68\nwheel\n' | $$d/bin/uv pip compile pyproject.toml - --all-extras --universal \
+		--python-version 3.11 --generate-hashes --custom-compile-command "make lock" --quiet -o $(LOCK).new && \
+	rm -rf $$d && mv $(LOCK).new $(LOCK) && echo "wrote $(LOCK): $$(grep -c '==' $(LOCK)) pinned versions"
 
 install: $(STAMP)
 
@@ -114,10 +126,24 @@ ablation-real: $(STAMP)
 real-data: $(STAMP)
 	$(BIN)/tfloc real-data --out data
 
-## Unit tests, the accuracy regression guard and a benchmark smoke run (CI).
+## Unit tests, the accuracy regression guard and a benchmark smoke run (CI), then test-cpu.
 test: $(STAMP)
 	$(BIN)/python -m pytest -q tests
 	$(BIN)/python -m pytest -q benchmarks --benchmark-disable
+	$(MAKE) --no-print-directory test-cpu
+
+## The tests that compare with committed files or pinned values (marker bitwise) again, as a CPU
+## without AVX-512 computes (numpy's dispatch below X86_V4, OpenBLAS's Haswell kernels), then
+## one without AVX2 (numpy's baseline, OpenBLAS's Sandybridge kernels): what another CPU of the
+## machine's kind would get, shown on this one (tests/cpu_levels.py names the features).
+test-cpu: $(STAMP)
+	@for level in no-avx512 no-avx2; do \
+		features="$$($(BIN)/python tests/cpu_levels.py $$level)" && \
+		coretype="$$($(BIN)/python -c "import sys; sys.path.insert(0, 'tests'); import cpu_levels; print(cpu_levels.OPENBLAS_CORETYPE['$$level'])")" && \
+		echo "test-cpu $$level: NPY_DISABLE_CPU_FEATURES='$$features' OPENBLAS_CORETYPE=$$coretype" && \
+		TFLOC_CPU_LEVEL=$$level NPY_DISABLE_CPU_FEATURES="$$features" OPENBLAS_CORETYPE=$$coretype \
+			$(BIN)/python -m pytest -q -m bitwise tests || exit 1; \
+	done
 
 ## Every reader against thousands of damaged inputs, and every matcher parameter against bad
 ## values (make test runs a few hundred per reader); prints how many inputs each reader tried.

@@ -135,7 +135,7 @@ class CorrelativeMatcher(Configured):
         bs = grid.block_starts
         block_off = (bs[:, None] * w + bs[None, :]).ravel()  # (B²,), y-major
         bounds = np.take(pooled, base[:, :, None] + block_off[None, None, :]).sum(axis=1)  # (R, B²)
-        order = np.argsort(bounds, axis=None)[::-1]
+        order = np.argsort(-bounds, axis=None, kind="stable")  # ties: the first block (any CPU)
         flat_bounds = bounds.ravel()[order]
 
         # Full resolution inside blocks, best bound first, until no bound can beat the best score.

@@ -41,7 +41,8 @@ from .threads import limit_threads
 from .workspace import load_matcher
 
 PACKAGES = ("tfloc", "numpy", "scipy", "shapely", "numba", "pandas", "open3d", "kiss-icp",
-            "opencv-python-headless", "small-gicp", "karto-scanmatcher", "pebble", "matplotlib")
+            "opencv-python-headless", "small-gicp", "karto-scanmatcher", "pebble", "matplotlib",
+            "llvmlite", "evo", "amcl")
 
 
 def make_tasks(config: RunConfig, log: Callable[[str], None] | None = None) -> list[Task]:

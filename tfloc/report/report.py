@@ -29,6 +29,7 @@ from tfloc.evaluation.summary import (
 )
 from tfloc.harness.workspace import load_dataset, map_of
 from tfloc.io.estimates import status_kind
+from tfloc.io.lock import LOCK_NAME, find_lock, lock_differences, read_lock
 from tfloc.io.rundir import RunDir, RunInfo
 from tfloc.io.scenario import GLOBAL, SCAN_TO_SCAN, SEQUENCE
 
@@ -79,6 +80,7 @@ def header(run_dir: Path, run: dict, df: pd.DataFrame, thr: Thresholds, s2s: set
              f"{mach.get('python', '?')}; {cfg.get('jobs', '?')} worker(s) of one thread each; "
              f"time limit {cfg.get('timeout_s', '?')} s per scan",
              "- Versions: " + (", ".join(f"{k} {v}" for k, v in run.get("versions", {}).items() if v) or "unknown")]
+    lines += lock_note(run)
     if not run:
         lines.append("- **run.json is missing**: provenance unknown, default thresholds used.")
     lim = cfg.get("limit_per_group")
@@ -103,6 +105,20 @@ def header(run_dir: Path, run: dict, df: pd.DataFrame, thr: Thresholds, s2s: set
                      + (f"; at the end: {end[0]:.2f}" if end else "") + f" ({mach.get('cpu_count', '?')} CPUs)")
     lines += contention(df)
     return "\n".join(lines) + "\n"
+
+
+def lock_note(run: dict) -> list[str]:
+    """Whether the run's recorded package versions are those of the checkout's
+    ``requirements.lock`` (nothing when there is no lock or nothing was recorded)."""
+    lock, versions = find_lock(), run.get("versions") or {}
+    if lock is None or not versions:
+        return []
+    diff = lock_differences(versions, read_lock(lock, run.get("machine", {}).get("python")))
+    if not diff:
+        return [f"- Versions: those of `{LOCK_NAME}`"]
+    return [f"- **Versions other than `{LOCK_NAME}`'s**: "
+            + ", ".join(f"{k} {got or 'not installed'} (lock {want})" for k, (got, want) in sorted(diff.items()))
+            + "; answers may differ from a run made with the lock in the last digits, or more"]
 
 
 def contention(p: pd.DataFrame) -> list[str]:

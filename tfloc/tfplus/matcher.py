@@ -188,7 +188,7 @@ class TurningFunctionPlusMatcher(Configured):
         else:
             cands = np.column_stack((np.full(len(heads), vp.x), np.full(len(heads), vp.y), heads))
             if not cfg.refine:
-                cands = cands[np.argsort(pose_scores(_field(problem.map, cfg), points, cands))[:1]]
+                cands = cands[np.argsort(pose_scores(_field(problem.map, cfg), points, cands), kind="stable")[:1]]
             evaluations = len(heads)
         if cfg.refine:
             to = cfg.refine_to
