@@ -216,7 +216,17 @@ class AmclTracker:
             raise RuntimeError("AmclTracker.reset before start")
         self._init_at, self._odom_at_update, self._pose_at_update = (pose, self._odom), None, pose
 
-    def step(self, ranges: np.ndarray, odom_delta: Pose, stamp: float) -> Estimate:
+    def predict(self, odom_delta: Pose) -> Pose:
+        """The pose the next step starts from: the last estimate carried by the odometry."""
+        if self._filter is None:
+            raise RuntimeError("AmclTracker.predict before start")
+        odom = self._odom.compose(odom_delta)
+        if self._init_at is not None:
+            pose, at = self._init_at
+            return pose.compose(at.between(odom))
+        return self._pose_at_update.compose(self._odom_at_update.between(odom))
+
+    def step(self, ranges: np.ndarray, odom_delta: Pose, stamp: float, where: str = "scan") -> Estimate:
         """One scan: integrate the odometry; update the filter when Nav2 would (the first scan,
         then when the odometry moved more than ``update_min_d`` along x or y or ``update_min_a``
         in heading since the last update); otherwise carry the last estimate by the odometry."""

@@ -69,12 +69,16 @@ def synthetic_run(path: Path, truth: bool = True, seed: int = 7, wall_per_cpu: f
                                 score_est=None if succ or not ok else 1.0,
                                 score_true=None if succ or not ok else (0.5 if i % 2 else 2.0),
                                 outcome="", cpu_s=wall / wall_per_cpu))
-    return write_run(path, rows, {d: str(path / "no-such-dir" / d) for d in datasets})
+    declared = {d: {"mode": "single", "paper_scenarios": ["I"]} for d in datasets[:3]}
+    declared["office-pool"] = {"mode": "single", "paper_scenarios": ["II", "III"]}
+    declared["real-x-relations"] = {"mode": "scan-to-scan", "paper_scenarios": []}
+    return write_run(path, rows, {d: str(path / "no-such-dir" / d) for d in datasets}, declared)
 
 
-def write_run(path: Path, rows: list[dict], datasets: dict[str, str]) -> Path:
+def write_run(path: Path, rows: list[dict], datasets: dict[str, str], declared: dict | None = None) -> Path:
     """A run directory: ``estimates.csv`` of ``rows`` and a ``run.json`` as the runner writes it
-    (matchers tf and csm-corr, thresholds 10 cm / 2°)."""
+    (matchers tf and csm-corr, thresholds 10 cm / 2°; ``declared``: what each dataset's
+    ``scenario.json`` declares, as the runner records it)."""
     path.mkdir(parents=True, exist_ok=True)
     frame(rows).to_csv(path / "estimates.csv", index=False)
     run = {"config": {"name": "synthetic", "matchers": [{"label": "tf", "name": "tf", "params": {}},
@@ -83,7 +87,7 @@ def write_run(path: Path, rows: list[dict], datasets: dict[str, str]) -> Path:
                       "success": {"dist_m": 0.1, "orient_deg": 2.0}},
            "versions": {"tfloc": "0.1.0"}, "git": {"commit": "abc123", "dirty": False},
            "machine": {"platform": "test", "cpu_count": 2, "python": "3.11"},
-           "datasets": datasets,
+           "datasets": datasets, "declared": declared or {},
            "sessions": [{"started": "2026-01-01T00:00:00+0000", "tasks": 10, "already_done": 0,
                          "loadavg_start": [3.5, 3.0, 2.5], "loadavg_end": [4.25, 3.5, 3.0]}]}
     (path / "run.json").write_text(json.dumps(run))

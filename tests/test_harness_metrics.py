@@ -9,8 +9,8 @@ import pandas as pd
 import pytest
 
 from tests._estimates import frame, row
+from tfloc.core.thresholds import Thresholds
 from tfloc.evaluation.metrics import angle_bin, classify, dist_bin, prepare, summarize
-from tfloc.evaluation.outcome import Thresholds
 from tfloc.evaluation.summary import scenario_summary, summary_table
 
 
@@ -137,11 +137,13 @@ def test_paper_scenarios_and_summary_groupings():
             row("A", 0.03, 0.5, 2.5, 12.0, dataset="office-pool", scan_id="p1"),
             row("A", 0.04, 0.5, 0.2, 1.0, dataset="real-lab", scan_id="r")]
     p = prepare(frame(rows), Thresholds())
-    sc = scenario_summary(p)
+    paper = {"detail-2": ("I",), "office-pool": ("II", "III")}   # as their scenario.json declare
+    sc = scenario_summary(p, paper)
     got = {(r.scenario, r.sample): r.n for r in sc.itertuples()}
     assert got == {("I", "detail-2"): 1, ("II", "5–10"): 1, ("II", "10–15"): 1,
                    ("III", "100–200"): 1, ("III", "200–300"): 1}
-    t = summary_table(p)
+    assert scenario_summary(p, {}).empty        # by what they declare, not by their names
+    t = summary_table(p, paper=paper)
     assert set(t["grouping"]) == {"scenario-I", "scenario-II", "scenario-III", "dataset",
                                   "dataset-dist_bin", "dataset-angle_bin", "overall"}
     overall = t[t["grouping"] == "overall"].iloc[0]

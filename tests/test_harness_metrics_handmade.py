@@ -6,8 +6,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from tfloc.core.thresholds import Thresholds
 from tfloc.evaluation.metrics import angle_bin, classify, dist_bin, prepare, summarize
-from tfloc.evaluation.outcome import Thresholds
 
 
 def _row(d_m, o_deg, init_d_m, init_o_deg, status="ok", score_est=1.0, score_true=0.5,

@@ -120,8 +120,8 @@ def test_empty_run_is_a_one_line_error(tmp_path):
 
 
 def test_a_sweeps_line_figures_show_the_first_label_and_the_most_successful_others():
+    from tfloc.core.thresholds import Thresholds
     from tfloc.evaluation.metrics import prepare
-    from tfloc.evaluation.outcome import Thresholds
     from tfloc.report.report import line_figure_matchers
 
     order = [f"m{i:02d}" for i in range(20)]          # m00 first; m19 succeeds most often
@@ -135,8 +135,8 @@ def test_a_sweeps_line_figures_show_the_first_label_and_the_most_successful_othe
 def test_a_sweeps_bar_figures_turn_horizontal(tmp_path):
     from matplotlib.image import imread
 
+    from tfloc.core.thresholds import Thresholds
     from tfloc.evaluation.metrics import prepare
-    from tfloc.evaluation.outcome import Thresholds
     from tfloc.report.figures import MANY_MATCHERS, fig_outcomes
 
     many_n = MANY_MATCHERS + 30

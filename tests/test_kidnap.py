@@ -20,7 +20,8 @@ from tfloc.evaluation.kidnap import (
     scans_to_relocalize,
     score_kidnaps,
 )
-from tfloc.harness.track import odom_deltas, row
+from tfloc.harness.track import odom_deltas
+from tfloc.io.estimates import result_row
 from tfloc.io.scenario import SEQUENCE, read_scans, read_scenario
 
 SCEN = Path(__file__).resolve().parents[1] / "data" / "scenarios"
@@ -123,8 +124,9 @@ def test_report_kidnap_table(tmp_path) -> None:
         # "late" is found 5 scans after every event; "lost" is never found after the first one
         late = s.true if not any(0 <= k - e < 5 for e in events) else s.true.compose(Pose(3.0, 0.0, 0.0))
         lost = s.true if k < events[0] else scans[events[0] - 1].true
-        rows.append(row(name, "late", s, late, late, "ok", 0.002, 0.002))
-        rows.append(row(name, "lost", s, lost, lost, "ok", 0.002, 0.002))
+        for label, pose in (("late", late), ("lost", lost)):
+            rows.append(result_row(name, label, s.scan_id, s.group, true=s.true, init=pose, est=pose,
+                                   status="ok", wall_s=0.002, cpu_s=0.002, info={}))
     df = pd.DataFrame(rows).astype(str)
     text = tracking_section(df, {name: sc}, {}, tmp_path, figures=False)
     assert "**kidnap: kidnap events** (1 sequence: seq-kidnap-b)" in text

@@ -8,8 +8,8 @@ import math
 import pytest
 
 from tfloc.core.pose import Pose
+from tfloc.core.thresholds import Thresholds
 from tfloc.errors import ResultsError
-from tfloc.evaluation.outcome import Thresholds
 from tfloc.evaluation.relocalization import (
     free_area_m2,
     hypotheses_from_info,

@@ -11,8 +11,8 @@ import pytest
 
 from tests._estimates import frame, row, synthetic_run
 from tests.test_harness_runner import cfg, make_dataset
+from tfloc.core.thresholds import Thresholds
 from tfloc.evaluation.metrics import prepare
-from tfloc.evaluation.outcome import Thresholds
 from tfloc.evaluation.paired import paired_comparisons
 from tfloc.evaluation.stats import mcnemar_exact, wilson
 from tfloc.harness.config import MatcherSpec

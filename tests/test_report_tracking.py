@@ -7,7 +7,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from tfloc.harness.track import dead_reckoning, row
+from tfloc.harness.track import dead_reckoning
+from tfloc.io.estimates import result_row
 from tfloc.io.maps import load_map
 from tfloc.io.scenario import read_scans, read_scenario
 from tfloc.report.tracking import sequence_scores, tracking_section
@@ -21,7 +22,8 @@ def _rows(name: str, n: int, lost_from: int | None = None) -> list[dict]:
     out = dead_reckoning(sc, scans, dataset=name)
     for k, s in enumerate(scans):  # a "perfect" matcher, lost (1 m off) from lost_from on
         est = s.true if lost_from is None or k < lost_from else s.true.compose(type(s.true)(1.0, 0.0, 0.0))
-        out.append(row(name, "perfect", s, s.true, est, "ok", 0.002, 0.002))
+        out.append(result_row(name, "perfect", s.scan_id, s.group, true=s.true, init=s.true, est=est,
+                              status="ok", wall_s=0.002, cpu_s=0.002, info={}))
     return out
 
 

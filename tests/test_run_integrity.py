@@ -136,7 +136,7 @@ def test_changed_data_thresholds_or_matchers_are_named(tmp_path, test_room, lms2
     with pytest.raises(ConfigError, match=r"dataset ds: scans.csv changed"):
         run(c, progress=False)
     (ds / "scans.csv").write_bytes(scans)
-    from tfloc.evaluation.outcome import Thresholds
+    from tfloc.core.thresholds import Thresholds
     with pytest.raises(ConfigError, match=r"success dist_m 0.1 → 0.05"):
         run(c.with_overrides(success=Thresholds(0.05, 2.0)), progress=False)
     other = MatcherSpec.make("toy_matchers:TwoMinima", {"false_value": 0.4}, label="toy")

@@ -4,7 +4,8 @@ import math
 
 import numpy as np
 
-from tfloc.evaluation.outcome import Thresholds, search_outcome
+from tfloc.core.thresholds import Thresholds
+from tfloc.evaluation.outcome import search_outcome
 
 THR = Thresholds()
 

@@ -14,6 +14,7 @@ from tfloc.cli import main
 from tfloc.core.matcher import get_matcher
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate
+from tfloc.core.thresholds import Thresholds
 from tfloc.harness.track import dead_reckoning, track
 from tfloc.io.estimates import COLUMNS
 from tfloc.io.scenario import Scan, read_scans, read_scenario, write_scenario
@@ -65,7 +66,11 @@ def test_guess_is_last_estimate_composed_with_odometry(tmp_path):
             assert rows[k]["est_x"] == pytest.approx(want.x)
         else:
             assert rows[k]["status"] == "ok" and rows[k]["est_x"] == pytest.approx(want.x + 0.01)
-    assert all(r["dist_err_m"] == "" and r["outcome"] == "" for r in rows)
+    for r, scan in zip(rows, scans, strict=True):  # errors where the truth is known; no outcome without thresholds
+        est = Pose(r["est_x"], r["est_y"], r["est_theta"])
+        assert (r["dist_err_m"], r["orient_err_rad"]) == est.error_to(scan.true) and r["outcome"] == ""
+    scored = track(sc, scans, Shift(), thresholds=Thresholds(0.015, 2.0))
+    assert {r["outcome"] for r in scored} == {"success", "unscored", "no-answer"}
 
 
 def test_blanked_truth_gives_the_same_estimates(tmp_path):

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from tfloc.evaluation.outcome import Thresholds
+from tfloc.core.thresholds import Thresholds
 from tfloc.evaluation.trajectory import episodes, errors, score_rows, score_track
 
 

@@ -40,8 +40,8 @@ import sys
 from pathlib import Path
 
 from tfloc.core.matcher import available_matchers
+from tfloc.core.thresholds import Thresholds
 from tfloc.errors import ConfigError
-from tfloc.evaluation.outcome import Thresholds
 from tfloc.harness.config import RunConfig, check_imports, load_config, parse_matchers
 
 HELP = "run matchers over scenario datasets (resumable), writing RUN/estimates.csv"

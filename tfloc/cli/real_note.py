@@ -21,7 +21,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from tfloc.evaluation.outcome import Thresholds
+    from tfloc.core.thresholds import Thresholds
     from tfloc.io.rundir import RunDir
     from tfloc.report.relations_note import write_note
 

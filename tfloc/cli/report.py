@@ -29,7 +29,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from tfloc.evaluation.outcome import Thresholds
+    from tfloc.core.thresholds import Thresholds
     from tfloc.io.rundir import RunDir
     from tfloc.report.report import write_report
 

@@ -68,5 +68,10 @@ class Pose:
         """Euclidean distance between the two positions (metres)."""
         return math.hypot(self.x - other.x, self.y - other.y)
 
+    def error_to(self, truth: Pose) -> tuple[float, float]:
+        """The errors of this pose against ``truth``: distance (metres) and the absolute
+        orientation difference of Eq. 6 (radians). The one error rule of every row."""
+        return self.distance_to(truth), abs(float(angdiff(self.theta, truth.theta)))
+
     def is_finite(self) -> bool:
         return all(math.isfinite(v) for v in (self.x, self.y, self.theta))

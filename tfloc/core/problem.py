@@ -81,6 +81,10 @@ class Problem:
         return self.laser.to_points(self.ranges)
 
 
+#: ``info["status"]`` of an estimate whose matcher declined to answer
+NO_ANSWER = "no-answer"
+
+
 @dataclass(frozen=True)
 class Estimate:
     """A matcher's answer.
@@ -101,3 +105,10 @@ class Estimate:
     evaluations: int = 0
     info: dict[str, Any] = field(default_factory=dict)
     hypotheses: tuple[Pose, ...] = ()
+
+    @property
+    def declined(self) -> bool:
+        """The matcher gave no answer: it said so (``info["status"] == "no-answer"``) or its pose
+        is not finite. The one rule: a declined estimate is a ``failed`` row, and a tracker
+        keeps its prediction instead."""
+        return self.info.get("status") == NO_ANSWER or not self.pose.is_finite()

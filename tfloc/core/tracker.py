@@ -19,6 +19,8 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
+from tfloc.errors import InvalidProblemError
+
 from .laser import LaserSpec
 from .map import Map
 from .params import Configured
@@ -31,7 +33,11 @@ PREDICTED = "predicted"
 
 @runtime_checkable
 class Tracker(Protocol):
-    """What the harness needs of a localizer that runs along a sequence."""
+    """What the harness needs of a localizer that runs along a sequence. The tracker owns its
+    belief: it says what it expects before a scan (``predict``), takes the scan (``step``) and
+    can be put back at a pose when a step raised (``reset``). It may also define
+    ``warm(map, laser, ranges, pose)``: untimed work the harness asks for before ``start``
+    (compiling kernels, map-only structures) with the first scan and the start pose."""
 
     name: str
 
@@ -39,9 +45,20 @@ class Tracker(Protocol):
         """Begin a sequence on ``map`` at the robot's starting ``pose`` (world frame)."""
         ...
 
-    def step(self, ranges: np.ndarray, odom_delta: Pose, stamp: float) -> Estimate:
+    def predict(self, odom_delta: Pose) -> Pose:
+        """The pose the next ``step`` starts from, given the odometry increment (no state
+        change): the guess a row records as ``init_*``."""
+        ...
+
+    def step(self, ranges: np.ndarray, odom_delta: Pose, stamp: float, where: str = "scan") -> Estimate:
         """One scan: ``ranges`` (metres), ``odom_delta`` the odometry increment since the last
-        step (metres/radians, in the robot frame of the previous scan), ``stamp`` seconds."""
+        step (metres/radians, in the robot frame of the previous scan), ``stamp`` seconds;
+        ``where`` names the scan in messages (``file:line``). An estimate that keeps the
+        prediction says so in ``info["status"]`` (:data:`PREDICTED`)."""
+        ...
+
+    def reset(self, pose: Pose) -> None:
+        """Put the belief at ``pose`` (the harness's prediction after a step raised)."""
         ...
 
 
@@ -56,9 +73,16 @@ def has_single_scan_mode(obj: object) -> bool:
     return callable(getattr(obj, "localize", None))
 
 
+def kept_prediction(est: Estimate) -> bool:
+    """Whether a tracker's step kept its prediction (the matcher declined, or the prediction
+    posed no problem): such a row is ``failed``."""
+    return est.info.get("status") == PREDICTED
+
+
 class LocalTracker:
     """A single-scan matcher run as a tracker: each scan is localized from the prediction
-    (last estimate ⊕ odometry increment); a declined scan keeps the prediction."""
+    (last estimate ⊕ odometry increment); a declined scan, or a prediction that poses no
+    problem (it left the map), keeps the prediction."""
 
     def __init__(self, matcher) -> None:
         self.matcher = matcher
@@ -70,20 +94,34 @@ class LocalTracker:
     def start(self, map: Map, laser: LaserSpec, pose: Pose) -> None:
         self._map, self._laser, self.pose = map, laser, pose
 
+    def warm(self, map: Map, laser: LaserSpec, ranges: np.ndarray, pose: Pose) -> None:
+        """Untimed: the matcher's map-only work (``prepare``), one ``score`` and one
+        ``localize`` of the first scan from ``pose`` (numba kernels compiled or loaded)."""
+        problem = Problem(map, laser, ranges, pose)
+        prepare = getattr(self.matcher, "prepare", None)
+        if prepare is not None:
+            prepare(problem)
+        if callable(getattr(self.matcher, "score", None)):
+            self.matcher.score(problem, pose)
+        self.matcher.localize(problem)
+
     def predict(self, odom_delta: Pose) -> Pose:
         """The guess for the next scan: the last estimate composed with ``odom_delta``."""
         if self.pose is None:
-            raise RuntimeError("LocalTracker.step before start")
+            raise RuntimeError("LocalTracker.predict before start")
         return self.pose.compose(odom_delta)
 
-    def answer(self, ranges: np.ndarray, guess: Pose, where: str = "scan") -> tuple[Problem, Estimate]:
-        """The matcher's answer to the scan from ``guess`` (the prediction, kept when it
-        declines), and the problem it answered."""
-        problem = Problem(self._map, self._laser, ranges, guess, where=where)
+    def answer(self, ranges: np.ndarray, guess: Pose, where: str = "scan") -> tuple[Problem | None, Estimate]:
+        """The matcher's answer to the scan from ``guess``, and the problem it answered; the
+        guess itself (:data:`PREDICTED`) when the matcher declines, or when the guess poses no
+        problem (problem ``None``, ``info["reason"]`` says why)."""
+        try:
+            problem = Problem(self._map, self._laser, ranges, guess, where=where)
+        except InvalidProblemError as exc:
+            return None, Estimate(guess, False, info={"status": PREDICTED, "reason": str(exc)[:200]})
         est = self.matcher.localize(problem)
-        if est.info.get("status") == "no-answer" or not est.pose.is_finite():
-            est = Estimate(guess, False, est.iterations, est.evaluations,
-                           {**est.info, "status": PREDICTED})
+        if est.declined:
+            est = Estimate(guess, False, est.iterations, est.evaluations, {**est.info, "status": PREDICTED})
         return problem, est
 
     def step(self, ranges: np.ndarray, odom_delta: Pose, stamp: float, where: str = "scan") -> Estimate:

@@ -95,17 +95,17 @@ def generate_bundle(out: str | Path, spec: BundleSpec = BundleSpec(), log=None) 
         maps[level] = (path, read_vector_map(path))  # sample on the map exactly as stored
     jobs = [("office-pool", 2, spec.pool_per_cell,
              "Scenarios II and III: one pool on the furnished office (level 2), "
-             "binned by initial angle offset (II) or initial distance offset (III)")]
+             "binned by initial angle offset (II) or initial distance offset (III)", ["II", "III"])]
     jobs += [(f"detail-{lv}", lv, spec.detail_per_cell,
-              f"Scenario I: environmental detail level {lv} (office-{lv})") for lv in (1, 2, 3)]
+              f"Scenario I: environmental detail level {lv} (office-{lv})", ["I"]) for lv in (1, 2, 3)]
     seeds = np.random.SeedSequence(spec.seed).spawn(len(jobs))
     dirs = []
-    for (name, level, per_cell, desc), ss in zip(jobs, seeds, strict=True):
+    for (name, level, per_cell, desc, paper), ss in zip(jobs, seeds, strict=True):
         path, m = maps[level]
         scans = sample_scans(m, spec.laser, spec.noise, per_cell, np.random.default_rng(ss),
                              spec.clearance_m)
         root = out / "scenarios" / name
-        write_scenario(root, name, path, spec.laser, scans, description=desc,
+        write_scenario(root, name, path, spec.laser, scans, description=desc, paper_scenarios=paper,
                        generator={"seed": spec.seed, "child": int(ss.spawn_key[-1]),
                                   "per_cell": per_cell, "clearance_m": spec.clearance_m,
                                   "noise": spec.noise.record()})

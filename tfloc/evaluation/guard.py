@@ -27,8 +27,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from tfloc.core.thresholds import Thresholds
+
 from .metrics import prepare, summarize
-from .outcome import Thresholds
 
 CONFIG = Path("benchmarks/regression.toml")
 REFERENCE = Path("results/reference/summary.csv")

@@ -24,7 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .outcome import Thresholds
+from tfloc.core.thresholds import Thresholds
+
 from .trajectory import errors
 
 #: scans an estimate must stay correct for to count as relocalized

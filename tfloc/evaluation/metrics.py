@@ -34,6 +34,7 @@ import itertools
 import numpy as np
 import pandas as pd
 
+from tfloc.core.thresholds import Thresholds
 from tfloc.datasets.protocol import ANGLE_BINS_DEG, DIST_BINS_M
 
 from .outcome import (
@@ -42,7 +43,6 @@ from .outcome import (
     OUTCOMES,
     SUCCESS,
     UNSCORED,
-    Thresholds,
     outcome,
     search_outcome,
 )

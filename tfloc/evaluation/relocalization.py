@@ -27,9 +27,10 @@ from typing import Any
 import numpy as np
 
 from tfloc.core.pose import Pose, angdiff
+from tfloc.core.thresholds import Thresholds
 from tfloc.errors import ResultsError
 
-from .outcome import AMBIGUOUS, Thresholds, failure_kind
+from .outcome import AMBIGUOUS, failure_kind
 from .stats import wilson
 
 TOP_K = 5

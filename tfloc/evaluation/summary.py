@@ -1,57 +1,66 @@
 """The paper's scenarios and the run summary (``summary.csv``): metrics per matcher × grouping.
 
-Scenario I = datasets ``detail-1``, ``detail-2``, ``detail-3`` (one sample each); Scenario II =
-dataset ``office-pool`` binned by initial angle offset; Scenario III = ``office-pool`` binned
-by initial distance offset. Other datasets get per-dataset rows, binned by distance and angle
-offset when they are scan-to-map (a scan-to-scan dataset's offsets are odometry, not bins).
+Which datasets pose which of the paper's scenarios is what each declares in its
+``scenario.json`` (``"paper_scenarios"``, :func:`tfloc.io.scenario.paper_scenarios_of`; the
+mapping ``paper`` below, dataset → scenarios), never its name: Scenario I = every dataset that
+declares ``I`` (one sample each); Scenario II = a dataset declaring ``II`` binned by initial angle
+offset; Scenario III = one declaring ``III`` binned by initial distance offset. Other datasets
+get per-dataset rows, binned by distance and angle offset when they are scan-to-map (a
+scan-to-scan dataset's offsets are odometry, not bins).
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
 import pandas as pd
 
 from .metrics import METRIC_COLUMNS, summarize
 
-SCENARIO_I = ("detail-1", "detail-2", "detail-3")
-POOL = "office-pool"
 SUMMARY_KEYS = ["grouping", "dataset", "bin", "matcher"]
+Paper = Mapping[str, Sequence[str]]
 
 
-def scenario_rows(p: pd.DataFrame) -> pd.DataFrame:
-    """Prepared rows labelled by paper scenario (``scenario``: I/II/III) and ``sample``.
+def declaring(paper: Paper, scenario: str) -> list[str]:
+    """The datasets that declare ``scenario`` (sorted)."""
+    return sorted(d for d, s in paper.items() if scenario in s)
 
-    Office-pool rows appear twice (in II by angle bin, in III by distance bin).
-    """
+
+def scenario_rows(p: pd.DataFrame, paper: Paper) -> pd.DataFrame:
+    """Prepared rows labelled by paper scenario (``scenario``: I/II/III), ``sample`` and the
+    dataset they come from. A dataset declaring II and III appears twice (by angle bin, by
+    distance bin)."""
     parts = []
-    one = p[p["dataset"].isin(SCENARIO_I)]
+    one = p[p["dataset"].isin(declaring(paper, "I"))]
     if len(one):
         parts.append(one.assign(scenario="I", sample=one["dataset"]))
-    pool = p[p["dataset"] == POOL]
-    if len(pool):
-        parts.append(pool.assign(scenario="II", sample=pool["angle_bin"].astype(object)))
-        parts.append(pool.assign(scenario="III", sample=pool["dist_bin"].astype(object)))
+    for name, col in (("II", "angle_bin"), ("III", "dist_bin")):
+        pool = p[p["dataset"].isin(declaring(paper, name))]
+        if len(pool):
+            parts.append(pool.assign(scenario=name, sample=pool[col].astype(object)))
     if not parts:
         return p.iloc[:0].assign(scenario=pd.Series(dtype=object), sample=pd.Series(dtype=object))
     return pd.concat(parts, ignore_index=True)
 
 
-def scenario_summary(p: pd.DataFrame) -> pd.DataFrame:
-    """Metrics per (scenario, sample, matcher), samples in table order, missing bins dropped."""
-    s = scenario_rows(p)
+def scenario_summary(p: pd.DataFrame, paper: Paper) -> pd.DataFrame:
+    """Metrics per (scenario, sample, matcher), samples in table order, missing bins dropped;
+    ``dataset``: the dataset of a Scenario I sample, or the binned dataset(s) of II and III."""
+    s = scenario_rows(p, paper)
     if s.empty:
-        return pd.DataFrame(columns=["scenario", "sample", "matcher", *METRIC_COLUMNS])
+        return pd.DataFrame(columns=["scenario", "sample", "matcher", "dataset", *METRIC_COLUMNS])
     s = s[s["sample"].notna()]
     out = summarize(s, ["scenario", "sample", "matcher"])
-    order = {k: i for i, k in enumerate([*SCENARIO_I, *p["angle_bin"].cat.categories,
+    origin = s.groupby(["scenario", "sample"], observed=True)["dataset"].agg(lambda d: "+".join(sorted(set(d))))
+    out["dataset"] = [origin[(a, b)] for a, b in zip(out["scenario"], out["sample"], strict=True)]
+    order = {k: i for i, k in enumerate([*declaring(paper, "I"), *p["angle_bin"].cat.categories,
                                          *p["dist_bin"].cat.categories])}
     out["_o"] = out["sample"].map(order)
     return out.sort_values(["scenario", "_o", "matcher"]).drop(columns="_o").reset_index(drop=True)
 
 
-def summary_table(p: pd.DataFrame, scan_to_scan: Iterable[str] = ()) -> pd.DataFrame:
+def summary_table(p: pd.DataFrame, scan_to_scan: Iterable[str] = (), paper: Paper | None = None) -> pd.DataFrame:
     """Every grouping of the report in one long table (columns :data:`SUMMARY_KEYS` + metrics).
 
     groupings: ``scenario-I`` (bin = all), ``scenario-II`` (bin = angle bin), ``scenario-III``
@@ -62,11 +71,9 @@ def summary_table(p: pd.DataFrame, scan_to_scan: Iterable[str] = ()) -> pd.DataF
     """
     s2s = set(scan_to_scan)
     parts = []
-    sc = scenario_summary(p)
+    sc = scenario_summary(p, paper or {})
     for name, g in sc.groupby("scenario", sort=True):
-        one = name == "I"
-        parts.append(g.assign(grouping=f"scenario-{name}", bin="all" if one else g["sample"],
-                              dataset=g["sample"] if one else POOL))
+        parts.append(g.assign(grouping=f"scenario-{name}", bin="all" if name == "I" else g["sample"]))
     parts.append(summarize(p, ["dataset", "matcher"]).assign(grouping="dataset", bin="all"))
     truth = p[p["truth"]]
     s2m = truth[~truth["dataset"].isin(s2s)]

@@ -30,8 +30,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from tfloc.core.pose import angdiff
-
-from .outcome import Thresholds
+from tfloc.core.thresholds import Thresholds
 
 LOST_DIST_M, LOST_ORIENT_DEG = 0.5, 10.0
 DEFAULT = Thresholds()

@@ -41,8 +41,8 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from tfloc.core.thresholds import Thresholds
 from tfloc.errors import ConfigError
-from tfloc.evaluation.outcome import Thresholds
 from tfloc.io.text import parse_text
 
 

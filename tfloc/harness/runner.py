@@ -125,8 +125,12 @@ def environment() -> dict:
 def session_doc(config: RunConfig, fp: dict | None) -> dict:
     """What ``run.json`` records of a session besides the sessions themselves: the configuration,
     the environment, the datasets (name → directory) and the fingerprint."""
+    scenarios = [read_scenario(d) for d in config.datasets]
     return {"config": config.to_dict(), **environment(),
-            "datasets": {read_scenario(d).name: str(d) for d in config.datasets}, "fingerprint": fp}
+            "datasets": {sc.name: str(d) for sc, d in zip(scenarios, config.datasets, strict=True)},
+            "declared": {sc.name: {"mode": sc.mode, "paper_scenarios": list(sc.paper_scenarios)}
+                         for sc in scenarios},
+            "fingerprint": fp}
 
 
 def execute_local(tasks: list[Task], jobs: int, timeout_s: float,

@@ -25,11 +25,11 @@ from typing import Any
 import numpy as np
 
 from tfloc.core.matcher import check_solvable
-from tfloc.core.pose import Pose, angdiff
+from tfloc.core.thresholds import Thresholds
 from tfloc.errors import InvalidProblemError
-from tfloc.evaluation.outcome import AMBIGUOUS, NO_ANSWER, Thresholds, outcome
+from tfloc.evaluation.outcome import AMBIGUOUS, NO_ANSWER, outcome
 from tfloc.evaluation.relocalization import HYPOTHESES_KEY, hypotheses_info
-from tfloc.io.estimates import pose_fields
+from tfloc.io.estimates import result_row
 from tfloc.io.scenario import Scan
 
 from .workspace import load_dataset, load_matcher, problem_of, status_of, timed_localize, warm
@@ -56,15 +56,10 @@ class Task:
 
 
 def base_row(task: Task, scan: Scan | None) -> dict[str, Any]:
-    """The identifying part of a result row (also used for timeout/error rows)."""
-    row: dict[str, Any] = {"dataset": task.dataset_name, "scan_id": task.scan_id,
-                           "group": scan.group if scan else "", "matcher": task.label}
-    row.update(pose_fields("true", scan.true if scan else None))
-    row.update(pose_fields("init", scan.initial if scan else None))
-    if scan is not None and scan.true is not None and scan.initial is not None:
-        row["init_dist_err_m"] = scan.initial.distance_to(scan.true)
-        row["init_orient_err_rad"] = abs(angdiff(scan.initial.theta, scan.true.theta))
-    return row
+    """The row of a task before its matcher answers: identity, truth and initial guess
+    (:func:`tfloc.io.estimates.result_row`); also the row of a timeout or error."""
+    return result_row(task.dataset_name, task.label, task.scan_id, scan.group if scan else "",
+                      true=scan.true if scan else None, init=scan.initial if scan else None)
 
 
 def failure_row(task: Task, status: str, scan: Scan | None = None) -> dict[str, Any]:
@@ -123,18 +118,14 @@ def run_task(task: Task) -> dict[str, Any] | list[dict[str, Any]]:
     except Exception as exc:  # noqa: BLE001 - a failing matcher is a result, not a crash
         return failure_row(task, f"error:{type(exc).__name__}: {exc}", scan)
     est = timed.estimate
-    row = base_row(task, scan)
-    p = est.pose
     status = status_of(est)
     info = est.info if not est.hypotheses else {**est.info, HYPOTHESES_KEY: hypotheses_info(est.hypotheses)}
-    row.update(est_x=p.x, est_y=p.y, est_theta=p.theta, runtime_s=timed.wall_s, cpu_s=timed.cpu_s,
-               converged=int(bool(est.converged)), iterations=est.iterations,
-               evaluations=est.evaluations, status=status,
-               info=json.dumps(info, default=str, separators=(",", ":")))
+    row = result_row(task.dataset_name, task.label, task.scan_id, scan.group, true=scan.true,
+                     init=scan.initial, est=est.pose, estimate=est, status=status,
+                     wall_s=timed.wall_s, cpu_s=timed.cpu_s, info=info)
     if scan.true is None:
         return row
-    d, o = p.distance_to(scan.true), abs(angdiff(p.theta, scan.true.theta))
-    row.update(dist_err_m=d, orient_err_rad=o)
+    p, d, o = est.pose, row["dist_err_m"], row["orient_err_rad"]
     s_est = s_true = np.nan
     recorded = ""
     if status == "ok" and not task.thresholds.success(d, o) and callable(getattr(matcher, "score", None)):
@@ -163,21 +154,11 @@ def warm_up(task: Task) -> None:
 
 def run_sequence_task(task: Task) -> list[dict[str, Any]]:
     """A whole sequence tracked (:func:`tfloc.harness.track.run_sequence`): one row per scan in
-    order; each row with truth gets its errors and outcome by the one rule (a tracking loop has
-    no objective to score a failure with: such a failure is ``unscored``). A matcher that cannot
-    be built is one ``error:`` row for the task."""
+    order, scored by the one rule under the task's thresholds. A matcher that cannot be built is
+    one ``error:`` row for the task."""
     from .track import run_sequence
 
     try:
-        rows = run_sequence(task.dataset, task.label, task.matcher, task.params_json)
+        return run_sequence(task.dataset, task.label, task.matcher, task.params_json, task.thresholds)
     except Exception as exc:  # noqa: BLE001 - a failing matcher is a result, not a crash
         return [failure_row(task, f"error:{type(exc).__name__}: {exc}")]
-    for r in rows:
-        if r["true_x"] == "" or r["init_x"] == "":
-            continue
-        true, pred, est = (Pose(r[f"{k}_x"], r[f"{k}_y"], r[f"{k}_theta"]) for k in ("true", "init", "est"))
-        d, o = est.distance_to(true), abs(angdiff(est.theta, true.theta))
-        r.update(dist_err_m=d, orient_err_rad=o, init_dist_err_m=pred.distance_to(true),
-                 init_orient_err_rad=abs(angdiff(pred.theta, true.theta)),
-                 outcome=outcome(r["status"] == "ok", d, o, np.nan, np.nan, task.thresholds))
-    return rows

@@ -1,39 +1,36 @@
-"""The tracking loop: one sequence dataset run with one matcher (or tracker), scan by scan.
+"""The tracking loop: one sequence dataset run with one tracker, scan by scan.
 
-The robot starts at the first row's ``init_*``; the guess for scan k is the estimate of scan k−1
-composed with the odometry increment ``odom(k−1)⁻¹ · odom(k)`` (:mod:`tfloc.core.tracker`; for
-scan 0 the increment is the identity). The truth is never read by the loop: ``true_*`` is only
-copied into the rows so that they can be scored later (:mod:`tfloc.evaluation.trajectory`).
+The robot starts at the first row's ``init_*``. A single-scan matcher runs as a
+:class:`~tfloc.core.tracker.LocalTracker`. For each scan the loop asks the tracker for its guess
+(``predict``: for a local tracker the last estimate ⊕ ``odom(k−1)⁻¹ · odom(k)``; identity for
+scan 0), times its ``step`` with the workspace's one timer and writes one row with the one row
+builder (:func:`tfloc.io.estimates.result_row`). The truth is never handed to the tracker; it is
+copied into the rows to score them.
 
-One row per scan, in order, in the columns of :data:`tfloc.io.estimates.COLUMNS`:
-
-* ``init_*``: the prediction handed to the matcher; ``est_*``: its answer, or the prediction
-  when it declined (``status`` = ``failed``), when the prediction posed no problem (it left the
-  map: ``failed``, ``info.reason``) or when it raised (``status`` = ``error:<message>``; the run
-  goes on from the prediction);
-* ``cpu_s``/``runtime_s``: process CPU time and wall time of the step alone (the matcher's
-  ``prepare``, one ``score`` and one ``localize`` of the first scan run untimed before it);
-* ``dist_err_m``, ``orient_err_rad``, ``init_*_err``, ``outcome``, ``score_*``: left empty.
+* ``init_*``: the tracker's prediction; ``est_*``: its answer (the prediction when it kept it:
+  ``failed``, or when the step raised: ``error:<message>``, and the loop resets the tracker to
+  the prediction and goes on);
+* ``cpu_s``/``runtime_s``: CPU and wall time of the step alone (the tracker's ``warm`` runs
+  untimed before the sequence);
+* errors where the truth is known, and the ``outcome`` of the one rule when thresholds are given
+  (a tracking loop has no objective to tell a local optimum: such a failure is unscored).
 """
 
 from __future__ import annotations
 
-import json
-import time
+import math
 from collections.abc import Callable, Sequence
 from typing import Any
 
 from tfloc.core.pose import Pose
-from tfloc.core.problem import Estimate, Problem
-from tfloc.core.tracker import PREDICTED, DeadReckoning, LocalTracker, as_tracker, is_tracker
-from tfloc.errors import DatasetError, InvalidProblemError
-from tfloc.io.estimates import COLUMNS, pose_fields
+from tfloc.core.thresholds import Thresholds
+from tfloc.core.tracker import DeadReckoning, as_tracker
+from tfloc.errors import DatasetError
+from tfloc.evaluation.outcome import outcome
+from tfloc.io.estimates import result_row
 from tfloc.io.scenario import SEQUENCE, Scan, Scenario, map_for
 
-from .workspace import warm
-
-#: status of a row whose estimate is the matcher's own answer / the prediction kept
-OK, FAILED = "ok", "failed"
+from .workspace import status_of, timed_step, warm_tracker
 
 
 def check_sequence(scenario: Scenario, scans: Sequence[Scan]) -> None:
@@ -54,67 +51,42 @@ def odom_deltas(scans: Sequence[Scan]) -> list[Pose]:
     return out
 
 
-def row(dataset: str, label: str, scan: Scan, pred: Pose, est: Pose, status: str, cpu_s: float,
-        wall_s: float, estimate: Estimate | None = None, info: dict | None = None) -> dict[str, Any]:
-    """One result row of the loop (columns of :data:`tfloc.io.estimates.COLUMNS`)."""
-    out = {c: "" for c in COLUMNS}
-    out.update(dataset=dataset, scan_id=scan.scan_id, group=scan.group, matcher=label,
-               **pose_fields("true", scan.true), **pose_fields("init", pred),
-               **pose_fields("est", est), runtime_s=wall_s, cpu_s=cpu_s, status=status)
-    if estimate is not None:
-        out.update(converged=int(bool(estimate.converged)), iterations=estimate.iterations,
-                   evaluations=estimate.evaluations)
-    out["info"] = json.dumps(info or {}, default=str, sort_keys=True)
-    return out
-
-
 def track(scenario: Scenario, scans: Sequence[Scan], matcher, *, label: str | None = None,
-          dataset: str | None = None, map=None,
+          dataset: str | None = None, map=None, thresholds: Thresholds | None = None,
           progress: Callable[[int], None] | None = None) -> list[dict[str, Any]]:
     """Run ``matcher`` (a single-scan matcher or a :class:`~tfloc.core.tracker.Tracker`) along
     the sequence ``scans`` of ``scenario``; one row per scan, in order (module notes).
-    ``map`` overrides the dataset's map; ``progress(k)`` is called after each scan."""
+    ``map`` overrides the dataset's map; ``thresholds`` fill each scored row's ``outcome``;
+    ``progress(k)`` is called after each scan."""
     check_sequence(scenario, scans)
-    name = getattr(matcher, "name", type(matcher).__name__)
-    label = label or name
+    tracker = as_tracker(matcher)
+    label = label or getattr(tracker, "name", type(matcher).__name__)
     dataset = dataset or scenario.name
     the_map = map if map is not None else map_for(scenario, scans[0], {})
-    laser = scenario.laser
     start = scans[0].initial
-    if not is_tracker(matcher):
-        where = f"{scenario.scans_path}:{scans[0].line}"
-        try:  # untimed: map-only structures and numba kernels, as the runner's warm-up
-            problem = Problem(the_map, laser, scans[0].ranges, start, where=where)
-            warm(matcher, problem)
-            matcher.localize(problem)
-        except Exception:  # noqa: BLE001 - the timed steps report what is wrong
-            pass
-    tracker = as_tracker(matcher)
-    tracker.start(the_map, laser, start)
+    warm_tracker(tracker, the_map, scenario.laser, scans[0].ranges, start)
+    tracker.start(the_map, scenario.laser, start)
     rows = []
-    last = start
     for k, (scan, delta) in enumerate(zip(scans, odom_deltas(scans), strict=True)):
-        pred = last.compose(delta)
+        pred = tracker.predict(delta)
         where = f"{scenario.scans_path}:{scan.line}"
-        info: dict[str, Any] = {}
-        est: Estimate | None = None
-        t0, c0 = time.perf_counter(), time.process_time()
         try:
-            est = (tracker.step(scan.ranges, delta, scan.stamp, where=where)
-                   if isinstance(tracker, LocalTracker) else tracker.step(scan.ranges, delta, scan.stamp))
-            status = FAILED if est.info.get("status") == PREDICTED else OK
-            pose = est.pose if est.pose.is_finite() else pred
-            info = dict(est.info)
-        except InvalidProblemError as exc:
-            status, pose, info = FAILED, pred, {"status": PREDICTED, "reason": str(exc)[:200]}
-        except Exception as exc:  # noqa: BLE001 - a raising matcher is a result; the run goes on
+            t = timed_step(tracker, scan.ranges, delta, scan.stamp, where)
+            est, status, info = t.estimate, status_of(t.estimate), dict(t.estimate.info)
+            pose, wall_s, cpu_s = est.pose, t.wall_s, t.cpu_s
+            if not pose.is_finite():
+                pose = pred
+                tracker.reset(pred)
+        except Exception as exc:  # noqa: BLE001 - a raising tracker is a result; the run goes on
+            est, info, pose, wall_s, cpu_s = None, {}, pred, "", ""
             status = f"error:{type(exc).__name__}: {exc}".replace("\n", " ")[:300]
-            pose = pred
-        cpu, wall = time.process_time() - c0, time.perf_counter() - t0
-        if pose is pred and hasattr(tracker, "reset"):
             tracker.reset(pred)
-        rows.append(row(dataset, label, scan, pred, pose, status, cpu, wall, est, info))
-        last = pose
+        row = result_row(dataset, label, scan.scan_id, scan.group, true=scan.true, init=pred, est=pose,
+                         estimate=est, status=status, wall_s=wall_s, cpu_s=cpu_s, info=info)
+        if thresholds is not None and scan.true is not None:
+            row["outcome"] = outcome(status == "ok", row["dist_err_m"], row["orient_err_rad"],
+                                     math.nan, math.nan, thresholds)
+        rows.append(row)
         if progress is not None:
             progress(k)
     return rows
@@ -128,15 +100,16 @@ def dead_reckoning(scenario: Scenario, scans: Sequence[Scan], *, label: str = De
     return track(scenario, scans, DeadReckoning(), label=label, dataset=dataset)
 
 
-def run_sequence(dataset: str, label: str, matcher: str, params_json: str = "{}") -> list[dict[str, Any]]:
+def run_sequence(dataset: str, label: str, matcher: str, params_json: str = "{}",
+                 thresholds: Thresholds | None = None) -> list[dict[str, Any]]:
     """One sequence task of a run, as a worker executes it: the dataset ``dataset`` (a directory)
     and the matcher ``matcher`` with ``params_json`` from the worker's workspace, the whole
     sequence tracked; the rows carry ``label`` as their matcher. Dataset errors raise
-    :class:`DatasetError`; a matcher that raises on a scan is that scan's ``error:`` row, the
+    :class:`DatasetError`; a tracker that raises on a scan is that scan's ``error:`` row, the
     run goes on."""
     from .workspace import load_dataset, load_matcher, map_of
 
     scenario, by_id = load_dataset(dataset)
     scans = list(by_id.values())
     return track(scenario, scans, load_matcher(matcher, params_json), label=label,
-                 map=map_of(scenario, scans[0]) if scans else None)
+                 map=map_of(scenario, scans[0]) if scans else None, thresholds=thresholds)

@@ -6,12 +6,14 @@ how it runs one matcher on one problem.
   (:func:`tfloc.core.matcher.get_matcher`, registered names and ``module:Class`` alike);
 * :func:`problem_of` — the :class:`~tfloc.core.problem.Problem` of a scan (the dataset's map,
   loaded once, or the scan's reference scan);
-* :func:`warm` — the untimed warm-up before a matcher's first timed call on a map;
-* :func:`timed_localize` — one ``localize`` call timed by CPU time (``time.process_time``: this
-  process, all its threads; workers run every library on one thread) and wall time.
+* :func:`warm` / :func:`warm_tracker` — the untimed warm-up before a matcher's first timed call
+  on a map, or a tracker's first timed step;
+* :func:`timed` — the one timer: a call timed by CPU time (``time.process_time``: this process,
+  all its threads; workers run every library on one thread) and wall time;
+  :func:`timed_localize` and :func:`timed_step` time a ``localize`` and a tracker's ``step``.
 
-The runner's tasks, the timing pass, the report's pictures, ``tfloc localize`` and the scripts
-all use these, so a scan is posed, warmed and timed the same way everywhere.
+The runner's tasks, the tracking loop, the timing pass, the report's pictures and ``tfloc
+localize`` all use these, so a scan is posed, warmed and timed the same way everywhere.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from functools import lru_cache
 
 from tfloc.core.matcher import Matcher, get_matcher
 from tfloc.core.problem import Estimate, Problem
+from tfloc.core.tracker import Tracker, kept_prediction
 from tfloc.io.scenario import Scan, Scenario, map_for, read_scans, read_scenario
 
 _MAPS: dict = {}
@@ -72,6 +75,18 @@ def warm(matcher: Matcher, problem: Problem) -> None:
         matcher.score(problem, problem.initial)
 
 
+def warm_tracker(tracker: Tracker, map_, laser, ranges, pose) -> None:
+    """Untimed warm-up of a tracker before ``start``: its ``warm`` if it has one (errors are
+    left to the timed steps to report)."""
+    warm_ = getattr(tracker, "warm", None)
+    if warm_ is None:
+        return
+    try:
+        warm_(map_, laser, ranges, pose)
+    except Exception:  # noqa: BLE001 - the timed steps report what is wrong
+        pass
+
+
 @dataclass(frozen=True)
 class Timed:
     """One timed call: the estimate, its wall time and its CPU time (seconds)."""
@@ -81,14 +96,25 @@ class Timed:
     cpu_s: float
 
 
-def timed_localize(matcher: Matcher, problem: Problem) -> Timed:
-    """``matcher.localize(problem)`` timed by wall and CPU time (exceptions propagate)."""
+def timed(call, *args, **kwargs) -> Timed:
+    """``call(*args, **kwargs)`` (an :class:`Estimate`) timed by wall and CPU time; exceptions
+    propagate."""
     t0, c0 = time.perf_counter(), time.process_time()
-    est = matcher.localize(problem)
+    est = call(*args, **kwargs)
     return Timed(est, time.perf_counter() - t0, time.process_time() - c0)
 
 
+def timed_localize(matcher: Matcher, problem: Problem) -> Timed:
+    """``matcher.localize(problem)``, timed."""
+    return timed(matcher.localize, problem)
+
+
+def timed_step(tracker: Tracker, ranges, odom_delta, stamp: float, where: str) -> Timed:
+    """One tracker step, timed."""
+    return timed(tracker.step, ranges, odom_delta, stamp, where=where)
+
+
 def status_of(est: Estimate) -> str:
-    """``failed`` when the matcher declined to answer (``info["status"] == "no-answer"``) or gave a
-    non-finite pose, else ``ok``; whether it converged is reported separately."""
-    return "failed" if est.info.get("status") == "no-answer" or not est.pose.is_finite() else "ok"
+    """``failed`` when the matcher declined (:attr:`Estimate.declined`) or a tracker kept its
+    prediction, else ``ok``; whether it converged is reported separately."""
+    return "failed" if est.declined or kept_prediction(est) else "ok"

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import csv
 import errno
+import json
 import os
 from pathlib import Path
 from typing import Any
@@ -43,6 +44,31 @@ def pose_fields(prefix: str, pose) -> dict[str, Any]:
     if pose is None:
         return {f"{prefix}_x": "", f"{prefix}_y": "", f"{prefix}_theta": ""}
     return {f"{prefix}_x": pose.x, f"{prefix}_y": pose.y, f"{prefix}_theta": pose.theta}
+
+
+def result_row(dataset: str, matcher: str, scan_id: str, group: str = "", *, true=None, init=None,
+               est=None, estimate=None, status: str = "", wall_s: float | str = "", cpu_s: float | str = "",
+               info: dict | None = None) -> dict[str, Any]:
+    """The one builder of a result row (:data:`COLUMNS`): identity, the true, initial and
+    estimated poses (:class:`~tfloc.core.pose.Pose` or ``None``), their errors where the truth
+    is known (:meth:`~tfloc.core.pose.Pose.error_to`), the times (seconds), the estimate's
+    counters (an :class:`~tfloc.core.problem.Estimate`, if any), ``status`` and ``info`` (as
+    JSON). ``outcome`` and ``score_*`` are the caller's (they need the thresholds and the
+    matcher)."""
+    row = {c: "" for c in COLUMNS}
+    row.update(dataset=dataset, scan_id=scan_id, group=group, matcher=matcher, status=status,
+               runtime_s=wall_s, cpu_s=cpu_s, **pose_fields("true", true), **pose_fields("init", init),
+               **pose_fields("est", est))
+    if true is not None and init is not None:
+        row["init_dist_err_m"], row["init_orient_err_rad"] = init.error_to(true)
+    if true is not None and est is not None:
+        row["dist_err_m"], row["orient_err_rad"] = est.error_to(true)
+    if estimate is not None:
+        row.update(converged=int(bool(estimate.converged)), iterations=estimate.iterations,
+                   evaluations=estimate.evaluations)
+    if info is not None:
+        row["info"] = json.dumps(info, default=str, separators=(",", ":"))
+    return row
 
 
 def status_kind(status: str) -> str | None:

@@ -28,11 +28,11 @@ def find_lock() -> Path | None:
 
 
 def read_lock(path: Path, python: str | None = None) -> dict[str, str]:
-    """Canonical package name → locked version for Python ``python`` (``"3.11.7"``; ``None``:
-    markers that name the Python version are not evaluated, the first pin of a name wins).
+    """Canonical package name → locked version for Python ``python`` (``"3.11.7"``; ``None`` or
+    anything but a version: markers are not evaluated, the first pin of a name wins).
     A line that is neither a pin, a hash, a comment nor blank is a ``ConfigError`` naming it."""
     env = None
-    if python:
+    if isinstance(python, str) and re.fullmatch(r"\d+\.\d+(\.\d+)?", python):
         major_minor = ".".join(python.split(".")[:2])
         env = {"python_version": major_minor, "python_full_version": python}
     out: dict[str, str] = {}

@@ -29,7 +29,7 @@ from tfloc.core.thresholds import Thresholds
 from tfloc.errors import ResultsError, TflocError
 
 from .estimates import REQUIRED, read_estimates, sync_dir
-from .scenario import SCAN_TO_SCAN, SINGLE, read_scenario
+from .scenario import SINGLE, read_scenario
 from .text import parse_text
 
 RUN_JSON = "run.json"
@@ -37,6 +37,7 @@ ESTIMATES = "estimates.csv"
 
 #: the run.json fields a reader relies on, and what each must be
 _FIELDS = {"config": dict, "git": dict, "machine": dict, "versions": dict, "datasets": dict, "sessions": list,
+           "declared": dict,
            "config.success": dict, "config.matchers": list, "git.commit": (str, type(None)),
            "git.dirty": (bool, type(None)), "config.name": str}
 
@@ -112,17 +113,32 @@ class RunInfo:
     def fingerprint(self) -> dict | None:
         return self.doc.get("fingerprint")
 
-    def mode(self, dataset: str) -> str:
-        """The mode of a dataset of the run (:data:`tfloc.io.scenario.MODES`), from its
-        ``scenario.json``; a dataset no longer on disk is ``scan-to-scan`` if its name says
-        ``relations``, else ``single``."""
+    def declared(self, dataset: str) -> dict:
+        """What a dataset of the run declares in its ``scenario.json`` (``mode``,
+        ``paper_scenarios``): read from the dataset if it is on disk, else as the run recorded
+        it (``run.json``'s ``declared``); ``{}`` if neither knows."""
         path = self.datasets.get(dataset)
         try:
             if path is not None:
-                return read_scenario(path).mode
+                sc = read_scenario(path)
+                return {"mode": sc.mode, "paper_scenarios": list(sc.paper_scenarios)}
         except TflocError:
             pass
-        return SCAN_TO_SCAN if "relations" in dataset else SINGLE
+        return dict(self.doc.get("declared", {}).get(dataset, {}))
+
+    def mode(self, dataset: str) -> str:
+        """The mode of a dataset of the run (:data:`tfloc.io.scenario.MODES`; ``single`` when
+        nothing says otherwise)."""
+        return str(self.declared(dataset).get("mode", SINGLE))
+
+    def paper_scenarios(self) -> dict[str, tuple[str, ...]]:
+        """Dataset → the paper scenarios it declares (datasets that declare none left out)."""
+        out = {}
+        for name in self.datasets:
+            got = tuple(self.declared(name).get("paper_scenarios", ()))
+            if got:
+                out[name] = got
+        return out
 
     def datasets_in(self, names: list[str], mode: str) -> set[str]:
         """Which of ``names`` are datasets of ``mode``."""

@@ -81,6 +81,25 @@ class Scenario:
             return SCAN_TO_SCAN
         return str(self.extra.get("mode", SINGLE))
 
+    @property
+    def paper_scenarios(self) -> tuple[str, ...]:
+        """The paper scenarios the dataset declares it poses (:func:`paper_scenarios_of`)."""
+        return paper_scenarios_of(self.extra, str(self.root / "scenario.json"))
+
+
+PAPER_SCENARIOS = ("I", "II", "III")
+
+
+def paper_scenarios_of(extra: dict, where: str = "scenario.json") -> tuple[str, ...]:
+    """The paper scenarios (Section 5) a dataset declares it poses (``"paper_scenarios"``):
+    ``I`` (its scans are one sample of Scenario I), ``II`` (binned by initial angle offset),
+    ``III`` (binned by initial distance offset); ``()`` for every other dataset."""
+    got = extra.get("paper_scenarios", [])
+    if not isinstance(got, list) or not set(got) <= set(PAPER_SCENARIOS):
+        raise DatasetError(f"{where}: field 'paper_scenarios' must be a list of {', '.join(PAPER_SCENARIOS)}, "
+                           f"got {got!r:.60}")
+    return tuple(got)
+
 
 def read_scenario(root: str | Path) -> Scenario:
     """Read and validate ``root/scenario.json``."""
@@ -111,6 +130,7 @@ def read_scenario(root: str | Path) -> Scenario:
     if laser.fov / laser.resolution > MAX_BEAMS:
         raise DatasetError(f"{path}: laser resolution_deg is too fine: more than {MAX_BEAMS} beams")
     extra = {k: v for k, v in doc.items() if k not in ("name", "map", "laser", "description")}
+    paper_scenarios_of(extra, str(path))
     if extra.get("mode", SINGLE) not in MODES:
         raise DatasetError(f"{path}: field 'mode' must be one of {', '.join(MODES)}, got {extra['mode']!r:.40}")
     try:

@@ -64,8 +64,9 @@ class RecoveringTracker(LocalTracker):
         return self.matcher
 
     def prepare(self, problem: Problem) -> None:
-        """Map-only work of both matchers (``tf-global``'s place index), untimed: call it before
-        the sequence, else the first relocalization builds the index inside a timed step."""
+        """Map-only work of both matchers (``tf-global``'s place index), untimed (``warm`` calls
+        it before the sequence; else the first relocalization builds the index inside a timed
+        step)."""
         for m in (self.local, self.global_):
             prepare = getattr(m, "prepare", None)
             if prepare is not None and (problem.initial is not None or m is self.global_):
@@ -78,14 +79,15 @@ class RecoveringTracker(LocalTracker):
     def step(self, ranges, odom_delta: Pose, stamp: float, where: str = "scan") -> Estimate:
         cfg = self.config
         problem, est = self.answer(ranges, self.predict(odom_delta), where)
-        score = float(self.local.score(problem, est.pose))
+        score = float(self.local.score(problem, est.pose)) if problem is not None else float("inf")
         self.bad = self.bad + 1 if not score <= cfg.lost_score else 0
         lost = self.bad >= cfg.lost_after
         relocalized = False
         if lost:
-            found = self.global_.localize(Problem(self._map, self._laser, ranges, None, where=where))
-            if found.info.get("status") != "no-answer" and found.pose.is_finite():
-                g_score = float(self.global_.score(problem, found.pose))
+            anywhere = Problem(self._map, self._laser, ranges, None, where=where)
+            found = self.global_.localize(anywhere)
+            if not found.declined:
+                g_score = float(self.global_.score(problem if problem is not None else anywhere, found.pose))
                 if g_score <= cfg.accept_score and g_score < score:
                     est = Estimate(found.pose, found.converged, found.iterations,
                                    est.evaluations + found.evaluations,
@@ -125,15 +127,10 @@ class TfPlusRecoverTracker(RecoveringTracker):
                          RecoveryConfig(cfg.lost_score, cfg.lost_after, cfg.accept_score))
         self.name, self.config = "tf-plus-recover", cfg   # (the rule's fields are its own)
 
-    def start(self, map: Map, laser: LaserSpec, pose: Pose) -> None:
-        """Begin at ``pose``. The map-only work (``tf-global``'s place index, ``tf-plus``'s map
-        view and compiled kernels) is done here, before the harness times any step, on a scan
-        ray-cast in the map from ``pose`` (the start the tracker is given; never the truth)."""
-        super().start(map, laser, pose)
-        ranges = map.raycast(pose, laser)
-        self.prepare(Problem(map, laser, ranges, pose))
+    def warm(self, map: Map, laser: LaserSpec, ranges, pose: Pose) -> None:
+        """Untimed, before the sequence: the map-only work of both matchers (``tf-global``'s
+        place index, ``tf-plus``'s map view) and ``tf-plus``'s compiled kernels, on the first
+        scan from the start pose (never the truth)."""
+        super().warm(map, laser, ranges, pose)
         self.prepare(Problem(map, laser, ranges, None))
-        warm = Problem(map, laser, ranges, pose)
-        self.local.score(warm, pose)
-        self.local.localize(warm)
 

@@ -7,15 +7,16 @@ plot for it (e.g. no ground truth, no paper scenario datasets).
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from tfloc.evaluation.outcome import OUTCOMES, Thresholds
+from tfloc.core.thresholds import Thresholds
+from tfloc.evaluation.outcome import OUTCOMES
 from tfloc.evaluation.paper import PAPER_TF
-from tfloc.evaluation.summary import POOL, SCENARIO_I
 
 OUTCOME_COLOURS = {"success": "#2ca02c", "local-optimum": "#ff7f0e", "ambiguous": "#d62728",
                    "no-answer": "#7f7f7f"}
@@ -93,9 +94,9 @@ def fig_scenarios(sc: pd.DataFrame, path: Path) -> Path | None:
     return _save(fig, path)
 
 
-def _families(p: pd.DataFrame, scan_to_scan: set[str]) -> list[tuple[str, pd.DataFrame]]:
+def _families(p: pd.DataFrame, scan_to_scan: set[str], paper_datasets: Iterable[str] = ()) -> list[tuple[str, pd.DataFrame]]:
     t = p[p["truth"] & ~p["dataset"].isin(scan_to_scan)]
-    paper = t[t["dataset"].isin([*SCENARIO_I, POOL])]
+    paper = t[t["dataset"].isin(list(paper_datasets))]
     out = [("synthetic: " + ", ".join(sorted(paper["dataset"].unique())), paper)] if len(paper) else []
     for d in sorted(set(t["dataset"]) - set(paper["dataset"])):
         out.append((d, t[t["dataset"] == d]))
@@ -110,9 +111,11 @@ def _rate_curve(g: pd.DataFrame, values: pd.Series, width: float) -> tuple[np.nd
     return (keys + 0.5) * width, rate
 
 
-def fig_basin(p: pd.DataFrame, path: Path, scan_to_scan: set[str] = frozenset()) -> Path | None:
-    """Convergence basin: success rate against initial distance and angle offset, per matcher."""
-    fams = _families(p, scan_to_scan)
+def fig_basin(p: pd.DataFrame, path: Path, scan_to_scan: set[str] = frozenset(),
+              paper_datasets: Iterable[str] = ()) -> Path | None:
+    """Convergence basin: success rate against initial distance and angle offset, per matcher
+    (the datasets of the paper's scenarios pooled in one panel row)."""
+    fams = _families(p, scan_to_scan, paper_datasets)
     if not fams:
         return None
     col = colours(list(p["matcher"].unique()))

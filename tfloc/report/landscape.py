@@ -44,17 +44,21 @@ class LandscapeStats:
     far_rank_correlation: float
 
 
-def _pick(p: pd.DataFrame) -> pd.DataFrame:
+def _pick(p: pd.DataFrame, binned: list[str]) -> pd.DataFrame:
+    """One ``tf`` scan of each cell of :data:`CELLS` from the datasets the paper's Scenarios II
+    and III bin (``binned``), else the first three ``tf`` scans with truth."""
     rows = p[(p["matcher"] == MATCHER) & p["truth"]]
-    pool = rows[(rows["dataset"] == "office-pool") & rows["group"].isin(CELLS)]
+    pool = rows[rows["dataset"].isin(binned) & rows["group"].isin(CELLS)]
     chosen = pool.groupby("group", sort=True).head(1) if len(pool) else rows.head(3)
     return chosen.head(3)
 
 
-def draw_landscapes(run_dir: Path, p: pd.DataFrame, datasets: dict[str, Path]) -> tuple[Path | None, list[LandscapeStats]]:
+def draw_landscapes(run_dir: Path, p: pd.DataFrame, datasets: dict[str, Path],
+                    binned: list[str] = ()) -> tuple[Path | None, list[LandscapeStats]]:
     """Compute and draw the landscapes of :func:`_pick`'s scans; ``datasets`` maps dataset names to
-    directories (``run.json``). Returns the figure (relative to ``run_dir``) and the statistics."""
-    chosen = _pick(p)
+    directories (``run.json``), ``binned`` names the datasets of Scenarios II/III. Returns the
+    figure (relative to ``run_dir``) and the statistics."""
+    chosen = _pick(p, list(binned))
     if chosen.empty:
         return None, []
     panels, stats = [], []

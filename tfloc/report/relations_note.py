@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 
 from tfloc.core.pose import angdiff
-from tfloc.evaluation.outcome import Thresholds
+from tfloc.core.thresholds import Thresholds
 from tfloc.evaluation.relations import relation_stats
 from tfloc.evaluation.stats import wilson
 from tfloc.io.estimates import read_estimates

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from tfloc.evaluation.outcome import Thresholds
+from tfloc.core.thresholds import Thresholds
 from tfloc.evaluation.relocalization import free_area_m2, result_from_row, summarize
 
 from .mdtable import num

@@ -16,13 +16,12 @@ from pathlib import Path
 
 import pandas as pd
 
+from tfloc.core.thresholds import Thresholds
 from tfloc.evaluation.metrics import prepare, summarize
-from tfloc.evaluation.outcome import Thresholds
 from tfloc.evaluation.paired import ALPHA, paired_table
 from tfloc.evaluation.paper import CITATION
 from tfloc.evaluation.summary import (
-    POOL,
-    SCENARIO_I,
+    declaring,
     scenario_summary,
     summary_table,
     write_summary,
@@ -139,7 +138,14 @@ def contention(p: pd.DataFrame) -> list[str]:
             "re-timing: `tfloc timing RUN` (timing.md)."]
 
 
-def definitions(thr: Thresholds) -> str:
+def _scenario_definition(paper: dict) -> str:
+    """Which datasets of the run pose the paper's scenarios (as their ``scenario.json`` declare)."""
+    one, two, three = (", ".join(declaring(paper, k)) or "none in this run" for k in ("I", "II", "III"))
+    return (f"I = datasets {one}; II = {two} by initial angle offset; III = {three} by initial "
+            "distance offset (as each dataset's `scenario.json` declares, `paper_scenarios`)")
+
+
+def definitions(thr: Thresholds, paper: dict | None = None) -> str:
     """How every number of the report is defined."""
     return f"""## Definitions
 
@@ -178,8 +184,7 @@ def definitions(thr: Thresholds) -> str:
 - **Bins** come from the true and initial poses (not from group labels): initial distance offset
   [0, 100), [100, 200), [200, 300), [300, ∞) cm; initial angle offset [0, 5), [5, 10), [10, 15),
   [15, ∞) degrees. Left edge included: an offset of exactly 100 cm is in 100–200.
-- **Scenarios** (the paper's Section 5): I = datasets {', '.join(SCENARIO_I)}; II = {POOL} by
-  initial angle offset; III = {POOL} by initial distance offset.
+- **Scenarios** (the paper's Section 5): {_scenario_definition(paper or {})}.
 - Published values: {CITATION}. The paper's tables give no success rates, medians or runtimes.
 """
 
@@ -225,12 +230,14 @@ def _paired_section(pt: pd.DataFrame, sweep: bool) -> list[str]:
 
 def render(run_dir: Path, run: dict, p: pd.DataFrame, thr: Thresholds, s2s: set[str],
            figs: list[Path], pt: pd.DataFrame | None = None, failures: str = "", landscape: str = "",
-           line_labels: list[str] | None = None, sweep: bool = False) -> str:
+           line_labels: list[str] | None = None, sweep: bool = False, paper: dict | None = None) -> str:
     """The whole report.md text (``sweep``: a parameter sweep, see :data:`MANY_MATCHERS`;
-    ``line_labels``: the labels its line figures show)."""
-    parts = [header(run_dir, run, p, thr, s2s), definitions(thr)]
+    ``line_labels``: the labels its line figures show; ``paper``: dataset → the paper scenarios
+    it declares)."""
+    paper = paper or {}
+    parts = [header(run_dir, run, p, thr, s2s), definitions(thr, paper)]
     truth = p[p["truth"]]
-    sc = scenario_summary(truth)
+    sc = scenario_summary(truth, paper)
     if not truth.empty and len(sc):
         parts.append("## The paper's Tables 2–4: published tf against tfloc's tf\n")
         parts.append(S.paper_vs_tf(sc))
@@ -240,8 +247,8 @@ def render(run_dir: Path, run: dict, p: pd.DataFrame, thr: Thresholds, s2s: set[
         parts.append("## Scoring\n\n_No scan in this run has ground truth: accuracy, success and outcome "
                      "sections are skipped; only runtimes are reported._\n")
     else:
-        parts.append("_None of the paper's scenario datasets (detail-1/2/3, office-pool) is in this run: "
-                     "the paper's tables are not shown._\n")
+        parts.append("_No dataset of this run declares one of the paper's scenarios (`paper_scenarios` "
+                     "in its `scenario.json`): the paper's tables are not shown._\n")
     parts.append("## Results per dataset\n")
     parts += [_dataset_section(p, d, s2s) for d in p["dataset"].unique()]
     s2m = truth[~truth["dataset"].isin(s2s)]
@@ -345,7 +352,8 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
         return ReportFiles(report, run_dir / ("tracking.csv" if seq else "relocalization.csv"), ())
     p = prepare(df[~df["dataset"].isin(seq | glob)], thr)
     s2s = info.datasets_in(list(p["dataset"].unique()), SCAN_TO_SCAN)
-    summary = write_summary(summary_table(p, s2s), run_dir / "summary.csv")
+    paper = {d: s for d, s in info.paper_scenarios().items() if d in set(p["dataset"])}
+    summary = write_summary(summary_table(p, s2s, paper), run_dir / "summary.csv")
     order = label_order(run, p)
     sweep = len(order) > MANY_MATCHERS  # a parameter sweep: compare each label with the first only
     pt = paired_table(p, s2s, reference=order[0] if sweep else None)
@@ -356,15 +364,16 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
     if with_figures:
         fd = run_dir / "figures"
         lines = p[p["matcher"].isin(line_labels)] if line_labels else p
-        sc = scenario_summary(lines[lines["truth"]])
+        sc = scenario_summary(lines[lines["truth"]], paper)
         made = [F.fig_scenarios(sc, fd / "scenario_errors.png") if len(sc) else None,
-                F.fig_basin(lines, fd / "basin.png", s2s), F.fig_cdf(lines, fd / "error_cdf.png", thr),
+                F.fig_basin(lines, fd / "basin.png", s2s, paper), F.fig_cdf(lines, fd / "error_cdf.png", thr),
                 F.fig_runtime(p, fd / "runtime.png"), F.fig_outcomes(p, fd / "outcomes.png", s2s)]
         figs = [f for f in made if f is not None]
         drawn = p[p["matcher"] == order[0]] if sweep else p
         failures = failures_section(draw_failures(run_dir, drawn, info.datasets))
-        landscape = landscape_section(*draw_landscapes(run_dir, p, info.datasets))
+        binned = sorted(set(declaring(paper, "II")) | set(declaring(paper, "III")))
+        landscape = landscape_section(*draw_landscapes(run_dir, p, info.datasets, binned))
     report = run_dir / "report.md"
-    text = render(run_dir, run, p, thr, s2s, figs, pt, failures, landscape, line_labels, sweep)
+    text = render(run_dir, run, p, thr, s2s, figs, pt, failures, landscape, line_labels, sweep, paper)
     report.write_text(text + ("\n" + tracking if tracking else ""))
     return ReportFiles(report, summary, tuple(figs))

@@ -15,9 +15,15 @@ from tfloc.evaluation.paper import PAPER_TF, TABLE_OF, paper_row
 
 from .mdtable import num, pm, table
 
-TITLES = {"I": "environmental detail (datasets detail-1/2/3)",
-          "II": "initial angle offset (office-pool binned by angle_bin)",
-          "III": "initial distance offset (office-pool binned by dist_bin)"}
+TITLES = {"I": "environmental detail (one sample per dataset)",
+          "II": "initial angle offset (binned by angle_bin)",
+          "III": "initial distance offset (binned by dist_bin)"}
+
+
+def _title(sc: pd.DataFrame, scenario: str) -> str:
+    """The scenario's title and the datasets its rows come from."""
+    names = sorted({n for d in sc.loc[sc["scenario"] == scenario, "dataset"] for n in str(d).split("+")})
+    return f"{TITLES[scenario]}; datasets: {', '.join(names)}"
 UNIT = {"I": "", "II": "°", "III": " cm"}
 PAPER_COLS = ["Mean Distance Error (cm)", "Mean Orientation Error (°)",
               "Distance Improvement (%)", "Orientation Improvement (%)"]
@@ -82,7 +88,7 @@ def paper_vs_tf(sc: pd.DataFrame, matcher: str = "tf") -> str:
     """Tables 2–4 as in the paper, the published row above the measured ``matcher`` row."""
     out = []
     for scenario, samples in _scenarios(sc):
-        out.append(f"### Table {TABLE_OF[scenario]} — Scenario {scenario}: {TITLES[scenario]}\n")
+        out.append(f"### Table {TABLE_OF[scenario]} — Scenario {scenario}: {_title(sc, scenario)}\n")
         mine = sc[(sc["scenario"] == scenario) & (sc["matcher"] == matcher)].set_index("sample")
         if mine.empty:
             out.append(f"_Matcher `{matcher}` is not in this run: only the published values are shown._\n")

@@ -25,9 +25,9 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
+from tfloc.core.thresholds import Thresholds
 from tfloc.core.tracker import DeadReckoning
 from tfloc.evaluation.kidnap import WITHIN, median_scans, score_kidnaps
-from tfloc.evaluation.outcome import Thresholds
 from tfloc.evaluation.trajectory import LOST_DIST_M, errors, path_length, pooled_share, score_rows
 from tfloc.io.scenario import Scenario
 
