@@ -46,7 +46,7 @@ print(json.dumps(out))
     ("cv-corners", "cv2", "o3d-icp"),
     ("gicp", "small_gicp", "csm-corr"),
     ("karto", "karto_scanmatcher", "o3d-icp"),   # as on Python ≥ 3.12, where it has no wheel
-    ("amcl", "amcl", "csm-corr"),                # an optional extra (GPL-3.0)
+    ("amcl-wheel", "amcl", "csm-corr"),          # an optional extra (GPL-3.0)
 ])
 def test_missing_library_is_a_clear_matcher_error(name: str, module: str, other: str) -> None:
     code = _SCRIPT.format(module=module, tests=str(ROOT / "tests"), name=name, other=other)
@@ -61,7 +61,7 @@ def test_missing_library_is_a_clear_matcher_error(name: str, module: str, other:
     if name == "karto":  # the one line says why
         assert "tfloc[karto]" in out["missing"] and "Python 3.8-3.11 only" in out["missing"]
         assert "\n" not in out["missing"]
-    if name == "amcl":
+    if name == "amcl-wheel":
         assert "tfloc[amcl]" in out["missing"] and "\n" not in out["missing"]
 
 

@@ -1,4 +1,5 @@
-"""``amcl``: AMCL (Nav2's adaptive Monte Carlo localization) as a tracker, through the ``amcl`` wheel.
+"""``amcl-wheel``: AMCL (Nav2's adaptive Monte Carlo localization) as a tracker, through the ``amcl``
+wheel: the fidelity reference of the ``amcl`` port (:mod:`tfloc.baselines.amcl`).
 
 The ``amcl`` 0.1.2 wheel on PyPI ("AMCL Python Bindings", GPL-3.0, nanobind) compiles Nav2's
 ``nav2_amcl`` particle filter (``pf.c``, KLD sampling, the differential/omni motion models, the
@@ -9,7 +10,7 @@ sigma_hit, lambda_short, chi_outlier, max_beams), robot_model_type)``, ``set_map
 ``get_pose_mean``/``get_pose_covariance``. Nothing of AMCL is rewritten here; this module does what
 Nav2's ``amcl_node`` does around the filter. What the wheel does and does not do (read from its
 signatures and its compiled code; measured in ``tests/test_baselines_amcl.py``), and each
-departure from Nav2's defaults, is in ``docs/baselines/amcl.md``. In short:
+departure from Nav2's defaults, is in ``docs/baselines/amcl-wheel.md``. In short:
 
 * **The sensor model is the beam model**: the wheel builds ``BeamModel`` in ``set_map`` whatever
   the parameters; it has no likelihood field (no ``laser_likelihood_max_dist``, no distance map).
@@ -120,7 +121,7 @@ def _pdf_seed_counter() -> ctypes.c_int | None:
     """The wheel's ``pf_pdf_gaussian_alloc`` seed counter (``srand48(++counter)`` before it draws
     the initial particles; process-wide, so a spread start would depend on how many filters the
     process built before), or None for a build we do not know (then only a zero-covariance start,
-    the default, is reproducible: ``AmclTracker.reproducible``)."""
+    the default, is reproducible: ``AmclWheelTracker.reproducible``)."""
     path = Path(_amcl_impl.__file__)
     known = _KNOWN_BUILDS.get(hashlib.sha256(path.read_bytes()).hexdigest())
     if known is None:
@@ -152,11 +153,11 @@ def _vec(p: Pose):  # noqa: ANN202 - an amcl.Vector3D
     return _amcl.Vector3D(float(p.x), float(p.y), float(p.theta))
 
 
-class AmclTracker:
+class AmclWheelTracker:
     """Nav2's AMCL run scan by scan (the :class:`~tfloc.core.tracker.Tracker` protocol); no
-    single-scan mode (no ``localize``). See the module docstring and ``docs/baselines/amcl.md``."""
+    single-scan mode (no ``localize``). See the module docstring and ``docs/baselines/amcl-wheel.md``."""
 
-    name = "amcl"
+    name = "amcl-wheel"
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
         self.config = resolve_params(Config, config, overrides)
@@ -213,13 +214,13 @@ class AmclTracker:
         """Start the filter again at ``pose`` (the current scan's), as Nav2 does on an initial-pose
         message; the particles are drawn at the next step, carried by its odometry."""
         if self._filter is None:
-            raise RuntimeError("AmclTracker.reset before start")
+            raise RuntimeError("AmclWheelTracker.reset before start")
         self._init_at, self._odom_at_update, self._pose_at_update = (pose, self._odom), None, pose
 
     def predict(self, odom_delta: Pose) -> Pose:
         """The pose the next step starts from: the last estimate carried by the odometry."""
         if self._filter is None:
-            raise RuntimeError("AmclTracker.predict before start")
+            raise RuntimeError("AmclWheelTracker.predict before start")
         odom = self._odom.compose(odom_delta)
         if self._init_at is not None:
             pose, at = self._init_at
@@ -231,7 +232,7 @@ class AmclTracker:
         then when the odometry moved more than ``update_min_d`` along x or y or ``update_min_a``
         in heading since the last update); otherwise carry the last estimate by the odometry."""
         if self._filter is None:
-            raise RuntimeError("AmclTracker.step before start")
+            raise RuntimeError("AmclWheelTracker.step before start")
         self._odom = self._odom.compose(odom_delta)
         if self._init_at is not None:
             pose, odom = self._init_at
@@ -290,3 +291,9 @@ class AmclTracker:
         scan = _amcl.LaserScan(r.size, rmax)
         scan.ranges = np.column_stack((r, self._bearings)).tolist()
         return scan
+
+
+class AmclTracker(AmclWheelTracker):
+    """``amcl`` until the Nav2 port (:mod:`tfloc.baselines.amcl`) replaces it."""
+
+    name = "amcl"

@@ -1,4 +1,4 @@
-"""Tracker ``amcl``: does the ``amcl`` wheel behave like AMCL before we trust a number from it?
+"""Tracker ``amcl-wheel``: does the ``amcl`` wheel behave like AMCL before we trust a number from it?
 
 A straight run down the office-1 corridor (scans ray-cast in the map AMCL is given, exact
 odometry): from a start 0.4 m and 8.6° off with a spread cloud it converges to the truth, and the
@@ -23,7 +23,7 @@ from tfloc.errors import ParameterError
 
 pytest.importorskip("amcl")
 import amcl._amcl_impl  # noqa: E402
-from tfloc.baselines.amcl import AmclTracker, _pdf_seed_counter, amcl_grid  # noqa: E402
+from tfloc.baselines.amcl_wheel import AmclWheelTracker, _pdf_seed_counter, amcl_grid  # noqa: E402
 
 OFFICE = Path(__file__).resolve().parents[1] / "data" / "maps" / "office-1.geojson"
 LASER = LaserSpec.lms200()
@@ -37,12 +37,12 @@ def office():
     return read_vector_map(OFFICE)
 
 
-def track(vmap, truth: list[Pose], start: Pose, **params) -> tuple[np.ndarray, list, AmclTracker]:
+def track(vmap, truth: list[Pose], start: Pose, **params) -> tuple[np.ndarray, list, AmclWheelTracker]:
     """Run the tracker along ``truth`` (scans ray-cast in the grid AMCL gets, exact odometry);
     the position errors (m), the estimates and the tracker."""
     grid = amcl_grid(vmap)
     scans = grid.raycast(np.array([p.as_array() for p in truth]), LASER)
-    tracker = AmclTracker(**params)
+    tracker = AmclWheelTracker(**params)
     tracker.start(vmap, LASER, start)
     ests = [tracker.step(scans[k], truth[k - 1].between(p) if k else Pose(0.0, 0.0, 0.0), 0.2 * k)
             for k, p in enumerate(truth)]
@@ -55,8 +55,8 @@ def corridor(n: int = 170) -> list[Pose]:
 
 
 def test_registered_as_a_tracker_without_a_single_scan_mode() -> None:
-    tracker = tfloc.get_matcher("amcl")
-    assert isinstance(tracker, AmclTracker) and tracker.name == "amcl"
+    tracker = tfloc.get_matcher("amcl-wheel")
+    assert isinstance(tracker, AmclWheelTracker) and tracker.name == "amcl-wheel"
     assert is_tracker(tracker) and not has_single_scan_mode(tracker) and as_tracker(tracker) is tracker
     assert has_single_scan_mode(tfloc.get_matcher("tf-plus"))
 
@@ -68,7 +68,7 @@ def test_registered_as_a_tracker_without_a_single_scan_mode() -> None:
                                                                 "z_rand": 0.0}, {"no_such": 1}])
 def test_bad_parameters_are_refused(bad) -> None:
     with pytest.raises(ParameterError, match="amcl"):
-        tfloc.get_matcher("amcl", **bad)
+        tfloc.get_matcher("amcl-wheel", **bad)
 
 
 def test_the_wheel_runs_the_beam_model_not_the_likelihood_field() -> None:
@@ -110,7 +110,7 @@ def test_the_motion_model_is_the_odometry_model(office) -> None:
     ranges = office.raycast(start, LASER)
     spreads = []
     for seed in range(3):
-        tracker = AmclTracker(alpha1=0.3, alpha2=a2, alpha3=a3, alpha4=0.3, alpha5=0.3, z_hit=0.0, z_short=0.0,
+        tracker = AmclWheelTracker(alpha1=0.3, alpha2=a2, alpha3=a3, alpha4=0.3, alpha5=0.3, z_hit=0.0, z_short=0.0,
                               z_max=0.0, z_rand=1.0, seed=seed)
         tracker.start(office, LASER, start)
         tracker.step(ranges, Pose(0.0, 0.0, 0.0), 0.0)
@@ -159,7 +159,7 @@ def test_a_grid_map_is_used_as_given(office) -> None:
     _, on_vector, _ = track(office, truth, truth[0])
     grid = amcl_grid(office)
     assert grid.resolution == 0.05
-    tracker = AmclTracker()
+    tracker = AmclWheelTracker()
     tracker.start(grid, LASER, truth[0])
     scans = grid.raycast(np.array([p.as_array() for p in truth]), LASER)
     on_grid = [tracker.step(scans[k], truth[k - 1].between(p) if k else Pose(0.0, 0.0, 0.0), 0.2 * k)
@@ -174,7 +174,7 @@ def test_start_and_reset_are_carried_by_the_odometry(office) -> None:
     grid = amcl_grid(office)
     scans = grid.raycast(np.array([p.as_array() for p in truth]), LASER)
     before = Pose(0.8, 7.5, 0.0)  # 0.2 m behind the first scan's pose
-    tracker = AmclTracker()
+    tracker = AmclWheelTracker()
     tracker.start(office, LASER, before)
     first = tracker.step(scans[0], before.between(truth[0]), 0.0)
     assert first.info["updated"] and first.pose.distance_to(truth[0]) < 1e-9
