@@ -112,15 +112,11 @@ scaling: $(STAMP)
 scaling-quick: $(STAMP)
 	$(BIN)/python scripts/scaling.py --quick --out results/scaling-quick
 
-## tf-plus's per-stage ablation on the real logs, maps as built and thickened (results/tf-plus-ablation-real/; ~5 min quiet).
+## tf-plus's stages switched off in turn on the real logs, as-built and thickened grids, csm-corr
+## beside it → results/tf-plus-ablation-real/ (benchmarks/tfplus-ablation-real.toml; ~10 min).
 ablation-real: $(STAMP)
-	OMP_NUM_THREADS=1 $(BIN)/python scripts/tfplus_ablation_real.py --thicken 0 1 2 \
-		--out results/tf-plus-ablation-real/development
-	OMP_NUM_THREADS=1 $(BIN)/python scripts/tfplus_ablation_real.py --thicken 0 1 2 \
-		--datasets data/scenarios/real-aces-scan-to-map --out results/tf-plus-ablation-real/held-out-aces
-	OMP_NUM_THREADS=1 $(BIN)/python scripts/tfplus_ablation_real.py --matcher csm-corr --thicken 1 2 \
-		--datasets real-intel-scan-to-map real-csail-scan-to-map real-aces-scan-to-map \
-		--out results/tf-plus-ablation-real/csm-corr-thickened
+	$(BIN)/tfloc bench benchmarks/tfplus-ablation-real.toml --jobs $(JOBS) --regenerate
+	$(BIN)/tfloc report results/tf-plus-ablation-real
 
 ## Rebuild the real-log datasets and grid maps from data/real/ (deterministic).
 real-data: $(STAMP)

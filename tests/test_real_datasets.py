@@ -11,6 +11,7 @@ import pytest
 from _committed import assert_same_file
 
 from tfloc.core.pose import angdiff
+from tfloc.datasets import spacing
 from tfloc.datasets.real import (
     ACES_LASER,
     ACES_NO_RETURN_M,
@@ -28,18 +29,6 @@ DATA = ROOT / "data"
 SCEN = DATA / "scenarios"
 
 
-def _spacing_analysis():
-    """scripts/spacing.py: the analysis behind SPACING.md (a research script, not in the package)."""
-    import importlib.util
-    import sys
-
-    spec = importlib.util.spec_from_file_location("real_spacing", DATA.parent / "scripts" / "spacing.py")
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = mod  # dataclasses look their module up while the class is made
-    spec.loader.exec_module(mod)
-    return mod
-
-
 @pytest.mark.parametrize(("log_file", "no_return", "laser"), [
     ("intel/intel-corrected.log.gz", NO_RETURN_M, INTEL_LASER),
     ("aces/aces-corrected.log.gz", ACES_NO_RETURN_M, ACES_LASER),
@@ -49,7 +38,6 @@ def test_spacing_decision_recomputed_on_a_subset(log_file: str, no_return: float
     log = read_carmen(DATA / "real" / log_file)
     R = np.vstack([clean_ranges(s.ranges, no_return) for s in log.lasers[:300]])
     P = log.poses()[:300]
-    spacing = _spacing_analysis()
     scores = spacing.compare(R, P, spacing.intel_candidates(50.0))
     assert scores[0].label == "1deg-from-90"
     assert scores[0].laser == laser

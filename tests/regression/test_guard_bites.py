@@ -44,3 +44,23 @@ def test_compare_rules_on_a_hand_made_example():
     missing = guard.compare(ref.assign(group="other"), ref)
     assert missing.worse.all()                            # a group that vanished is a regression
     assert np.isclose(guard.RULES[0].allowed(90.0, 20), 85.0)
+
+
+def test_update_records_the_code_and_configuration_beside_the_reference(tmp_path):
+    """``tfloc guard --update`` writes the reference and the run.json of the run that made it."""
+    from tfloc.cli import main
+
+    os.chdir(ROOT)
+    cfg = tmp_path / "tiny.toml"
+    cfg.write_text('name = "tiny"\nout = "' + str(tmp_path / "run") + '"\n'
+                   'datasets = ["data/scenarios/office-pool"]\nmatchers = ["odometry"]\nlimit_per_group = 1\n')
+    ref = tmp_path / "ref" / "summary.csv"
+    ref.parent.mkdir()
+    assert main(["guard", "--config", str(cfg), "--reference", str(ref), "--no-tracking", "--update",
+                 "--jobs", "1"]) in (0, None)
+    record = ref.with_suffix(".run.json")
+    assert ref.exists() and record.exists()
+    import json
+
+    doc = json.loads(record.read_text())
+    assert doc["config"]["name"] == "tiny" and "commit" in doc["git"] and doc["versions"]["numpy"]

@@ -79,7 +79,9 @@ def _one(args: argparse.Namespace, config: Path, reference: Path, summarise, rul
             keep = old[~old.matcher.isin(current.matcher.unique())]
             current = pd.concat([keep, current]).sort_values(list(guard.KEY), ignore_index=True)
         guard.write_reference(current, reference)
-        print(f"updated {reference}:\n{guard.format_changes(old, current)}")
+        record = reference.with_suffix(".run.json")  # the code and configuration that made it
+        shutil.copyfile(Path(cfg.out) / "run.json", record)
+        print(f"updated {reference} (made as {record} records):\n{guard.format_changes(old, current)}")
         return None
     if not reference.exists():
         raise ConfigError(f"{reference}: no reference yet; create it with 'tfloc guard --update'")

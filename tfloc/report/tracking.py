@@ -17,6 +17,7 @@ matcher, and the distance error over distance travelled. Sets whose sequences ha
 
 from __future__ import annotations
 
+import json
 import math
 import re
 from pathlib import Path
@@ -28,7 +29,7 @@ from matplotlib.figure import Figure
 from tfloc.core.thresholds import Thresholds
 from tfloc.core.tracker import DeadReckoning
 from tfloc.evaluation.kidnap import WITHIN, median_scans, score_kidnaps
-from tfloc.evaluation.trajectory import LOST_DIST_M, errors, path_length, pooled_share, score_rows
+from tfloc.evaluation.trajectory import LOST_DIST_M, LOST_ORIENT_DEG, errors, path_length, pooled_share, score_rows
 from tfloc.io.scenario import Scenario
 
 from .mdtable import num, table
@@ -208,6 +209,30 @@ def fig_error_distance(scenario: Scenario, rows: pd.DataFrame, path: Path) -> Pa
     return path
 
 
+def own_score_table(df: pd.DataFrame, thresholds: Thresholds = DEFAULT) -> str:
+    """Where a tracker reports its own score per scan (``info["score"]``, lower is better, e.g.
+    ``tf-plus-recover``'s residual in metres): its percentiles over the scans it tracked (within
+    the thresholds) and over the scans it had lost (above 0.5 m or 10°), per matcher. The truth
+    is read here, to choose a tracker's own "lost" rule on a development split, never by it."""
+    rows = []
+    for m, g in df.groupby("matcher", sort=False):
+        score = g["info"].map(lambda t: json.loads(t or "{}").get("score", np.nan)).to_numpy(float)
+        if not np.isfinite(score).any():
+            continue
+        d, o = g["dist_err_m"].to_numpy(float), np.degrees(g["orient_err_rad"].to_numpy(float))
+        ok = thresholds.success(d, np.radians(o)) & np.isfinite(score)
+        lost = ((d > LOST_DIST_M) | (o > LOST_ORIENT_DEG)) & np.isfinite(score)
+        pct = lambda v, q: " / ".join(f"{x:.4f}" for x in np.percentile(v, q)) if v.size else "–"  # noqa: E731
+        rows.append([f"`{m}`", str(int(ok.sum())), pct(score[ok], [50, 90, 99, 100]),
+                     str(int(lost.sum())), pct(score[lost], [0, 1, 10, 50])])
+    if not rows:
+        return ""
+    return ("\n**The trackers' own scores** (`info.score`, lower is better): percentiles over the "
+            "scans tracked and over the scans lost, read against the truth\n\n"
+            + table(["matcher", "tracked scans", "score p50 / p90 / p99 / max", "lost scans",
+                     "score min / p1 / p10 / p50"], rows, "lrlrl") + "\n")
+
+
 def tracking_section(df: pd.DataFrame, datasets: dict[str, Scenario], maps: dict[str, object],
                      out_dir: Path, thresholds: Thresholds = DEFAULT,
                      figures: bool = True) -> str:
@@ -220,7 +245,7 @@ def tracking_section(df: pd.DataFrame, datasets: dict[str, Scenario], maps: dict
             f"{100 * thresholds.dist_m:.0f} cm and {thresholds.orient_deg:g}°; a loss = the error "
             "goes above 0.5 m or 10°; a recovery = back within the thresholds by itself; APE/RPE by "
             "evo with no alignment (map frame); `odometry` = dead reckoning, the floor.\n",
-            tracking_tables(s)]
+            tracking_tables(s), own_score_table(df, thresholds)]
     ev = kidnap_events(df, datasets, thresholds)
     if len(ev):
         ev.to_csv(Path(out_dir) / "kidnap.csv", index=False, float_format="%.6g")
