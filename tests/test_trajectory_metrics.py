@@ -77,3 +77,14 @@ def test_rows_without_truth_are_left_out():
 def test_errors_wrap_angles():
     d, o = errors(np.array([[0, 0, math.pi - 0.01]]), np.array([[0, 0, -math.pi + 0.01]]))
     assert o[0] == pytest.approx(0.02)
+
+
+def test_jumps_are_estimates_far_from_their_prediction():
+    t = np.column_stack([np.arange(10.0) * 0.3, np.zeros(10), np.zeros(10)])
+    e = t.copy()
+    e[4, 0] += 2.5                         # one scan lands 2.5 m off, the next comes back
+    pred = t.copy()
+    pred[5] = e[4]                         # ... so it starts 2.5 m off and jumps back
+    s = score_track(e, t, pred=pred)
+    assert s.jumps == 2 and s.max_jump_m == pytest.approx(2.5)
+    assert score_track(t, t, pred=t).jumps == 0 and np.isnan(score_track(t, t).max_jump_m)

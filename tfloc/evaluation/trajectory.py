@@ -19,6 +19,10 @@ localizer must be right in the map's frame.
   loop never resets it). A loss with no recovery by the last scan is **unrecovered**.
 * **longest lost stretch** (metres): the true distance travelled from a loss's first scan to its
   recovery scan (or to the last scan), the largest over the losses; 0 without a loss.
+* **jumps**: how far each estimate lies from the prediction it started from (``init_*``: the
+  last estimate carried by the odometry), every row, truth or not: the largest (metres) and how
+  many exceed :data:`JUMP_M` (1 m). A tracker that leaves a correct track for a wrong place, or
+  comes back, jumps.
 * **CPU ms per scan**: the median of the rows' ``cpu_s`` (every row, truth or not), milliseconds.
 """
 
@@ -33,6 +37,7 @@ from tfloc.core.pose import angdiff
 from tfloc.core.thresholds import Thresholds
 
 LOST_DIST_M, LOST_ORIENT_DEG = 0.5, 10.0
+JUMP_M = 1.0
 DEFAULT = Thresholds()
 
 
@@ -57,6 +62,8 @@ class TrackScore:
     rpe_trans_m_per_m: float
     rpe_rot_deg_per_m: float
     cpu_ms_median: float
+    max_jump_m: float = math.nan
+    jumps: int = 0
 
     def to_dict(self) -> dict[str, float]:
         return asdict(self)
@@ -149,16 +156,23 @@ def episodes(dist_err: np.ndarray, orient_err: np.ndarray,
 
 
 def score_track(est: np.ndarray, true: np.ndarray, cpu_s: np.ndarray | None = None,
-                thresholds: Thresholds = DEFAULT) -> TrackScore:
-    """Every score of one sequence (module notes). ``true`` rows with NaN are left out."""
+                thresholds: Thresholds = DEFAULT, pred: np.ndarray | None = None) -> TrackScore:
+    """Every score of one sequence (module notes). ``true`` rows with NaN are left out;
+    ``pred``: the predictions the estimates started from (for the jumps)."""
     est, true = np.asarray(est, dtype=float).reshape(-1, 3), np.asarray(true, dtype=float).reshape(-1, 3)
     n_scans = len(est)
+    jump = np.full(0, np.nan)
+    if pred is not None:
+        p = np.asarray(pred, dtype=float).reshape(-1, 3)
+        jump = np.hypot(est[:, 0] - p[:, 0], est[:, 1] - p[:, 1])
+        jump = jump[np.isfinite(jump)]
+    jumps = {"max_jump_m": float(jump.max()) if jump.size else math.nan, "jumps": int((jump > JUMP_M).sum())}
     has = np.isfinite(true).all(axis=1) & np.isfinite(est).all(axis=1)
     e, t = est[has], true[has]
     cpu = math.nan if cpu_s is None or len(cpu_s) == 0 else float(np.median(np.asarray(cpu_s, float))) * 1e3
     if len(t) == 0:
         nan = math.nan
-        return TrackScore(n_scans, 0, nan, nan, 0, 0, 0, 0, nan, nan, nan, nan, nan, nan, nan, nan, cpu)
+        return TrackScore(n_scans, 0, nan, nan, 0, 0, 0, 0, nan, nan, nan, nan, nan, nan, nan, nan, cpu, **jumps)
     d, o = errors(e, t)
     ok = thresholds.success(d, o)
     eps = episodes(d, o, thresholds)
@@ -175,7 +189,7 @@ def score_track(est: np.ndarray, true: np.ndarray, cpu_s: np.ndarray | None = No
         ape_rmse_m=a["rmse_m"], ape_mean_m=a["mean_m"], ape_max_m=a["max_m"],
         ape_rot_rmse_deg=a["rot_rmse_deg"], ape_rot_max_deg=a["rot_max_deg"],
         rpe_trans_m_per_m=r["trans_m_per_m"], rpe_rot_deg_per_m=r["rot_deg_per_m"],
-        cpu_ms_median=cpu)
+        cpu_ms_median=cpu, **jumps)
 
 
 def score_rows(rows, thresholds: Thresholds = DEFAULT) -> TrackScore:
@@ -186,8 +200,9 @@ def score_rows(rows, thresholds: Thresholds = DEFAULT) -> TrackScore:
     df = pd.DataFrame(rows)
     num = lambda cols: df[cols].apply(pd.to_numeric, errors="coerce").to_numpy(float)  # noqa: E731
     cpu = pd.to_numeric(df["cpu_s"], errors="coerce").dropna().to_numpy(float)
+    pred = num(["init_x", "init_y", "init_theta"]) if "init_x" in df else None
     return score_track(num(["est_x", "est_y", "est_theta"]), num(["true_x", "true_y", "true_theta"]),
-                       cpu, thresholds)
+                       cpu, thresholds, pred)
 
 
 def pooled_share(k, n, n_boot: int = 2000, seed: int = 20261122) -> tuple[float, float, float]:

@@ -74,13 +74,14 @@ def condition_table(s: pd.DataFrame) -> str:
         ape = math.sqrt(float((n * g["ape_rmse_m"].to_numpy(float) ** 2).sum() / n.sum())) if n.sum() else math.nan
         cpu = np.concatenate(list(g["cpu_ms_all"])) if len(g) else np.array([])
         cpu = cpu[np.isfinite(cpu)]
+        jumps = "—" if m == DEAD_RECKONING else f"{int(g['jumps'].sum())} ({num(g['max_jump_m'].max(), 2)})"
         rows.append([m, f"{100 * share:.1f}{ci}", int(g["losses"].sum()), int(g["recoveries"].sum()),
                      int(g["unrecovered"].sum()), num(g["longest_lost_m"].max(), 1), num(100 * ape, 1),
-                     num(100 * g["rpe_trans_m_per_m"].mean(), 2),
+                     num(100 * g["rpe_trans_m_per_m"].mean(), 2), jumps,
                      "—" if m == DEAD_RECKONING or not cpu.size else num(float(np.median(cpu)), 2)])
     return table(["matcher", "tracked % [95 % CI over sequences]", "losses", "recoveries",
-                  "unrecovered", "longest lost (m)", "APE RMSE (cm)", "RPE (cm/m)", "CPU ms/scan (median)"],
-                 rows)
+                  "unrecovered", "longest lost (m)", "APE RMSE (cm)", "RPE (cm/m)",
+                  "jumps > 1 m (largest, m)", "CPU ms/scan (median)"], rows)
 
 
 def tracking_tables(s: pd.DataFrame) -> str:
@@ -88,8 +89,10 @@ def tracking_tables(s: pd.DataFrame) -> str:
     parts = []
     for cond, g in s.groupby("condition", sort=True):
         seqs = g.drop_duplicates("dataset")
+        scored, steps = int(seqs["n_truth"].sum()), int(seqs["n_scans"].sum())
+        scans = f"{scored} scans" if scored == steps else f"{steps} scans, {scored} of them with truth (scored)"
         parts.append(f"**{cond}** ({len(seqs)} sequence{'s' * (len(seqs) != 1)}: "
-                     f"{', '.join(seqs['dataset'])}; {int(seqs['n_truth'].sum())} scans, "
+                     f"{', '.join(seqs['dataset'])}; {scans}, "
                      f"{seqs['distance_m'].sum():.0f} m)\n\n" + condition_table(g))
     return "\n".join(parts)
 
@@ -244,7 +247,9 @@ def tracking_section(df: pd.DataFrame, datasets: dict[str, Scenario], maps: dict
             "(no reset); truth only for scoring. tracked = within "
             f"{100 * thresholds.dist_m:.0f} cm and {thresholds.orient_deg:g}°; a loss = the error "
             "goes above 0.5 m or 10°; a recovery = back within the thresholds by itself; APE/RPE by "
-            "evo with no alignment (map frame); `odometry` = dead reckoning, the floor.\n",
+            "evo with no alignment (map frame), over the scans with truth; a jump = an estimate more "
+            "than 1 m from the prediction it started from (every scan); `odometry` = dead reckoning, "
+            "the floor.\n",
             tracking_tables(s), own_score_table(df, thresholds)]
     ev = kidnap_events(df, datasets, thresholds)
     if len(ev):
