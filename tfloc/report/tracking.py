@@ -29,7 +29,14 @@ from matplotlib.figure import Figure
 from tfloc.core.thresholds import Thresholds
 from tfloc.core.tracker import DeadReckoning
 from tfloc.evaluation.kidnap import WITHIN, median_scans, score_kidnaps
-from tfloc.evaluation.trajectory import LOST_DIST_M, LOST_ORIENT_DEG, errors, path_length, pooled_share, score_rows
+from tfloc.evaluation.trajectory import (
+    LOST_DIST_M,
+    LOST_ORIENT_DEG,
+    errors,
+    path_length,
+    pooled_share,
+    score_rows,
+)
 from tfloc.io.scenario import Scenario
 
 from .mdtable import num, table
