@@ -1,55 +1,27 @@
 """``bnb-global``: Cartographer's branch-and-bound scan matcher over the whole map and all headings.
 
-The algorithm of Hess, Kohler, Rapp, Andor, "Real-Time Loop Closure in 2D LIDAR SLAM", ICRA 2016,
-Sec. V (``FastCorrelativeScanMatcher2D::MatchFullSubmap`` in Cartographer), the field's
-established answer to global localization. No maintained implementation is installable from PyPI
-(searched: no Cartographer bindings there), so the published algorithm is implemented as
-written, with compiled kernels (:mod:`tfloc.baselines._bnb_kernels`). Choices and why:
+Hess, Kohler, Rapp, Andor, "Real-Time Loop Closure in 2D LIDAR SLAM", ICRA 2016, Sec. V
+(Cartographer's ``MatchFullSubmap``), implemented as published (PyPI has no Cartographer bindings)
+with compiled kernels (:mod:`tfloc.baselines._bnb_kernels`) and Cartographer's defaults. Choices
+and why (the detail: ``docs/baselines/bnb-global.md``; results: ``docs/global.md``):
 
-* **Probability grid** (built once per map, ``prepare``): Cartographer scores scans against a
-  submap's probability grid, whose walls its own range-data insertion has smeared over
-  neighbouring cells. Our maps are vector maps or thresholded occupancy grids, so the grid is a
-  likelihood-blurred occupancy at ``resolution`` = 5 cm (Cartographer's submap resolution):
-  ``p = 0.1 + 0.8·exp(−d²/2σ²)`` with ``d`` the distance to the map's geometry (the project's one
-  distance field, :mod:`tfloc.maps.fields`) and ``sigma`` = 5 cm (one cell), in Cartographer's
-  probability range [0.1, 0.9] (unknown and free space score 0.1, its ``kMinProbability``),
-  stored as uint8 like its ``PrecomputationGrid2D``.
-* **Precomputed grids** (per map): ``branch_and_bound_depth`` = 7 levels (Cartographer's
-  default, ``pose_graph.lua``); level ``h`` holds the maximum over a ``2^h × 2^h`` window.
-* **Search** (per scan): every heading, step δθ from the scan's farthest return (paper Eq. (7),
-  Cartographer's ``SearchParameters``, with its 1 − 10⁻³ margin); every translation on the
-  grid's cells whose centre lies within the map's bounds (Cartographer's ``MatchFullSubmap``
-  searches the whole submap; ``ShrinkToFit`` would also admit a robot off the map, which a map
-  localizer never needs). Depth-first branch and bound, children best first, a node cut when
-  its bound does not exceed the threshold: ``min_score`` = 0.6 (Cartographer's
-  ``global_localization_min_score``; its ``min_score`` for local constraints is 0.55) until
-  ``hypotheses`` = 5 distinct answers (> ``distinct_m`` = 0.5 m or > ``distinct_deg`` = 10°
-  apart) are held, then the fifth one's score: a subtree whose bound does not beat five held
-  answers cannot hold a sixth (with 1 hypothesis this is Cartographer's search; with 5 the
-  list is exact unless one new answer displaces two held ones at once, after which subtrees
-  already cut at the higher threshold are not revisited).
-* **Refinement**: as Cartographer's constraint builder does after the branch and bound, each
-  hypothesis is refined by a least-squares fit on the bilinearly interpolated probability grid
-  (Cartographer's Ceres scan matcher: occupied-space residuals ``w/√N·(1 − p)`` with
-  ``occupied_space_weight`` 20, and translation/rotation residuals toward the branch-and-bound
-  pose with weights 10 and 1, ``constraint_builder.ceres_scan_matcher``), here
-  ``scipy.optimize.least_squares``. Hypotheses are re-ranked by the refined score.
-* **No answer**: if no pose scores above ``min_score``, Cartographer reports no match; so does
-  this matcher (``info["status"] = "no-answer"``).
-* **Local problems** (an initial guess): the same search within ±``linear_search_window`` = 7 m
-  and ±``angular_search_window_deg`` = 30° of the guess (Cartographer's constraint-builder
-  window); the harness's global datasets never use it.
-* **Adaptive voxel filter** of the scan, as Cartographer's constraint builder applies before
-  matching (``loop_closure_adaptive_voxel_filter``: ``voxel_max_length`` = 0.9 m,
-  ``voxel_min_num_points`` = 100): the coarsest voxel edge ≤ 0.9 m that keeps at least 100
-  returns (one per voxel, the first), by Cartographer's halving and binary search; a scan of at
-  most 100 returns is kept whole. It bounds the per-candidate cost on long-range scans.
+* **Probability grid**: our maps are not Cartographer submaps, whose insertion smears the walls,
+  so the grid is the map blurred through its distance field, ``p = 0.1 + 0.8·exp(−d²/2σ²)``
+  (Cartographer's probability range), stored as uint8 with its precomputed grids.
+* **Search**: every heading (Cartographer's angular step, from the farthest return) and every cell
+  whose centre lies within the map's bounds (a map localizer never needs a robot off the map);
+  depth-first branch and bound, cut at ``min_score`` until ``hypotheses`` distinct answers are
+  held, then at the last one's score, so that the best few answers come out, not only the best.
+* As Cartographer's constraint builder: the scan through its **adaptive voxel filter** first (it
+  bounds the per-candidate cost on long-range scans), each hypothesis **refined** by its Ceres
+  scan-matcher residuals (here ``scipy.optimize.least_squares``) and re-ranked; no pose above
+  ``min_score`` is no answer; a local problem is searched within its window about the guess.
 
 **Amortised per map** (``prepare``): the probability grid and its precomputed grids.
 **Per scan**: the rotated, discretised scans, the branch and bound, the refinement.
 
-``score(problem, pose)`` is the matcher's own objective: ``1 −`` the mean interpolated grid
-probability of the scan's (voxel-filtered) returns at ``pose`` (lower is better).
+``score(problem, pose)``: ``1 −`` the mean interpolated grid probability of the scan's
+(voxel-filtered) returns at ``pose``.
 """
 
 from __future__ import annotations

@@ -1,36 +1,27 @@
 """``csm-corr``: real-time correlative scan matching (Olson, ICRA 2009) against a likelihood field.
 
-Inputs are the map, the laser spec, the real scan and the initial pose (never the truth).
-Configuration choices and why:
+Inputs are the map, the laser spec, the real scan and the initial pose (never the truth). Choices
+and why (the detail: ``docs/baselines/csm-corr.md``):
 
-* **Likelihood field of the map** (:mod:`tfloc.baselines.likelihood`): ``resolution`` = 2 cm cells,
-  distance by ``scipy.ndimage.distance_transform_edt``, likelihood ``exp(-d² / 2σ²)`` with
-  ``sigma`` = 10 cm. σ is wide enough that a beam endpoint 10 m out, off by half a rotation step
-  (0.5° ≈ 9 cm), still scores, so the discrete search does not skip the right rotation; the
-  final refinement removes the discretisation. Built once per map and cached.
-* **Exhaustive search over the protocol's whole window**: ±``window_xy`` = 3.5 m in x and y,
-  ±``window_theta_deg`` = 20° about the initial pose, rotations every ``rot_step_deg`` = 1°
-  (41 rotations), translations every ``xy_step_cells`` = 2 cells (4 cm, 176² per rotation).
-  The score of a pose is the sum of the scan endpoints' likelihoods (Olson's Eq. for the
-  rasterised lookup table, with all beams weighted alike).
-* **Olson's multi-resolution scheme**: a low-resolution table (the field max-pooled over blocks
-  of ``block`` = 8 translation steps, :meth:`LikelihoodField.max_pooled`) gives, per rotation and
-  block, an upper bound on the score of every translation in the block. All (rotation, block)
-  bounds are computed in one vectorised lookup; blocks are then expanded at full resolution in
-  order of decreasing bound until the next bound cannot beat the best full-resolution score. The
-  result is exactly the best pose of the full grid, found without scoring most of it.
-* **Fine local refinement**: ``scipy.optimize.least_squares`` on the bilinearly interpolated
-  distance field with a Cauchy loss of scale ``refine_scale`` = 5 cm (the same robust shape as the
-  likelihood), from the best grid pose. It leaves the grid's 4 cm / 1° quantisation behind.
-* ``converged`` = the refinement reported success and the best grid score is at least
-  ``min_mean_likelihood`` = 0.3 per beam; a self-check, not a claim of correctness.
+* **Likelihood field of the map** (:mod:`tfloc.baselines.likelihood`): ``exp(-d² / 2σ²)`` of the
+  distance ``d`` to the map, ``sigma`` wide enough that an endpoint 10 m out, off by half a
+  rotation step, still scores, so the discrete search does not skip the right rotation.
+* **Exhaustive search over the protocol's whole window** about the initial pose (``window_xy``,
+  ``window_theta_deg``, steps ``rot_step_deg`` and ``xy_step_cells``); a pose scores the sum of its
+  endpoints' likelihoods (Olson's rasterised lookup table, all beams weighted alike).
+* **Olson's multi-resolution scheme**: the field max-pooled over blocks of ``block`` steps bounds
+  every translation of a block; blocks are expanded best bound first until no bound beats the best
+  score: exactly the full grid's best pose, without scoring most of it.
+* **Fine refinement**: ``scipy.optimize.least_squares`` on the interpolated distance field with a
+  Cauchy loss (the likelihood's robust shape) removes the grid's quantisation.
+* ``converged`` = the refinement succeeded and the grid score is at least ``min_mean_likelihood``
+  per beam: a self-check, not a claim of correctness.
 
-**Amortised per map** (``prepare``): the distance and likelihood fields and Olson's
-max-pooled low-resolution table. **Per scan**: the endpoint look-ups of the search, the block
-expansion and the refinement.
+**Amortised per map** (``prepare``): the distance and likelihood fields and the max-pooled table.
+**Per scan**: the search's look-ups, the block expansion and the refinement.
 
-``score(problem, pose)`` is the matcher's own objective: the negative mean likelihood
-``-mean exp(-d² / 2σ²)`` of the scan endpoints at ``pose`` (interpolated distance ``d``).
+``score(problem, pose)``: the negative mean likelihood ``-mean exp(-d² / 2σ²)`` of the scan
+endpoints at ``pose`` (interpolated distance ``d``).
 """
 
 from __future__ import annotations

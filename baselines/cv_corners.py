@@ -1,66 +1,27 @@
 """``cv-corners``: OpenCV ``estimateAffinePartial2D`` on ShortStraw corners of the real and virtual scans.
 
-Inputs are the map, the laser spec, the real scan and the initial pose (never the truth).
-Configuration choices and why:
+Inputs are the map, the laser spec, the real scan and the initial pose (never the truth). Choices
+and why (the detail and the measurements: ``docs/baselines/cv-corners.md``):
 
-* **Corners by the same code path as** ``tf``: ``tfloc.paper.shape.scan_corners`` (ShortStraw, Alg. 1–3)
-  on the real scan and on the virtual scan ray-cast from the current pose estimate (at first the
-  initial pose). The virtual scan, not the map's vertices, so that both corner sets come from the
-  same detector and see the same occlusions; it works for any map (vector or grid). The one
-  setting changed from ``tf``'s defaults is the resampling distance ``corner_spacing`` = 2 cm
-  (``tf`` uses S = 1 m): corners land on resampled points, so S bounds their accuracy.
-* **Noise corners dropped** (``straight_tol`` = 3 cm, :mod:`tfloc.baselines._corner_thin`): at S = 2 cm
-  the straws see the range noise, and a wall scanned from close by (raw points 1–2 cm apart) gets
-  a corner every few centimetres: 19.5 corners per simulated office scan where the noise-free
-  virtual scan at the truth has 13.5, and 75 (max 117) per real MIT CSAIL relation scan where
-  its virtual scan has 38. A corner is dropped when every raw point from the last kept corner to
-  the next lies within ``straight_tol`` of the chord between them (Alg. 3's "is it a line?"
-  asked of the raw points with a noise-sized tolerance; one pass as Alg. 3). 3 cm = 3σ of the
-  simulated noise; it brings the office scans to 15 corners (virtual 13.5) and the CSAIL
-  relation scans to 50. ``straight_tol`` = 0 switches it off.
-* **Sub-sample corner positions** (``refine_corners``, :mod:`tfloc.baselines._corner_refine`): a
-  corner between two straight pieces of the scan moves to the intersection of the lines fitted
-  to the raw points of those pieces; jump edges and field-of-view ends stay as ShortStraw put
-  them. Without it, range noise (σ = 1 cm) leaves corners 1–3 cm off and the pose jitters by as
-  much.
-* **Fair correspondences**: ``estimateAffinePartial2D`` fed all candidate pairs collapses the
-  scale to 0, so candidate rigid transforms are first proposed by pairs of real corners and
-  ordered pairs of virtual corners whose lengths agree within ``length_tol`` = 15 cm (pairs
-  shorter than ``min_pair_length`` = 0.5 m give no usable rotation), restricted to the window the
-  protocol's initial guess is known to lie in (``max_angle_deg`` = 25°, ``max_shift`` = 4 m per
-  step, the same prior as ``csm-corr``'s ±3.5 m / ±20° plus a margin). Each is scored by its
-  one-to-one (mutual nearest neighbour) inliers within ``inlier_tol`` = 20 cm, ties broken by
-  the summed inlier distance. The truth is never used. Each real pair is taken once: the
-  reversed pair onto the reversed virtual pair is the same transform.
-* **Adaptive search** (``confidence`` = 0.999, ``seed`` = 0, :func:`tfloc.baselines._corner_match.search_hypotheses`):
-  real corner pairs are drawn in a seeded random order, each matched with every virtual pair of
-  agreeing length and each transform scored at once; the search stops as adaptive RANSAC does,
-  once a pair supporting the best match so far would have been drawn with probability
-  ``confidence`` (w = that match's supporting pairs / all real pairs, n ≥ log(1 − c)/log(1 − w)),
-  and in any case after ``max_hypotheses`` = 5000 scored transforms per step (at most 6 × 5000
-  per scan). ``confidence`` = 1 scores every hypothesis (up to the cap).
-* **Refinement by OpenCV**: the best hypothesis's inlier pairs go to
-  ``cv2.estimateAffinePartial2D`` with RANSAC (reprojection threshold ``inlier_tol`` on the first
-  step, when the two viewpoints still differ, then ``fine_tol`` = 3 cm; OpenCV's default
-  Levenberg–Marquardt refinement). A result with |scale − 1| > ``max_scale_error`` = 0.05 is
-  rejected; otherwise it is projected onto SE(2) (scale dropped).
-* **Re-simulation**: the virtual scan is ray-cast again at the new estimate and the match repeated
-  (up to ``max_iterations`` = 6; ``converged`` when a step moves < 5 mm and < 0.05°). As the two
-  viewpoints coincide, both corner sets see the same occlusions and field-of-view ends.
-* ``straight_tol`` = 3 cm and ``confidence`` = 0.999 were chosen on a development subset and checked
-  on held-out scans: the measurements are in ``docs/baselines/cv-corners.md``.
-* Fewer than 2 corners in either scan, no hypothesis, fewer than 2 inliers or a rejected scale on
-  the first step is a ``no-answer``: the initial pose is returned with ``converged=False`` and
-  ``info["status"] = "no-answer"`` (never an exception). A later step that fails keeps the last
-  good estimate. ``info["hypotheses_total"]`` counts the transforms scored in all steps.
-* ``virtual_surface`` = ``near-face`` (the ray-cast range). ``run-centre`` ends each beam of the
-  virtual scan in the middle of the occupied run it enters on a grid (as karto's base scans, see
-  docs/baselines/karto.md); measured in issue 25 (docs/robustness.md): the same success on the
-  as-built grids, more on hits-only and thickened maps, at 40–70 % more CPU; not the default.
+* **Corners by** ``tf``'s **ShortStraw** (:func:`tfloc.paper.shape.scan_corners`) on the real scan
+  and on the virtual scan at the current estimate, so that one detector sees the same occlusions in
+  both, on any map; resampled every ``corner_spacing``, not ``tf``'s 1 m, because a corner lands
+  on a resampled point.
+* **Noise corners dropped** (:mod:`tfloc.baselines._corner_thin`): so finely resampled, the straws
+  see the range noise; a corner whose raw neighbourhood is straight within ``straight_tol`` goes.
+* **Sub-sample corners** (:mod:`tfloc.baselines._corner_refine`): a corner between two straight
+  pieces moves to their fitted lines' intersection; else the noise makes the pose jitter.
+* **Fair rigid hypotheses** (:mod:`tfloc.baselines._corner_match`): fed every candidate pair,
+  ``estimateAffinePartial2D`` collapses the scale to 0; so corner pairs of agreeing length propose
+  transforms within the protocol's window, scored by one-to-one inliers, drawn in a seeded order
+  and stopped as adaptive RANSAC stops.
+* **Refined by OpenCV** (RANSAC on the best hypothesis's inliers), projected onto SE(2), and
+  **re-simulated** at the estimate until a step is small: the two viewpoints then coincide.
+* A first step without an answer returns the initial pose with ``info["status"] = "no-answer"``;
+  a later one keeps the last estimate.
 
-``score(problem, pose)`` is its own objective at ``pose``: minus the number of one-to-one corner
-inliers between the real scan and the virtual scan at ``pose`` (identity transform), plus their
-mean distance divided by ``inlier_tol`` (a tie-breaker in [0, 1]).
+``score(problem, pose)``: minus the one-to-one corner inliers between the real scan and the virtual
+scan at ``pose``, plus their mean distance / ``inlier_tol`` (a tie-breaker in [0, 1]).
 """
 
 from __future__ import annotations
@@ -95,25 +56,25 @@ class Config:
         "(0, 1)": ("confidence", "ransac_confidence",),
         ("near-face", "run-centre"): ("virtual_surface",)}
 
-    corner_spacing: float = 0.02
-    straight_tol: float = 0.03
-    refine_corners: bool = True
-    length_tol: float = 0.15
-    min_pair_length: float = 0.5
-    max_angle_deg: float = 25.0
-    max_shift: float = 4.0
-    max_hypotheses: int = 5000
-    confidence: float = 0.999
-    seed: int = 0
-    inlier_tol: float = 0.20
-    fine_tol: float = 0.03
-    ransac_max_iters: int = 2000
-    ransac_confidence: float = 0.99
-    max_scale_error: float = 0.05
-    max_iterations: int = 6
-    step_xy_tol: float = 0.005
-    step_theta_tol_deg: float = 0.05
-    virtual_surface: str = "near-face"
+    corner_spacing: float = 0.02  #: ShortStraw's resampling distance S (metres)
+    straight_tol: float = 0.03  #: drop a corner if its raw points lie this near a chord (metres; 0: off)
+    refine_corners: bool = True  #: move corners to the fitted lines' intersection
+    length_tol: float = 0.15  #: pairs' lengths agree within this (metres)
+    min_pair_length: float = 0.5  #: shorter pairs give no rotation (metres)
+    max_angle_deg: float = 25.0  #: a step's rotation window (degrees; csm-corr's 20° + margin)
+    max_shift: float = 4.0  #: a step's shift window (metres; csm-corr's 3.5 m + margin)
+    max_hypotheses: int = 5000  #: transforms scored per step, at most
+    confidence: float = 0.999  #: adaptive stop: P(a supporting pair was drawn)
+    seed: int = 0  #: seed of the corner pairs' draw order
+    inlier_tol: float = 0.20  #: inlier distance; OpenCV's threshold, step 1 (metres)
+    fine_tol: float = 0.03  #: OpenCV's threshold after step 1 (metres)
+    ransac_max_iters: int = 2000  #: OpenCV's RANSAC iterations
+    ransac_confidence: float = 0.99  #: OpenCV's RANSAC confidence
+    max_scale_error: float = 0.05  #: reject OpenCV's answer if |scale − 1| > this
+    max_iterations: int = 6  #: re-simulation steps, at most
+    step_xy_tol: float = 0.005  #: converged: a step moves less than this (metres) ...
+    step_theta_tol_deg: float = 0.05  #: ... and turns less than this (degrees)
+    virtual_surface: str = "near-face"  #: on a grid: near-face (ray cast) or run-centre (mid-run)
 
 
 class _NoAnswer(Exception):
@@ -185,7 +146,8 @@ class CvCornersMatcher:
                      "inliers": int(mask.sum()), "scale": float(scale)}
 
     def localize(self, problem: Problem) -> Estimate:
-        """Match corners, refine with OpenCV, re-simulate at the estimate and repeat."""
+        """Match corners, refine with OpenCV, re-simulate at the estimate and repeat;
+        ``info["hypotheses_total"]`` counts the transforms scored in all steps."""
         c = self.config
         real = self._corners(problem.ranges, problem)
         pose, info, steps = problem.initial, {}, 0

@@ -1,37 +1,28 @@
 """``karto``: OpenKarto's correlative scan matcher (the one behind slam_toolbox), two-stage.
 
 Inputs are the map, the laser spec, the real scan and the initial pose (never the truth). It calls
-``karto_scanmatcher.Wrapper.match_scan`` (the ``karto-scanmatcher`` 1.0.0 wheel: pybind11 bindings of
-OpenKarto's ``ScanMatcher``; wheels for Python 3.8–3.11 only; GPL-3.0 licence file, OpenKarto itself
-is LGPL-3.0); Karto's internals are not rewritten. Its Python API: ``ScanMatcherConfig`` (search
-size, resolution, smear, range threshold, angular search and penalties), ``Wrapper(config)``,
-``LaserScanConfig``/``LocalizedRangeScan`` (ranges + pose) and
-``Wrapper.match_scan(scan, base_scans, penalize, refine) → MatchResult`` (best pose, covariance,
-response in [0, 1]). ``create_occupancy_grid`` builds a grid *from* scans for display; nothing
-matches against a grid.
+``karto_scanmatcher.Wrapper.match_scan`` unchanged (``karto-scanmatcher`` 1.0.0: pybind11 bindings of
+OpenKarto's ``ScanMatcher``, Python 3.8–3.11; OpenKarto LGPL-3.0, the wheel ships GPL-3.0), which
+correlates a scan with other scans, never with a grid. Choices and why (the tuning record, the
+wrapper's API and the measurements: ``docs/baselines/karto.md``):
 
-What it is fed and why, in short (the tuning record, with the measurements behind every choice,
-is docs/baselines/karto.md):
-
-* **The map is handed over as scans** (Karto's documented use: ``MatchScan`` correlates a scan
-  with *base scans*): 360° scans of the map from a lattice of free positions every 1 m
-  (:mod:`tfloc.baselines._scan_lattice`), those within 4 m of the initial pose. On a grid each
-  beam ends in the middle of the run of occupied cells it meets (``base_surface`` =
-  ``run-centre``), where the recorded scans a SLAM system would hand Karto put the surface;
-  ``near-face`` (the ray-cast range) is the earlier choice, biased short on thick walls.
-* **Two stages, Karto's loop-closure pattern**: a ±3.5 m / ±20° coarse search at 0.1 m without
-  penalties, then Karto's sequential defaults (0.3 m at 0.01 m, with penalties).
-* ``range_threshold`` = the laser's range; ``converged`` = final response ≥ 0.45
-  (slam_toolbox's ``loop_match_minimum_response_fine``), a self-check.
+* **The map is handed over as scans** (Karto's documented use): 360° scans from a lattice of free
+  positions (:mod:`tfloc.baselines._scan_lattice`), those within ``base_radius`` of the guess. On a
+  grid a beam ends in the middle of the occupied run it meets (``base_surface`` = ``run-centre``),
+  where a SLAM system's recorded scans would put the surface; the near face is biased short on
+  thick walls.
+* **Two stages, Karto's loop-closure pattern**: a coarse search over the protocol's window without
+  penalties, then Karto's sequential defaults with its penalties.
+* ``range_threshold`` = the laser's range (Karto's 40 m default sizes its grids for 40 m);
+  ``converged`` = final response ≥ ``min_response``, a self-check.
 
 **Amortised per map** (``prepare``): the lattice and every position's base scan as a Karto scan.
 **Per scan**: the query scans and Karto's two correlations (Karto builds its grid from the base
 scans for every match; its API keeps no grid between matches).
 
-``score(problem, pose)`` is Karto's own objective at ``pose``: minus the response (mean smeared
-occupancy under the scan's points) of a correlation centred at ``pose`` with a ±2 cm window at the
-pose's heading, against the same base scans, the grid built around ``pose`` as Karto builds it
-around the scan it matches.
+``score(problem, pose)``: minus Karto's response (mean smeared occupancy under the scan's points)
+of a correlation centred at ``pose`` within ``score_window``, at the pose's heading, against the
+same base scans.
 """
 
 from __future__ import annotations
@@ -73,28 +64,28 @@ class Config:
                  "min_response"),
         ("run-centre", "near-face"): ("base_surface",)}
 
-    coarse_search_size: float = 7.0
-    coarse_resolution: float = 0.1
-    coarse_smear_deviation: float = 0.1
-    fine_search_size: float = 0.3
-    fine_resolution: float = 0.01
-    fine_smear_deviation: float = 0.03
-    coarse_angle_offset_deg: float = 20.0
-    coarse_angle_resolution_deg: float = 2.0
-    fine_angle_resolution_deg: float = 0.2
-    use_response_expansion: bool = True
-    distance_variance_penalty: float = 0.5
-    minimum_distance_penalty: float = 1.0
-    angle_variance_penalty: float = 0.349
-    minimum_angle_penalty: float = 0.9
-    range_threshold: float | None = None
-    lattice_spacing: float = 1.0
-    lattice_clearance: float = 0.2
-    virtual_beam_deg: float = 0.25
-    base_surface: str = "run-centre"
-    base_radius: float = 4.0
-    min_response: float = 0.45
-    score_window: float = 0.04
+    coarse_search_size: float = 7.0  #: coarse stage: window width (metres: ±3.5 m, the protocol's)
+    coarse_resolution: float = 0.1  #: coarse stage: cell (metres)
+    coarse_smear_deviation: float = 0.1  #: coarse stage: Karto's smear deviation (metres)
+    fine_search_size: float = 0.3  #: fine stage: window width (metres; Karto's sequential default)
+    fine_resolution: float = 0.01  #: fine stage: cell (metres; Karto's default)
+    fine_smear_deviation: float = 0.03  #: fine stage: smear deviation (metres)
+    coarse_angle_offset_deg: float = 20.0  #: angular search ± this, both stages (degrees; Karto's default)
+    coarse_angle_resolution_deg: float = 2.0  #: coarse angular step (degrees; Karto's default)
+    fine_angle_resolution_deg: float = 0.2  #: fine angular step (degrees; Karto's default)
+    use_response_expansion: bool = True  #: Karto's retries over wider angles when nothing responds
+    distance_variance_penalty: float = 0.5  #: Karto's default; penalties apply in the fine stage only
+    minimum_distance_penalty: float = 1.0  #: Karto's default (1: no distance penalty)
+    angle_variance_penalty: float = 0.349  #: Karto's default
+    minimum_angle_penalty: float = 0.9  #: Karto's default
+    range_threshold: float | None = None  #: Karto's range threshold (metres; None: the laser's range)
+    lattice_spacing: float = 1.0  #: base scans' positions this far apart (metres)
+    lattice_clearance: float = 0.2  #: ... and at least this far from obstacles (metres)
+    virtual_beam_deg: float = 0.25  #: beam spacing of the 360° base scans (degrees)
+    base_surface: str = "run-centre"  #: on a grid: run-centre (mid-run) or near-face (ray cast)
+    base_radius: float = 4.0  #: base scans within this of the guess (metres; 3.5 m + margin)
+    min_response: float = 0.45  #: converged: final response ≥ this (slam_toolbox's loop match)
+    score_window: float = 0.04  #: score's correlation window width (metres: ±2 cm)
 
 
 @dataclass(frozen=True)

@@ -1,45 +1,25 @@
 """``kiss-icp``: KISS-ICP's own registration of the real scan against a voxel map of the map.
 
-Inputs are the map, the laser spec, the real scan and the initial pose (never the truth). It calls
-``kiss_icp.registration.Registration.align_points_to_map`` with a ``kiss_icp.mapping.VoxelHashMap``
-filled with the map's geometry; KISS-ICP's internals are not rewritten. Configuration choices and
-why (the strongest honest setup we found for this method):
+Inputs are the map, the laser spec, the real scan and the initial pose (never the truth).
+KISS-ICP's ``Registration.align_points_to_map`` runs unchanged on a ``VoxelHashMap`` of the map's
+samples. Choices and why (the detail and the measurements: ``docs/baselines/kiss-icp.md``):
 
-* **Scan embedded at z = 0**, all valid beams, no KISS-ICP preprocessing (no deskewing, no
-  voxel downsampling of 181 points: every point helps on a single 2D scan).
-* **Target = the map's sampled geometry** (``map.sample_points`` every ``map_spacing`` = 2 cm)
-  in one ``VoxelHashMap`` per voxel size, built once per map and cached. Cropping around the initial
-  pose is unnecessary here: KISS-ICP's correspondence search only visits the 27 voxels around each
-  transformed scan point, so distant map points are never touched.
-  ``max_points_per_voxel`` is KISS-ICP's default (20); its insertion keeps points at least
-  ``voxel / sqrt(20)`` apart, which still leaves ~2 cm detail at the finest voxel.
-* **Voxel schedule** ``voxel_sizes`` = 2.0 → 1.0 → 0.3 → 0.1 m. KISS-ICP's default voxel size
-  here (max_range / 100 = 0.1 m) only converges from about 0.2 m, because the neighbour-voxel
-  search makes the voxel size the effective correspondence gate. Each stage starts from the last
-  result.
-* Per stage, ``max_correspondance_distance`` = ``gate_factor`` × voxel (3, i.e. no cut beyond
-  what the neighbour-voxel search already reaches) and the Geman–McClure ``kernel`` =
-  ``kernel_factor`` × voxel (1).
-  On the quick test-room check (90 problems, 0–3 m / 0–15°; a script of the first session, since replaced by
-  the harness's run configurations):
-  voxels 1.0 → 0.3 → 0.1 with kernel voxel/3 succeeded on 56 %, with kernel = voxel on 66 %,
-  with kernel voxel/10 on 50 %; a 2 m first voxel with kernel = voxel on 69 %, a 3 m one on 71 %
-  (one or two problems more: noise at this size, so the 2 m stage that matches ``o3d-icp``'s
-  first gate is kept). A gate of 1 × voxel instead of 3 × changed nothing (56 %).
-* KISS-ICP's defaults for ``max_num_iterations`` (500) and ``convergence_criterion`` (1e-4);
-  ``max_num_threads`` = 1 because the harness already runs one worker per core.
-* The 6-DoF result is **projected onto SE(2)** after every stage.
-* ``converged`` = at least ``min_inlier_fraction`` (0.5) of the scan points lie within the last
-  voxel size of a map point at the result; a self-check, not a claim of correctness.
+* **Scan at z = 0**, every valid beam, no deskewing or downsampling (on one 2D scan every point
+  helps).
+* **Target**: the map's samples every ``map_spacing``, one ``VoxelHashMap`` per voxel size, built
+  once per map; not cropped (the search visits only the 27 voxels around each scan point).
+* **Voxel schedule** ``voxel_sizes``, each stage from the last result: the neighbour-voxel search
+  makes the voxel the correspondence gate, so KISS-ICP's default voxel (max_range / 100) alone
+  converges only from small offsets. Gate ``gate_factor`` × voxel, Geman–McClure kernel
+  ``kernel_factor`` × voxel; KISS-ICP's defaults otherwise, one thread (one worker per core).
+* **Projected onto SE(2)** after every stage; ``converged`` = at least ``min_inlier_fraction`` of
+  the scan points within the last voxel of a map point (a self-check).
 
-**Amortised per map** (``prepare``): the map's 2 cm samples with their KD-tree (for the inlier
-check and ``score``) and one ``VoxelHashMap`` per voxel size. **Per scan**: only KISS-ICP's
-registration against those voxel maps and the inlier check.
+**Amortised per map** (``prepare``): the samples, their KD-tree (inlier check, ``score``) and the
+voxel maps. **Per scan**: KISS-ICP's registration and the inlier check.
 
-``score(problem, pose)`` is KISS-ICP's own objective at ``pose``: the mean Geman–McClure cost
-``r² / (κ + r²)`` of the point-to-point distance ``r`` from each scan point to its nearest map
-sample, with KISS-ICP's last-stage kernel κ; a point with no sample within the last voxel counts
-as 1.
+``score(problem, pose)``: the mean Geman–McClure cost ``r² / (κ + r²)`` of each scan point's
+distance ``r`` to its nearest map sample (κ the last stage's kernel; none within the last voxel: 1).
 """
 
 from __future__ import annotations

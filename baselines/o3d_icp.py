@@ -1,38 +1,25 @@
 """``o3d-icp``: open3d point-to-line ICP of the real scan against the map, coarse to fine.
 
-Inputs are the map, the laser spec, the real scan and the initial pose (never the truth).
-Configuration choices and why (the strongest honest setup we found for this method):
+Inputs are the map, the laser spec, the real scan and the initial pose (never the truth). Choices
+and why (the detail and the measurements: ``docs/baselines/o3d-icp.md``):
 
-* **Scan embedded at z = 0, target = the map's sampled geometry** (``map.sample_points``,
-  ``map_spacing`` = 5 cm) **within** ``max_range + crop_margin`` **of the initial pose**. Scan
-  points lie within ``max_range`` of the true pose, which the protocol puts at most ~3.5 m from
-  the initial pose; the 4 m margin covers that, so no true partner is cropped away.
-* **Point-to-line via** ``TransformationEstimationPointToPlane`` **with in-plane normals** taken
-  from the map (``sample_points`` returns them; no ``estimate_normals``). open3d 0.20's
-  ``estimate_normals()`` on z = 0 points returns (0, 0, ±1), for which ICP silently returns the
-  identity. With (nx, ny, 0) normals only x, y and yaw enter the residual, i.e. 2D point-to-line.
-* **Coarse-to-fine correspondence gates** ``gates`` = 2.0 → 1.0 → 0.5 → 0.2 → 0.1 m. One small
-  gate finds no partners at large offsets and stalls; one large gate pairs points with the wrong
-  wall near convergence. Each stage starts from the previous stage's result. On the quick
-  test-room check (90 problems, 0–3 m / 0–15°; a script of the first session, since replaced by
-  the harness's run configurations) the schedule
-  1.0 → … → 0.1 m succeeded on 54 %, adding a 2 m first stage on 76 %; a 3 m or 1.5 m first
-  stage and 60 instead of 30 iterations per stage gained nothing (76 %, 66 %, 76 %).
-* **Projected onto SE(2) after every stage** (z, roll, pitch are unconstrained by in-plane
-  normals; the projection keeps them at zero).
-* ``max_iterations`` = 30 per stage with open3d's relative fitness/RMSE tolerances of 1e-6: the
-  stages converge well within that on 181-beam scans.
-* ``converged`` is open3d's final fitness (fraction of scan points with a partner within the last
-  gate) ≥ ``min_fitness`` = 0.5; it is a self-check, not a claim of correctness.
+* **Scan at z = 0; target = the map's samples** (:func:`tfloc.maps.cache.map_geometry`) within the
+  laser's range plus ``crop_margin`` of the initial pose: the margin covers the protocol's
+  offsets, so no true partner of a scan point is cropped away.
+* **Point-to-line** through ``TransformationEstimationPointToPlane`` with the map's in-plane
+  normals: open3d's ``estimate_normals`` gives (0, 0, ±1) on z = 0 points, for which ICP silently
+  returns the identity; with (nx, ny, 0) only x, y and yaw enter the residual.
+* **Coarse-to-fine gates** (``gates``), each stage from the last result: one small gate finds no
+  partners at large offsets, one large gate pairs points with the wrong wall near convergence.
+  **Projected onto SE(2) after every stage** (in-plane normals leave z, roll and pitch free).
+* ``converged`` = open3d's final fitness ≥ ``min_fitness``: a self-check, not a claim of correctness.
 
-**Amortised per map** (``prepare``, :func:`tfloc.maps.cache.map_geometry`): the map's samples,
-their normals and a KD-tree over them. **Per scan**: cropping them around the initial pose (a
-ball query on that tree), the open3d target cloud of the crop, and the KD-tree open3d builds over
-the target inside every ``registration_icp`` call (five per scan; open3d takes no prebuilt tree).
+**Amortised per map** (``prepare``): the map's samples, their normals and a KD-tree. **Per scan**:
+the crop (a ball query on that tree), its open3d cloud, and the KD-tree open3d builds inside every
+``registration_icp`` call (one per gate; open3d takes no prebuilt tree).
 
-``score(problem, pose)`` is the ICP's own objective at ``pose``: the mean point-to-line residual of
-the scan points against their nearest map samples, each truncated at the last gate (a point with no
-sample within that gate counts as the gate), in metres.
+``score(problem, pose)``: the mean point-to-line residual (metres) of the scan points against their
+nearest map samples, each truncated at the last gate (no sample within it: the gate).
 """
 
 from __future__ import annotations

@@ -1,17 +1,12 @@
 """Run registered matchers over scenario datasets and stream the results to RUN/estimates.csv.
 
-Either name datasets and matchers on the command line, or give a run configuration (TOML,
-see benchmarks/*.toml); options given on the command line override the file. Every matcher is
-built before anything runs: an unknown parameter or a bad value stops the command at once,
-naming the configuration key. Re-running the same command after an interruption (Ctrl-C,
-kill -9) resumes: finished (scan, matcher) pairs are skipped, nothing is repeated or lost. A run
-directory holds one configuration (run.json records its fingerprint: the datasets' contents, the
-matchers' resolved parameters, the thresholds, the tfloc version); a run with another
-configuration is refused there (use --regenerate or another --out).
-
-Each task has a time limit; a matcher that raises or hangs gets an `error:`/`timeout` row and the
-run goes on; a scan whose problem cannot be posed (e.g. its initial pose lies outside the map)
-gets an `invalid:` row. The end of the run prints the rows per status.
+Either name datasets and matchers on the command line, or give a run configuration (TOML, see
+benchmarks/*.toml); options given on the command line override the file. Every matcher is built
+before anything runs: a bad parameter stops the command at once, naming its configuration key.
+Re-running the same command after an interruption (Ctrl-C, kill -9) resumes it. A run directory
+holds one configuration (run.json's fingerprint); another is refused there: use --regenerate or
+another --out. Every task ends in one row: ok, failed, invalid:<reason>, timeout or error:<message>
+(README.md, "A run is one configuration").
 
 Exit status: 0 the run is complete (rows may be failed, invalid or timeout); 2 nothing was run
 (a bad configuration, dataset or parameter, a run of another configuration in --out, an output
@@ -21,8 +16,7 @@ the `error:` rows; --retry-errors runs them again).
 Matchers named `module:Class` (not registered ones) are imported: that runs the module's code.
 Run only configurations you trust; such matchers are refused without --allow-import.
 
---quick runs a small stratified subset (the first 3 scans of every group of every dataset) into
-RUN-quick: a full report with figures in a few minutes (make quick).
+--quick runs the first 3 scans of every group of every dataset into RUN-quick (make quick).
 
 Examples:
   tfloc bench benchmarks/paper-protocol.toml

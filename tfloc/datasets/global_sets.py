@@ -1,5 +1,5 @@
 """Global-localization datasets (``"mode": "global"``): no initial guess, the pose is searched over
-the whole map (issue 24).
+the whole map.
 
 * ``global-office-{1,2,3}`` (evaluation): :data:`OFFICE_SCANS` = 500 simulated LMS200 scans per
   office floor, true poses uniform over the free space (≥ 0.3 m from geometry,

@@ -16,8 +16,8 @@ and names what makes a robot lose track:
 * ``people``: 10 Hz, low noise, four people (0.3 m discs, not in the map) walking back and forth
   along the route at 0.8 m/s, 0.35 m to its side, ray-cast into the scans (one within 0.6 m of
   the robot steps aside: it is not drawn);
-* ``combined``: all of it at once: 1 Hz, high odometry noise, wheel slip and people (added after
-  the single-factor conditions were measured and none made any matcher lose track often).
+* ``combined``: all of it at once: 1 Hz, high odometry noise, wheel slip and people (no single
+  factor made any matcher lose track often: ``docs/tracking.md``).
 
 Design (all under ``data/scenarios/seq-*``, about 16 MB): ``easy`` and the rate conditions on all
 three routes (route a on office-1, b on office-2, c on office-3); the other hard conditions on

@@ -1,4 +1,4 @@
-"""Metrics of global localization (issue 24): top-1, top-5, ``ambiguous`` and cost against map area.
+"""Metrics of global localization: top-1, top-5, ``ambiguous`` and cost against map area.
 
 Per scan (:func:`scan_result`), with the run's :class:`~tfloc.evaluation.outcome.Thresholds`:
 

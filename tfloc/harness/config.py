@@ -1,35 +1,29 @@
 """Run configurations: which matchers on which datasets, with which limits (TOML ↔ RunConfig).
 
-A run configuration file looks like::
+A run configuration file looks like (relative paths are relative to where tfloc runs)::
 
     name = "paper-protocol"
-    out = "results/paper-protocol"          # relative paths are relative to where tfloc runs
-    datasets = ["data/scenarios/office-pool", "data/scenarios/detail-1"]
-    # a dataset may be a table: { path = "...", skip_per_group = 40 } skips the first 40 scans of
-    # each of its groups (a held-out selection after a development split)
+    out = "results/paper-protocol"
+    datasets = ["data/scenarios/office-pool", { path = "data/scenarios/detail-1", skip_per_group = 40 }]
     matchers = ["tf", "csm-corr", { label = "tf-S0.5", name = "tf", params = { spacing = 0.5 } }]
-    jobs = 2                 # worker processes
-    timeout_s = 60           # per (scan, matcher) task
+    jobs = 2                   # worker processes
+    timeout_s = 60             # per (scan, matcher) task
     sequence_timeout_s = 3600  # per (sequence, matcher) task of a sequence dataset
-    limit_per_group = 0      # 0 = all scans; N = the first N scans of each group (smoke runs)
+    limit_per_group = 0        # 0 = all scans; N = the first N scans of each group (smoke runs)
     [success]
     dist_m = 0.10
     orient_deg = 2.0
-    [params.tf]              # parameters for every matcher entry named "tf" without its own
+    [params.tf]                # for every matcher entry named "tf" without its own params
     spacing = 1.0
-    [[sweep]]                # a parameter grid: one matcher label per grid point
-    name = "tf"              # registered matcher name
+    [[sweep]]                  # one matcher label per point of the grid, in the order written:
+    name = "tf"                # tf[spacing=0.5,straw_t=0.95], tf[spacing=0.5,straw_t=0.99], ...
     grid = { spacing = [0.5, 1.0], straw_t = [0.95, 0.99] }
-    params = { }             # optional fixed parameters (over [params.tf])
-    label = "tf"             # optional label prefix (default: name)
+    params = { }               # optional, over [params.tf]; label = "tf": optional label prefix
 
-A sweep adds the cartesian product of its grid, in the order the keys and values are written,
-as matchers labelled ``tf[spacing=0.5,straw_t=0.95]``, ``tf[spacing=0.5,straw_t=0.99]``, ...
-
-A matcher may also be named ``module:Class``: running such a configuration imports that module,
-that is, runs its code. :func:`check_imports` refuses it unless the caller allows imports
-(``tfloc bench --allow-import``). Every matcher spec remembers which configuration key set each of
-its parameters, so that a bad one is reported by its key (``[params.csm-corr] search_radiuss``).
+``skip_per_group`` skips the first N scans of each group (a held-out selection after a development
+split). A matcher named ``module:Class`` runs that module's code: :func:`check_imports` refuses it
+unless imports are allowed (``tfloc bench --allow-import``). Each parameter remembers the key that
+set it, so that a bad one is reported by its key (``[params.csm-corr] search_radiuss``).
 """
 
 from __future__ import annotations

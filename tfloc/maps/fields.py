@@ -91,8 +91,7 @@ def lattice_anchor(map_: Map, resolution: float) -> np.ndarray:
     :class:`~tfloc.maps.grid.GridMap`) whose cells are an odd number of field cells wide: there
     its first cell's centre. Either way the raster's sample points (its occupied cells' centres)
     never fall on a border between two field cells, where rounding would shift the whole map by
-    half a field cell (measured: 3–5 cm of bias in a refinement on thick walls, with 5 cm cells
-    anchored at the grid's corner)."""
+    half a field cell, a bias every refinement on the field would inherit."""
     x0, y0 = map_.bounds[:2]
     if hasattr(map_, "occupied") and hasattr(map_, "origin") and hasattr(map_, "resolution"):
         k = float(map_.resolution) / resolution

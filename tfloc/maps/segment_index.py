@@ -2,11 +2,10 @@
 within range of a pose without testing every segment of the map.
 
 The segment ray-caster (:mod:`tfloc.maps._raycast`) starts each cast by collecting the segments
-closer than the scanner's range. Tested one by one that is O(M) per pose: measured in the
-scaling study (issue 26), 6.8 µs per virtual scan on an office of 81 segments and 22 µs on the
-same floor tiled to 20 698 m² (5 184 segments), which made ``tf`` 5.1 ms and ``tf-plus`` 0.75 ms
-per scan slower on the large map. With the buckets a cast looks only at the cells within range;
-the set of segments found, and so every range, is the same (``tests/test_kernels_raycast.py``).
+closer than the scanner's range. Tested one by one that is O(M) per pose, so a scan's cost grew
+with the map (measured in ``docs/scaling.md``). With the buckets a cast looks only at the cells
+within range; the set of segments found, and so every range, is the same
+(``tests/test_kernels_raycast.py``).
 
 An index is the tuple ``(x0, y0, inv_cell, nx, ny, start, items)``: cell ``(i, j)`` (column,
 row; ``cell = 1 / inv_cell`` metres from ``(x0, y0)``) holds the segments ``items[start[c]:

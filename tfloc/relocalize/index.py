@@ -6,8 +6,8 @@ Every free lattice position (``step`` metres apart, ``clearance`` from the walls
 walls when it turns, so one signature per position cannot stand for all of them. A query finds
 the entries whose signatures lie nearest the real scan's and returns the best ``count`` distinct
 places. The search is brute force, one matrix-vector product: in 97 dimensions a KD-tree
-(scipy's ``cKDTree``) visits most of its leaves anyway; measured on the MIT CSAIL index
-(89 344 entries, 560 neighbours) it took 17.9 ms per query against 5.3 ms, same neighbours. The disk copy (``<cache>/<sha256>.npz``) is keyed by
+(scipy's ``cKDTree``) visits most of its leaves anyway, and was slower (``docs/tf-global.md``).
+The disk copy (``<cache>/<sha256>.npz``) is keyed by
 the map's content (:func:`map_digest`: segments and mapped area of a vector map, cells,
 resolution, origin and thresholds of a grid), the laser, the build parameters and
 :data:`VERSION`: a changed map, laser or parameter builds a new index, and an index is never
