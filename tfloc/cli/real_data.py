@@ -4,8 +4,10 @@ Writes OUT/scenarios/real-csail-relations/ and real-csail-relations-perturbed/ (
 1172 MIT CSAIL relations from the odometry guess and from perturbed guesses),
 OUT/scenarios/real-{intel,csail,aces}-scan-to-map/ (scan-to-map), their grid maps
 OUT/maps/real-{intel,csail,aces}.yaml|.pgm, OUT/scenarios/real-{intel,csail,aces}-sequence/
-(tracking: every scan in time order, odometry drawn from the corrected increments), and the
-map-style datasets
+(tracking, condition real-sparse: every corrected scan in time order, odometry simulated from the
+corrected increments), OUT/scenarios/real-{intel,csail,aces}-native/ (tracking, condition
+real-native: every raw scan from the first corrected one on, the robot's raw odometry, truth on the
+corrected scans; tfloc.datasets.real_native), and the map-style datasets
 OUT/scenarios/real-{intel,csail,aces}-<style>/ with their maps OUT/maps/styles/ (every 4th scan of
 each log on the same corrected scans drawn as other mapping tools draw them: as-built, hits-only,
 thick-1, thick-2, cartographer, gmapping, incomplete; tfloc.datasets.styles), and the
@@ -19,7 +21,7 @@ import argparse
 from pathlib import Path
 
 HELP = ("build the real-log scenario datasets (MIT CSAIL relations, Intel/CSAIL/ACES scan-to-map, "
-        "sequences, map styles and global sets)")
+        "sparse and native-rate sequences, map styles and global sets)")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -38,6 +40,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from tfloc.datasets.global_sets import build_global_real
     from tfloc.datasets.real import build_all
+    from tfloc.datasets.real_native import build_native
     from tfloc.datasets.real_sequences import build_sequences
     from tfloc.datasets.relations import build_relations
     from tfloc.datasets.styles import build_styles
@@ -45,6 +48,7 @@ def run(args: argparse.Namespace) -> int:
     for root in [*build_relations(args.real, args.out, args.seed),
                  *build_all(args.real, args.out, args.seed, args.resolution),
                  *build_sequences(args.real, args.out),
+                 *build_native(args.real, args.out),
                  *build_styles(args.real, args.out, args.seed, args.resolution),
                  *build_global_real(args.real, args.out)]:
         print(root)

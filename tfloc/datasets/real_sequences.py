@@ -1,17 +1,19 @@
-"""Real sequence datasets: the Intel, MIT CSAIL and ACES corrected logs in time order.
+"""Sparse real sequences: every corrected scan of the Intel, MIT CSAIL and ACES logs, simulated odometry.
 
 Each ``real-<log>-sequence`` holds every front-laser scan of the SLAM-corrected log in file order
-(the logs' order of recording), truth = the corrected pose, the robot starting at the first
-corrected pose, on the same grid map as the log's scan-to-map dataset (``data/maps/real-*.yaml``).
+(a median of every 4th (CSAIL), 11th (ACES) or 18th (Intel) scan of the
+original log), truth = the corrected pose, the robot starting at the
+first corrected pose, on the same grid map as the log's scan-to-map dataset
+(``data/maps/real-*.yaml``). Condition ``real-sparse``: "every corrected scan, simulated
+odometry". The logs' scans at their native rate with the robot's raw odometry are
+:mod:`tfloc.datasets.real_native` (``real-<log>-native``).
 
-**Odometry.** None of the three logs carries raw odometry (measured, data/real/PROVENANCE.md):
-the FLASER ``odom_*`` fields equal the corrected pose on every line, and dead reckoning over the
-ODOM messages stays within 0.3 m of the corrected end pose after 320–500 m (raw wheel odometry
-drifts by metres). So the odometry is drawn from the corrected increments with the odometry
-motion model (:mod:`tfloc.datasets.motion`), all α = :data:`ALPHA` (the simulated sequences'
-``low`` level), on the corrected trajectory cut into odometry steps of at most 0.1 m and 3°
+**Odometry.** Simulated: drawn from the corrected increments with the odometry motion model
+(:mod:`tfloc.datasets.motion`), all α = :data:`ALPHA` (the simulated sequences' ``low`` level),
+on the corrected trajectory cut into odometry steps of at most 0.1 m and 3°
 (:func:`~tfloc.datasets.motion.densify`: odometry runs at its own rate, not at the laser's),
-seeded per log.
+seeded per log. (The corrected logs' FLASER odometry fields hold the corrected pose, and their
+timed ODOM lines are raw odometry re-anchored at every corrected pose: data/real/PROVENANCE.md.)
 
 **Stamps.** The logs' ``ipc_timestamp`` where it increases strictly along the file (ACES);
 Intel (4 steps backwards) and CSAIL (corrected stamps spread over a constant 10 000 s with 404
@@ -38,6 +40,9 @@ from .real import (
 #: the α's of the drawn odometry (all four)
 ALPHA = 0.05
 SEQ_SEED = 20091201
+
+#: the condition of these sequences (their sequence set in reports)
+CONDITION = {"name": "real-sparse", "label": "every corrected scan, simulated odometry"}
 
 #: each bundled log (:data:`tfloc.datasets.real.REAL_LOGS`) with its title in the descriptions
 TITLES = {"intel": "Intel Research Lab", "csail": "MIT CSAIL", "aces": "ACES building, UT Austin"}
@@ -77,18 +82,19 @@ def build_sequences(real: Path, out: Path, seed: int = SEQ_SEED) -> list[Path]:
         made.append(write_scenario(
             out / "scenarios" / name, name, out / "maps" / f"real-{key}.yaml", laser, rows,
             description=(
-                f"Tracking on the {title} corrected log: all {len(rows)} front-laser scans in file "
-                f"order ({steps.sum():.0f} m; median {np.median(steps):.2f} m, max {steps.max():.2f} m "
-                f"and max {turns.max():.0f} deg between scans), true = corrected pose (pseudo ground "
-                "truth), start = the first corrected pose, map = the scan-to-map dataset's grid. "
-                "The log has no raw odometry (data/real/PROVENANCE.md): odom_* is drawn from the "
-                "corrected increments by the odometry motion model (Probabilistic Robotics Table "
-                "5.6) on steps of at most 0.1 m and 3 deg (odometry at its own rate), alphas {ALPHA:g}/{ALPHA:g}/{ALPHA:g}/{ALPHA:g}, seed {seed} child "
-                f"{int(ss.spawn_key[-1])}. "
+                f"Every corrected scan, simulated odometry: tracking on the {title} corrected log, all "
+                f"{len(rows)} front-laser scans in file order ({steps.sum():.0f} m; median "
+                f"{np.median(steps):.2f} m, max {steps.max():.2f} m and max {turns.max():.0f} deg between "
+                "scans), true = corrected pose (pseudo ground truth), start = the first corrected pose, "
+                "map = the scan-to-map dataset's grid. odom_* is simulated: drawn from the corrected "
+                "increments by the odometry motion model (Probabilistic Robotics Table 5.6) on steps of at "
+                f"most 0.1 m and 3 deg (odometry at its own rate), alphas {ALPHA:g}/{ALPHA:g}/{ALPHA:g}/"
+                f"{ALPHA:g}, seed {seed} child {int(ss.spawn_key[-1])}. (The log's scans at their native "
+                f"rate with the robot's raw odometry: real-{key}-native.) "
                 + ("stamp = the log's ipc_timestamp." if own else
                    "stamp = the scan's index in seconds (the log's stamps do not increase).")),
             mode=SEQUENCE,
-            condition={"name": "real", "odom_noise": "drawn", "alphas": [ALPHA] * 4,
+            condition={**CONDITION, "odom_noise": "drawn", "alphas": [ALPHA] * 4,
                        "slip": False, "people": False},
             generator={"command": "tfloc real-data", "seed": seed, "child": int(ss.spawn_key[-1])},
             source={"files": [f"data/real/{rel}"], "provenance": "data/real/*/PROVENANCE.md"}))

@@ -1,4 +1,5 @@
-"""CARMEN log reader (``.clf``/``.log``, optionally ``.gz``): FLASER/RLASER, ROBOTLASER1, ODOM, PARAM.
+"""CARMEN log reader (``.clf``/``.log``, optionally ``.gz``): FLASER/RLASER, ROBOTLASER1, ODOM, PARAM;
+and the raw scan files without timestamps (``*.flaser_no_timestamps.txt``, :func:`read_flaser_no_timestamps`).
 
 Strict: a known message with a truncated or garbled line raises
 :class:`~tfloc.errors.LogFormatError` naming ``file:line`` and the problem. ``#`` comments and
@@ -231,3 +232,76 @@ def read_carmen(path: str | Path) -> CarmenLog:
     if not lasers:
         raise LogFormatError(f"{path}: no laser scans (FLASER/RLASER/ROBOTLASER1) in the log")
     return CarmenLog(path, tuple(lasers), tuple(odom), params, dict(skipped))
+
+
+@dataclass(frozen=True, eq=False)
+class RawScans:
+    """Every scan of a log without timestamps (``*.flaser_no_timestamps.txt[.gz]``).
+
+    Attributes:
+        path: the file read.
+        ranges: ``(N, n)`` metres, as logged (no-return values kept).
+        odom: ``(N, 3)`` the robot's raw odometry pose of each scan (m, rad).
+        lines: ``(N,)`` 1-based line of each scan in the file, for messages.
+    Scan ``k`` is the ``k``-th laser scan of the original log (the file's ``scan_index``).
+    """
+
+    path: Path
+    ranges: np.ndarray
+    odom: np.ndarray
+    lines: np.ndarray
+
+
+def read_flaser_no_timestamps(path: str | Path) -> RawScans:
+    """Read ``<scan_index> <n_beams> r_1 … r_n x y theta`` lines (``#`` comments skipped).
+
+    Strict: the indices run 0, 1, 2, … in file order, every scan has the first scan's beam
+    count, every value is a finite number and no range is negative; otherwise
+    :class:`~tfloc.errors.LogFormatError` naming ``file:line``."""
+    path = Path(path)
+    text = read_text(path, LogFormatError, "raw scan file", latin1=True)
+    ranges: list[np.ndarray] = []
+    odom: list[np.ndarray] = []
+    lines: list[int] = []
+    n_beams = 0
+    for lineno, line in enumerate(text.splitlines(), start=1):
+        tok = line.split()
+        if not tok or tok[0].startswith("#"):
+            continue
+        where = f"{path}:{lineno}"
+        if len(tok) < 2 or not tok[0].isdecimal() or not tok[1].isdecimal():
+            raise LogFormatError(f"{where}: expected '<scan_index> <n_beams> ranges… x y theta', "
+                                 f"got {line[:40]!r}")
+        index, n = int(tok[0]), int(tok[1])
+        if index != len(ranges):
+            raise LogFormatError(f"{where}: scan index {index}, expected {len(ranges)} (indices run 0, 1, 2, …)")
+        if n == 0 or (n_beams and n != n_beams):
+            raise LogFormatError(f"{where}: {n} beams, expected {n_beams or 'at least 1'}")
+        n_beams = n
+        if len(tok) != n + 5:
+            raise LogFormatError(f"{where}: {len(tok)} fields, expected {n + 5} for {n} beams "
+                                 "(index, beam count, ranges, x y theta)")
+        try:
+            vals = np.array(tok[2:], dtype=float)
+        except ValueError:
+            bad = next(k for k, s in enumerate(tok[2:]) if not _is_number(s))
+            raise LogFormatError(f"{where}: field {bad + 3} is not a number: {tok[bad + 2][:20]!r}") from None
+        if not np.isfinite(vals).all():
+            k = int(np.argmin(np.isfinite(vals)))
+            raise LogFormatError(f"{where}: field {k + 3} is not finite: {tok[k + 2][:20]!r}")
+        if (vals[:n] < 0).any():
+            raise LogFormatError(f"{where}: negative range at beam {int(np.argmax(vals[:n] < 0))}")
+        ranges.append(vals[:n])
+        odom.append(vals[n:])
+        lines.append(lineno)
+    if not ranges:
+        raise LogFormatError(f"{path}: no scans in the file")
+    return RawScans(path, np.vstack(ranges), np.vstack(odom), np.array(lines, dtype=np.int64))
+
+
+def _is_number(s: str) -> bool:
+    try:
+        float(s)
+    except ValueError:
+        return False
+    return True
