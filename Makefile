@@ -101,16 +101,17 @@ robustness-full: $(STAMP)
 	$(BIN)/tfloc report results/robustness-full
 	$(BIN)/tfloc robustness results/robustness-full
 
-## The scaling study (issue 26): every matcher's CPU per scan against map area (300-20 000 m²,
+## The scaling study (tfloc scaling): every matcher's CPU per scan against map area (300-20 000 m²,
 ## vector and 5 cm grid), beam count (181-1081) and initial offset, and each map's preparation
-## time and memory → results/scaling/ (README.md, scaling.png; ~15 min CPU, one pinned core).
+## time and memory → results/scaling/ (README.md, scaling.png, study.json; ~15 min CPU, one pinned
+## core; resumed if interrupted).
 scaling: $(STAMP)
-	$(BIN)/python scripts/scaling.py --out results/scaling
+	$(BIN)/tfloc scaling --out results/scaling --regenerate
 
 ## Its fixed subsample, part of make bench: every axis and level, 9 scans per level, 9 per
 ## offset bin → results/scaling-quick/ (~3 min CPU).
 scaling-quick: $(STAMP)
-	$(BIN)/python scripts/scaling.py --quick --out results/scaling-quick
+	$(BIN)/tfloc scaling --quick --out results/scaling-quick --regenerate
 
 ## tf-plus's stages switched off in turn on the real logs, as-built and thickened grids, csm-corr
 ## beside it → results/tf-plus-ablation-real/ (benchmarks/tfplus-ablation-real.toml; ~10 min).

@@ -1,11 +1,11 @@
-"""The scaling study (scripts/scaling.py): tiling, the same scans at every size, the slope fits,
-and the study end to end on a tiny configuration."""
+"""The scaling study (tfloc scaling): tiling, the same scans at every size, the slope fits, and the
+verb end to end on a tiny configuration: its files, the harness's timer, resume and refusal."""
 
 from __future__ import annotations
 
-import importlib.util
+import json
 import math
-import sys
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -13,24 +13,22 @@ import pandas as pd
 import pytest
 import shapely
 
+from tfloc.cli import main
 from tfloc.core.laser import LaserSpec
 from tfloc.datasets.tiling import Tiling, tile_vector_map, tiling_for_area
 from tfloc.errors import ConfigError
 from tfloc.evaluation.scaling import fit_loglog, level_table, slope_table
+from tfloc.harness import workspace
+from tfloc.harness.scaling import StudyConfig, StudyDir, run_study, study_matchers
 from tfloc.io.geojson import read_vector_map
 from tfloc.maps.build import rasterize
 from tfloc.maps.vector import VectorMap
 
 ROOT = Path(__file__).resolve().parents[1]
 OFFICE = ROOT / "data" / "maps" / "office-1.geojson"
-
-
-def _study():
-    spec = importlib.util.spec_from_file_location("scaling_study", ROOT / "scripts" / "scaling.py")
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = mod  # dataclasses look their module up there
-    spec.loader.exec_module(mod)
-    return mod
+#: The tiny study: 2 areas × 2 kinds, the 4 lasers, the 3 offset bins; 2 scans each; 2 cheap matchers.
+TINY = ["--matchers", "tf-plus,cv-corners", "--areas", "300,1200", "--scans", "2", "--scans-per-bin", "2",
+        "--map", str(OFFICE), "--no-progress"]
 
 
 @pytest.fixture(scope="module")
@@ -116,49 +114,113 @@ def test_slope_table_from_levels():
     assert sl.loc["b", "ms_per_unit"] == pytest.approx(2.0, rel=1e-3)
 
 
-def test_study_end_to_end_on_a_tiny_configuration(tmp_path):
-    study = _study()
-    cfg = study.StudyConfig(areas_m2=(300.0, 1200.0), kinds=("vector", "grid"),
-                            lasers=((180.0, 1.0), (180.0, 0.5)), resolution_m=0.1, scans_per_level=2,
-                            scans_per_offset_bin=2, matchers=("tf-plus", "cv-corners"), warmup=1)
-    result = study.run_study(cfg, log=lambda s: None)
-    rows, prep = result["rows"], result["prep"]
+@pytest.fixture(scope="module")
+def study(tmp_path_factory):
+    """``tfloc scaling`` on the tiny configuration, with every call of the harness's timer
+    recorded: (the called function's name, its :class:`~tfloc.harness.workspace.Timed`)."""
+    out = tmp_path_factory.mktemp("scaling") / "study"
+    calls: list[tuple[str, workspace.Timed]] = []
+    real = workspace.timed
+
+    def spy(call, *args, **kwargs):
+        t = real(call, *args, **kwargs)
+        calls.append((getattr(call, "__name__", ""), t))
+        return t
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(workspace, "timed", spy)
+        assert main(["scaling", "--out", str(out), *TINY]) == 0
+    return out, calls
+
+
+def test_the_verb_end_to_end_on_a_tiny_configuration(study):
+    out, _ = study
+    for f in ("scaling.csv", "prep.csv", "skips.csv", "levels.csv", "slopes.csv", "README.md", "scaling.png",
+              "study.json"):
+        assert (out / f).stat().st_size > 0, f
+    rows, prep, skips = StudyDir(out).raw()
     # every (axis, kind, level) × matcher × scan once
     area = rows[rows["axis"] == "area"]
-    assert len(area) == 2 * 2 * 2 * 2 and len(rows[rows["axis"] == "beams"]) == 2 * 2 * 2
+    assert len(area) == 2 * 2 * 2 * 2 and len(rows[rows["axis"] == "beams"]) == 4 * 2 * 2
     assert len(rows[rows["axis"] == "offset"]) == 3 * 2 * 2
+    assert not rows.duplicated(["axis", "kind", "level", "matcher", "scan_id"]).any()
     # the same scans at every map size
     ids = area.groupby(["kind", "level"])["scan_id"].apply(lambda s: tuple(sorted(set(s))))
     assert ids.nunique() == 1
-    assert sorted(rows.loc[rows["axis"] == "beams", "beams"].unique()) == [181, 361]
-    assert (rows["cpu_ms"] > 0).all() and rows["success"].isin([0, 1]).all()
+    assert sorted(rows.loc[rows["axis"] == "beams", "beams"].unique()) == [181, 361, 721, 1081]
+    assert rows["status"].isin(["ok", "failed"]).all() and (rows["cpu_ms"] > 0).all()
+    assert rows["success"].isin([0, 1]).all() and not rows.loc[rows["status"] == "failed", "success"].any()
     assert (rows["sys_ms"] >= 0).all() and rows["sys_ms"].sum() <= rows["cpu_ms"].sum() * 1.05 + 20
+    # interleaved: each matcher first on every other scan
+    first = rows[rows["position"] == 0].groupby(["axis", "kind", "level"])["matcher"].nunique()
+    assert (first == 2).all()
     # preparation: the map itself and each matcher, for each area level and kind
     assert set(prep["matcher"]) == {"(map)", "tf-plus", "cv-corners"}
-    assert len(prep) == 3 * 2 * 2 and (prep["status"] == "ok").all()
+    assert len(prep) == 3 * 2 * 2 and (prep["status"] == "ok").all() and skips.empty
     grid = prep[(prep["kind"] == "grid") & (prep["matcher"] == "(map)")].sort_values("size")
     assert grid["cells"].iloc[1] > 3.5 * grid["cells"].iloc[0]
-    study.write_results(tmp_path, result, cfg, {"cores": [1], "cpu": "test"})
-    for f in ("scaling.csv", "prep.csv", "skips.csv", "levels.csv", "slopes.csv", "README.md", "scaling.png",
-              "study.json"):
-        assert (tmp_path / f).stat().st_size > 0, f
-    readme = (tmp_path / "README.md").read_text()
+    readme = (out / "README.md").read_text()
+    assert "Written by `tfloc scaling`" in readme and "issue" not in readme
     assert "**tf-plus**" in readme and "CPU per scan against map area, 5 cm grid" in readme
-    # the tables and README are redrawn from the raw files alone, the same
-    (tmp_path / "README.md").unlink()
-    study.render(tmp_path)
-    assert (tmp_path / "README.md").read_text() == readme
+    # the record of the code and configuration that made it
+    doc = json.loads((out / "study.json").read_text())
+    assert doc["config"]["scans_per_level"] == 2 and doc["config"]["matchers"] == ["tf-plus", "cv-corners"]
+    assert set(doc["fingerprint"]["matchers"]) == {"tf-plus", "cv-corners"}
+    assert "commit" in doc["git"] and "dirty" in doc["git"] and doc["versions"]["numpy"]
+    assert doc["machine"]["python"] and doc["done"] == doc["levels"] and len(doc["levels"]) == 4 + 4 + 3
+    (session,) = doc["sessions"]
+    assert session["started"] <= session["ended"] and len(session["cores"]) == 1 and session["cpu_s"] > 0
+    assert doc["command"].startswith("tfloc scaling --out ")
 
 
-def test_a_matcher_over_budget_is_not_run_at_larger_levels():
-    study = _study()
-    cfg = study.StudyConfig(areas_m2=(300.0, 1200.0, 5000.0), kinds=("vector",), axes=("area",),
-                            scans_per_level=2, matchers=("tf-plus",), budget_ms=1e-6)
-    result = study.run_study(cfg, log=lambda s: None)
-    assert set(result["rows"]["level"]) == {"1x1"}
-    skips = result["skips"]
+def test_the_study_times_with_the_harness_timer(study):
+    out, calls = study
+    rows, _, _ = StudyDir(out).raw()
+    timed = [1000.0 * t.cpu_s for name, t in calls if name == "localize"]
+    assert len(timed) == len(rows)
+    np.testing.assert_allclose(rows["cpu_ms"], timed, rtol=1e-5)
+
+
+def test_a_complete_study_is_only_redrawn(study, capsys):
+    out, _ = study
+    before = {f: (out / f).read_text() for f in ("scaling.csv", "prep.csv", "README.md", "study.json")}
+    assert main(["scaling", "--out", str(out), *TINY]) == 0
+    assert {f: (out / f).read_text() for f in before} == before
+    assert "slope" in capsys.readouterr().err
+
+
+def test_a_directory_of_another_configuration_is_refused(study, capsys):
+    out, _ = study
+    before = (out / "scaling.csv").read_text()
+    assert main(["scaling", "--out", str(out), *TINY[:5], "3", *TINY[6:]]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "holds a study of another configuration" in err
+    assert "scans_per_level 2 → 3" in err and "--regenerate" in err
+    assert (out / "scaling.csv").read_text() == before
+
+
+def test_an_interrupted_study_resumes_without_mixing_rows(study, tmp_path):
+    src, _ = study
+    out = tmp_path / "cut"
+    shutil.copytree(src, out)
+    doc = json.loads((out / "study.json").read_text())
+    doc["done"] = doc["done"][:-2]   # killed after the rows of the last two levels, before study.json
+    (out / "study.json").write_text(json.dumps(doc))
+    assert main(["scaling", "--out", str(out), *TINY]) == 0
+    rows, prep, _ = StudyDir(out).raw()
+    old, _, _ = StudyDir(src).raw()
+    assert len(rows) == len(old) and not rows.duplicated(["axis", "kind", "level", "matcher", "scan_id"]).any()
+    assert len(prep) == 3 * 2 * 2
+    doc = json.loads((out / "study.json").read_text())
+    assert doc["done"] == doc["levels"] and [s["levels_done_before"] for s in doc["sessions"]] == [0, 9]
+
+
+def test_a_matcher_over_budget_is_not_run_at_larger_levels(tmp_path):
+    cfg = StudyConfig(map_path=str(OFFICE), areas_m2=(300.0, 1200.0, 5000.0), kinds=("vector",), axes=("area",),
+                      scans_per_level=2, matchers=("tf-plus",), budget_ms=1e-6)
+    rows, prep, skips = run_study(cfg, tmp_path, log=lambda s: None).raw()
+    assert set(rows["level"]) == {"1x1"}
     assert list(skips["level"]) == ["2x2", "4x4"] and skips["why"].str.contains("> 1e-06 ms at 1x1").all()
-    prep = result["prep"]
     assert list(prep.loc[prep["matcher"] == "tf-plus", "status"]) == ["ok", "skipped", "skipped"]
 
 
@@ -172,14 +234,25 @@ def test_default_matchers_are_the_single_scan_local_ones():
     from tfloc.core.matcher import solves_global
     from tfloc.core.tracker import has_single_scan_mode
 
-    study = _study()
     logged: list[str] = []
-    chosen = study.build_matchers(None, logged.append)
+    chosen = study_matchers(None, logged.append)
     assert "tf-plus" in chosen and "tf" in chosen
     assert not any(solves_global(m) or not has_single_scan_mode(m) for m in chosen.values())
     left_out = " ".join(logged)
     assert "tf-global" in left_out and "a global matcher" in left_out
     assert "amcl" in left_out and "no single-scan mode" in left_out and "odometry" in left_out
-    named = study.build_matchers(["tf-global"], logged.append)
-    assert list(named) == ["tf-global"]  # named on the command line, it runs
-    assert list(study.build_matchers(["odometry"], logged.append)) == ["odometry"]
+    assert list(study_matchers(["tf-global"], logged.append)) == ["tf-global"]  # named, it runs
+    assert list(study_matchers(["odometry"], logged.append)) == ["odometry"]
+    logged.clear()
+    assert list(study_matchers(["tf-plus", "amcl"], logged.append)) == ["tf-plus"]  # a tracker never does
+    assert logged == ["left out: amcl (no single-scan mode)"]
+    with pytest.raises(ConfigError, match="registered matchers only"):
+        study_matchers(["toy_matchers:Stay"], logged.append)
+
+
+def test_bad_study_configurations_are_refused():
+    with pytest.raises(ConfigError, match="axis 'size'"):
+        StudyConfig(axes=("size",))
+    with pytest.raises(ConfigError, match="scans per level 0"):
+        StudyConfig(scans_per_level=0)
+    assert StudyConfig.quick().scans_per_level == 9 and StudyConfig().scans_per_level == 45

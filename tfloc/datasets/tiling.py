@@ -7,19 +7,28 @@ a gap (metres), so the tiles are disjoint buildings, each closed by its own outl
 the original, unmoved: a scan simulated in it sees only its own walls (the outline stops every
 beam), so it is the same scan at every size, and a grid rasterised from any tiling has the same
 cells under tile (0, 0) (the grid's frame starts at the map's lower-left corner).
+:func:`tile_scans` and :func:`scan_ranges` make those scans (the protocol's sampler, seeded).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numpy as np
 import shapely
 from shapely import affinity
 from shapely.geometry.base import BaseGeometry
 
+from tfloc.core.laser import LaserSpec
+from tfloc.core.pose import Pose
 from tfloc.errors import ConfigError
 from tfloc.maps.vector import VectorMap
+
+from .noise import NoiseModel
+from .protocol import strata
+from .synthetic import sample_pose_pair
 
 #: Metres between neighbouring tiles' bounding boxes (a wall's thickness).
 DEFAULT_GAP_M = 0.4
@@ -86,3 +95,36 @@ def tile_vector_map(tile: VectorMap, tiling: Tiling, name: str | None = None) ->
     return VectorMap(walls=tuple(walls), obstacles=tuple(obstacles),
                      outline=_union(outlines), region=_union(regions),
                      name=name or f"{tile.name}x{tiling.nx}x{tiling.ny}")
+
+
+@dataclass(frozen=True)
+class TileScan:
+    """One scan simulated in tile (0, 0): id, the protocol's offset cell and distance bin
+    (``0-1 m``), true and initial poses (metres, radians), and the seed of its range noise."""
+
+    scan_id: str
+    cell: str
+    offset_bin: str
+    truth: Pose
+    initial: Pose
+    noise_seed: int
+
+
+def tile_scans(tile: VectorMap, cells: Sequence[int], seed: int, prefix: str) -> tuple[TileScan, ...]:
+    """One scan per entry of ``cells`` (indices into the protocol's 3 × 3 strata), true and
+    initial poses from the protocol's sampler; seeded, ids ``<prefix><k:03d>``."""
+    rng = np.random.default_rng(seed)
+    cs = strata()
+    out = []
+    for k, c in enumerate(cells):
+        truth, init = sample_pose_pair(tile, cs[c], rng)
+        lo, hi = cs[c].dist_m
+        out.append(TileScan(f"{prefix}{k:03d}", cs[c].label, f"{lo:g}-{hi:g} m", truth, init,
+                            int(rng.integers(2**31))))
+    return tuple(out)
+
+
+def scan_ranges(tile: VectorMap, scan: TileScan, laser: LaserSpec) -> np.ndarray:
+    """The scan's ranges (metres) for ``laser``: ray-cast on ``tile`` at the truth, plus the
+    default noise from the scan's own seed (so a scan does not depend on which others are made)."""
+    return NoiseModel().apply(tile.raycast(scan.truth, laser), laser, np.random.default_rng(scan.noise_seed))

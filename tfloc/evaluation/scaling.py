@@ -1,11 +1,12 @@
 """How a matcher's cost grows: medians per level and log–log slopes (the scaling study).
 
-The study (``scripts/scaling.py``) times every matcher per scan while one thing grows: the map's
+The study (``tfloc scaling``) times every matcher per scan while one thing grows: the map's
 area, the scanner's beam count or the initial offset. Per (matcher, axis, map kind, level) the
 median CPU ms is taken; the slope of log(median CPU) against log(level) (least squares over the
 levels, each level one point) says how the cost grows: 0 = flat, 1 = linear. A matcher *grows*
 with an axis when the slope exceeds :data:`GROWS_SLOPE` (0.2: ×16 the area costs ×1.74 or more).
-The same fit is applied to preparation CPU time and memory against map area.
+The same fit is applied to preparation CPU time and memory against map area. A matcher over
+the study's budgets at a level (:func:`over_budget`) is not run at the larger levels of that axis.
 """
 
 from __future__ import annotations
@@ -27,6 +28,8 @@ SCAN_COLUMNS = ["matcher", "axis", "kind", "level", "size", "tiles", "beams", "f
 #: the map itself (building it; its own arrays).
 PREP_COLUMNS = ["matcher", "kind", "tiles", "size", "cells", "segments", "prep_cpu_s",
                 "prep_wall_s", "rss_delta_mb", "peak_mb", "status"]
+#: Columns of the rows of matchers not run at a level (``skips.csv``).
+SKIP_COLUMNS = ["axis", "kind", "level", "size", "matcher", "why"]
 
 
 @dataclass(frozen=True)
@@ -109,3 +112,19 @@ def prep_slope_table(prep: pd.DataFrame) -> pd.DataFrame:
         out.append({"kind": kind, "matcher": matcher, "time_slope": t.slope, "memory_slope": m.slope,
                     "maps": t.n})
     return pd.DataFrame(out)
+
+
+def over_budget(rows: pd.DataFrame, prep: pd.DataFrame, level: str, budget_ms: float,
+                prep_budget_s: float | None = None) -> dict[str, str]:
+    """The matchers of one level's rows (``SCAN_COLUMNS``) over a budget, each with why: median
+    CPU per scan above ``budget_ms`` (ms), or preparation CPU (``prep``'s ``prep_cpu_s``) above
+    ``prep_budget_s`` (s; ``None``: not checked). A matcher without a finite median is not."""
+    med = rows.groupby("matcher", sort=False)["cpu_ms"].median()
+    prep_s = dict(zip(prep["matcher"], prep["prep_cpu_s"], strict=True)) if len(prep) else {}
+    out = {}
+    for m, ms in med.items():
+        if ms > budget_ms:
+            out[m] = f"median {ms:.0f} ms > {budget_ms:g} ms at {level}"
+        elif prep_budget_s is not None and prep_s.get(m, 0.0) > prep_budget_s:
+            out[m] = f"prepare {prep_s[m]:.0f} s > {prep_budget_s:g} s at {level}"
+    return out

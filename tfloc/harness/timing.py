@@ -19,6 +19,9 @@ conditions:
 :func:`run_timing` returns one row per (scan, matcher) (``TIMING_COLUMNS``); ``tfloc timing``
 writes them to ``RUN/timing.csv`` and the summary (:mod:`tfloc.evaluation.timing`) to
 ``RUN/timing.md``.
+
+The pinning (:func:`pinned`) and the interleaving (:func:`rotated`) are also the scaling study's
+(:mod:`tfloc.harness.scaling`).
 """
 
 from __future__ import annotations
@@ -26,8 +29,10 @@ from __future__ import annotations
 import json
 import os
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 import pandas as pd
@@ -41,6 +46,7 @@ from .workspace import load_dataset, load_matcher, problem_of, timed_localize, w
 
 TIMING_COLUMNS = ["dataset", "scan_id", "group", "matcher", "position", "cpu_ms", "wall_ms"]
 SEED = 20261130
+T = TypeVar("T")
 
 
 def read_run(run_dir: Path) -> tuple[pd.DataFrame, RunInfo]:
@@ -82,6 +88,27 @@ def pin(cores: Sequence[int]) -> list[int]:
     return []
 
 
+@contextmanager
+def pinned(cores: Sequence[int] | None = None) -> Iterator[list[int]]:
+    """The block runs pinned to ``cores`` (default: the last core this process may run on), every
+    library on one thread; yields the cores it runs on, and restores the affinity after."""
+    before = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []
+    try:
+        now = pin(before[-1:] if cores is None else cores)
+        limit_threads(1)
+        yield now
+    finally:
+        if before:
+            os.sched_setaffinity(0, before)
+
+
+def rotated(items: Sequence[T], i: int) -> list[tuple[int, T]]:
+    """Scan ``i``'s order of ``items`` (matchers): rotated by ``i``, each with its position, so
+    that slow drifts of the machine hit every matcher alike."""
+    k = len(items)
+    return [(pos, items[(i + pos) % k]) for pos in range(k)]
+
+
 def run_timing(run_dir: Path, per_stratum: int = 4, seed: int = SEED, cores: Sequence[int] | None = None,
                warmup: int = 2, progress: Callable[[int, int], None] | None = None,
                run: tuple[pd.DataFrame, RunInfo] | None = None) -> tuple[pd.DataFrame, dict]:
@@ -97,17 +124,10 @@ def run_timing(run_dir: Path, per_stratum: int = 4, seed: int = SEED, cores: Seq
     sample = sample_scans(df, per_stratum, seed)
     if sample.empty:
         raise ConfigError(f"{run_dir}: no scan that every matcher answered")
-    before = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []
-    cores = before[-1:] if cores is None else cores
     started, load_start = time.strftime("%Y-%m-%dT%H:%M:%S%z"), load_average()
-    try:
-        pinned = pin(cores)
-        limit_threads(1)
+    with pinned(cores) as on:
         rows = _time_sample(sample, specs, paths, warmup, progress)
-    finally:
-        if before:
-            os.sched_setaffinity(0, before)
-    info = {"cores": pinned, "per_stratum": per_stratum, "seed": seed, "warmup": warmup,
+    info = {"cores": on, "per_stratum": per_stratum, "seed": seed, "warmup": warmup,
             "scans": len(sample), "strata": int(sample.groupby(["dataset", "group"]).ngroups),
             "loadavg_start": load_start, "loadavg_end": load_average(), "started": started,
             "git": git_state(), "run_git": info_run.doc.get("git", {})}
@@ -131,12 +151,10 @@ def _time_sample(sample: pd.DataFrame, specs: list[dict], paths: dict[str, Path]
             for scan in first[:warmup]:
                 m.localize(problem_of(scenario, scan))
     rows = []
-    k = len(matchers)
     for i, r in enumerate(sample.itertuples(index=False)):
         scenario, scans = problems[r.dataset]
         scan = scans[r.scan_id]
-        for pos in range(k):
-            label, m = matchers[(i + pos) % k]
+        for pos, (label, m) in rotated(matchers, i):
             t = timed_localize(m, problem_of(scenario, scan))
             rows.append({"dataset": r.dataset, "scan_id": r.scan_id, "group": r.group, "matcher": label,
                          "position": pos, "cpu_ms": 1000.0 * t.cpu_s, "wall_ms": 1000.0 * t.wall_s})

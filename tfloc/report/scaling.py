@@ -1,7 +1,8 @@
 """The scaling study's README (tables, slopes, one sentence per matcher) and its figure.
 
-Inputs are the tables of :mod:`tfloc.evaluation.scaling` (levels, slopes, preparation rows); the
-study itself is ``scripts/scaling.py``.
+Inputs are the tables of :mod:`tfloc.evaluation.scaling` (levels, slopes, preparation rows);
+:func:`render` derives them from the study's raw rows. The study itself is ``tfloc scaling``
+(:mod:`tfloc.harness.scaling`).
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from tfloc.evaluation.scaling import GROWS_SLOPE
+from tfloc.evaluation.scaling import GROWS_SLOPE, level_table, prep_slope_table, slope_table
 
 from .figures import colours
 from .mdtable import num, table
@@ -184,18 +185,20 @@ def write_readme(path: Path, rows: pd.DataFrame, levels: pd.DataFrame, slopes: p
     """The study's README.md."""
     load0, load1 = provenance.get("loadavg_start", []), provenance.get("loadavg_end", [])
     lines = ["# Scaling study: CPU per scan against map area, beam count and initial offset", "",
-             "Written by `scripts/scaling.py` (issue 26, item 3); do not edit by hand: "
-             f"`{provenance.get('command', 'python scripts/scaling.py')}` "
-             "regenerates it.", "",
+             "Written by `tfloc scaling`; do not edit by hand: "
+             f"`{provenance.get('command') or 'tfloc scaling'}` regenerates it.", "",
              "**Conditions.** One process pinned to one core "
              f"({provenance.get('cores')}), every library on one thread; per-scan CPU time "
-             "(`time.process_time`) of `localize` alone, matchers interleaved scan by scan (order "
-             "rotated per scan), after `prepare` and an untimed warm-up. "
+             "(`time.process_time`, the harness's timer) of `localize` alone, matchers interleaved "
+             "scan by scan (order rotated per scan), after `prepare` and an untimed warm-up. "
              f"Machine: {provenance.get('cpu', '?')}, Python {provenance.get('python', '?')}; "
+             f"{_code(provenance.get('git'))}; "
              f"**the machine was shared** with other jobs (load average {load0} at the start, "
              f"{load1} at the end): CPU times are robust to that, wall times are not. Started "
              f"{provenance.get('started', '?')}, {provenance.get('wall_s', '?')} s wall"
-             + (f", {provenance['cpu_s']} s CPU in all." if "cpu_s" in provenance else "."), "",
+             + (f", {provenance['cpu_s']} s CPU in all" if "cpu_s" in provenance else "")
+             + (f" over {provenance['sessions']} sessions (resumed)." if provenance.get("sessions", 1) > 1
+                else "."), "",
              "**Problems.** The office floor `" + str(config.get("map_path")) + "` tiled n × n "
              "(tiles 0.4 m apart, each closed by its own outline); scans simulated in tile (0, 0) "
              "(LMS200 model plus 1 cm noise, seeded), so the same scans at every map size. Initial "
@@ -238,9 +241,31 @@ def write_readme(path: Path, rows: pd.DataFrame, levels: pd.DataFrame, slopes: p
     lines += ["## Files", "", "- `scaling.csv`: one row per (matcher, axis, level, scan): CPU and wall "
               "ms, errors, success.", "- `levels.csv`: medians per level; `slopes.csv`: the fits.",
               "- `prep.csv`: preparation per (matcher, map): CPU and wall s, retained RSS (MB).",
-              "- `study.json`: the configuration and the machine.", ""]
+              "- `study.json`: the configuration, its fingerprint, the code, versions and machine, "
+              "the sessions.", ""]
     path.write_text("\n".join(lines))
     return path
+
+
+def _code(git: dict | None) -> str:
+    """The code that made the study: its commit, and whether the tree had uncommitted changes."""
+    if not git or not git.get("commit"):
+        return "code not recorded"
+    return f"code `{git['commit'][:7]}`" + (" with uncommitted changes" if git.get("dirty") else "")
+
+
+def render(out: Path, rows: pd.DataFrame, prep: pd.DataFrame, skips: pd.DataFrame, config: dict,
+           provenance: dict) -> pd.DataFrame:
+    """``levels.csv``, ``slopes.csv``, ``scaling.png`` and ``README.md`` in ``out`` from the
+    study's raw rows (``scaling.csv``, ``prep.csv``, ``skips.csv``), its configuration and how it
+    was made (:func:`tfloc.harness.scaling.provenance`); returns the slopes."""
+    levels = level_table(rows)
+    slopes = slope_table(levels)
+    levels.to_csv(out / "levels.csv", index=False, float_format="%.6g")
+    slopes.to_csv(out / "slopes.csv", index=False, float_format="%.4g")
+    write_figure(out / "scaling.png", levels, slopes, prep)
+    write_readme(out / "README.md", rows, levels, slopes, prep, prep_slope_table(prep), skips, config, provenance)
+    return slopes
 
 
 def _plain_ticks(ax) -> None:
