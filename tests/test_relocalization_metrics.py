@@ -123,3 +123,21 @@ def test_summarize_rows_names_the_line_of_a_bad_row() -> None:
     bad["info"] = '{"hypotheses": [[1, 2]]}'
     with pytest.raises(ResultsError, match=r"run/estimates.csv:9: info 'hypotheses'\[0\]"):
         summarize_rows([*good, (9, bad)], T, path="run/estimates.csv")
+
+
+def test_place_rank_and_recall_from_the_proposed_places():
+    from tfloc.evaluation.relocalization import place_rank
+
+    truth = Pose(1.0, 2.0, 0.3)
+    places = [[5.0, 5.0, 0.3], [1.3, 2.2, 0.5], [1.0, 2.0, 0.3]]   # the second is within 0.5 m, 25°
+    assert place_rank(places, truth) == 2
+    assert place_rank([[1.0, 2.0, 0.3 + math.radians(30)]], truth) == 0   # too far turned
+    assert place_rank([], truth) is None
+    row = {"dataset": "d", "matcher": "m", "status": "ok", "true_x": 1.0, "true_y": 2.0, "true_theta": 0.3,
+           "est_x": 1.0, "est_y": 2.0, "est_theta": 0.3, "cpu_s": 0.01, "score_est": "", "score_true": "",
+           "info": json.dumps({"proposed": places})}
+    far = dict(row, info=json.dumps({"proposed": places[:1]}))
+    (s,) = summarize([result_from_row(row, Thresholds()), result_from_row(far, Thresholds())])
+    assert (s.place_recall1, s.place_recall5, s.place_recall_all) == (0.0, 0.5, 0.5)
+    (plain,) = summarize([result_from_row(dict(row, info="{}"), Thresholds())])
+    assert math.isnan(plain.place_recall_all)

@@ -8,7 +8,12 @@ Per scan (:func:`scan_result`), with the run's :class:`~tfloc.evaluation.outcome
 * **ambiguous**: the answer is wrong and the matcher's own score prefers it to the truth
   (:func:`~tfloc.evaluation.outcome.failure_kind`, the suite's one rule), so no better search
   could have saved it; unknown when either score is missing;
-* no answer (status not ``ok``): neither top-1 nor top-5.
+* no answer (status not ``ok``): neither top-1 nor top-5;
+* **place rank**: where a matcher records the places it considered before resolving them
+  (``info["proposed"]``, best first: ``tf-global``'s index), the rank of the first within
+  :data:`PLACE_DIST_M` and :data:`PLACE_ANGLE_DEG` of the truth (the resolver's reach); 0 = none
+  was, so the index, not the resolution, missed the scan. Summarised as place recall @1, @5 and
+  over all places proposed.
 
 Per (dataset, matcher) (:func:`summarize`): the rates with Wilson 95 % intervals, the ambiguous
 and no-answer shares, the median CPU ms per scan and that cost against the map's free area
@@ -18,6 +23,7 @@ JSON as ``"hypotheses": [[x, y, theta], ...]`` (:func:`hypotheses_from_info` rea
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from collections.abc import Iterable, Mapping, Sequence
@@ -35,6 +41,8 @@ from .stats import wilson
 
 TOP_K = 5
 HYPOTHESES_KEY = "hypotheses"
+PROPOSED_KEY = "proposed"
+PLACE_DIST_M, PLACE_ANGLE_DEG = 0.5, 25.0
 
 
 def hypotheses_info(hypotheses: Sequence[Pose], k: int = TOP_K) -> list[list[float]]:
@@ -82,6 +90,32 @@ class ScanResult:
     top5: bool
     ambiguous: bool | None  # None: a score is missing, so it cannot be told
     cpu_s: float
+    place_rank: int | None = None  # 1-based; 0: not proposed; None: no places recorded
+
+
+def place_rank(places: Sequence[Sequence[float]] | None, truth: Pose) -> int | None:
+    """The 1-based rank of the first of ``places`` (``[x, y, theta]``, best first) within
+    :data:`PLACE_DIST_M` and :data:`PLACE_ANGLE_DEG` of ``truth``; 0 if none is, ``None`` if
+    there are no places."""
+    if not places:
+        return None
+    p = np.asarray(places, dtype=float).reshape(-1, 3)
+    near = (np.hypot(p[:, 0] - truth.x, p[:, 1] - truth.y) <= PLACE_DIST_M) & (
+        np.degrees(np.abs(angdiff(p[:, 2], truth.theta))) <= PLACE_ANGLE_DEG)
+    hit = np.flatnonzero(near)
+    return int(hit[0]) + 1 if hit.size else 0
+
+
+def _proposed(info: Any) -> list | None:
+    """``info["proposed"]`` of a row (JSON text or dict), or None."""
+    if isinstance(info, str):
+        try:
+            info = json.loads(info) if info.strip() else {}
+        except json.JSONDecodeError:
+            return None
+    got = info.get(PROPOSED_KEY) if isinstance(info, Mapping) else None
+    ok = isinstance(got, list) and all(isinstance(h, list) and len(h) == 3 for h in got)
+    return got if ok else None
 
 
 def _within(p: Pose, truth: Pose, thresholds: Thresholds) -> bool:
@@ -125,9 +159,10 @@ def result_from_row(row: Mapping[str, Any], thresholds: Thresholds, where: str =
     if status.startswith("invalid") or not truth.is_finite():
         return None
     answer = Pose(*(_num(row, f"est_{c}") for c in ("x", "y", "theta"))) if status == "ok" else None
-    return scan_result(str(row.get("dataset", "")), str(row.get("matcher", "")), truth, answer,
-                       hypotheses_from_info(row.get("info"), where), thresholds,
-                       _num(row, "score_est"), _num(row, "score_true"), _num(row, "cpu_s"))
+    r = scan_result(str(row.get("dataset", "")), str(row.get("matcher", "")), truth, answer,
+                    hypotheses_from_info(row.get("info"), where), thresholds,
+                    _num(row, "score_est"), _num(row, "score_true"), _num(row, "cpu_s"))
+    return dataclasses.replace(r, place_rank=place_rank(_proposed(row.get("info")), truth))
 
 
 @dataclass(frozen=True)
@@ -152,6 +187,9 @@ class GlobalSummary:
     cpu_ms_median: float
     free_area_m2: float
     ms_per_100m2: float
+    place_recall1: float = math.nan  # NaN: the matcher records no places
+    place_recall5: float = math.nan
+    place_recall_all: float = math.nan
 
 
 def summarize(results: Iterable[ScanResult],
@@ -169,10 +207,13 @@ def summarize(results: Iterable[ScanResult],
         cpu = cpu[np.isfinite(cpu)]
         med = float(np.median(cpu) * 1e3) if cpu.size else math.nan
         area = float((free_area or {}).get(ds, math.nan))
+        ranks = [r.place_rank for r in rs if r.place_rank is not None]
+        recall = [sum(0 < k <= top for k in ranks) / len(ranks) if ranks else math.nan
+                  for top in (1, TOP_K, 10**9)]
         out.append(GlobalSummary(
             ds, m, n, k1 / n, *wilson(k1, n), k5 / n, *wilson(k5, n),
             sum(bool(r.ambiguous) for r in rs) / n, sum(not r.answered for r in rs) / n, med, area,
-            med / area * 100.0 if area > 0 else math.nan))
+            med / area * 100.0 if area > 0 else math.nan, *recall))
     return out
 
 

@@ -147,7 +147,7 @@ class TurningFunctionGlobalMatcher:
         if cfg.resolve == "batched":
             ranked, cost, evaluations = resolve_places(problem, idx.poses[entries], cfg.resolver,
                                                        cfg.refined)
-            return self._answer(ranked, cost, len(entries), evaluations, sig_dist)
+            return self._answer(ranked, cost, idx.poses[entries], evaluations, sig_dist)
         poses, costs, evaluations = [], [], 0
         for e in entries:
             guess = dataclasses.replace(problem, initial=Pose.from_array(idx.poses[e]))
@@ -160,22 +160,25 @@ class TurningFunctionGlobalMatcher:
         if not poses:
             return Estimate(Pose(math.nan, math.nan, math.nan), False, 1, evaluations,
                             {"status": "no-answer", "reason": "no place resolved"})
-        return self._answer(np.asarray(poses), np.asarray(costs), len(entries), evaluations, sig_dist)
+        return self._answer(np.asarray(poses), np.asarray(costs), idx.poses[entries], evaluations, sig_dist)
 
-    def _answer(self, poses: np.ndarray, costs: np.ndarray, places: int, evaluations: int,
+    def _answer(self, poses: np.ndarray, costs: np.ndarray, places: np.ndarray, evaluations: int,
                 sig_dist: np.ndarray) -> Estimate:
         """The estimate: resolved ``poses`` ranked by their selection ``costs``, the best
-        distinct ones as hypotheses."""
+        distinct ones as hypotheses; ``info["proposed"]`` keeps the index's ``places`` ``(P, 3)``
+        in signature order (millimetres, milliradians), so a report can tell a place the index
+        never proposed from one the resolution missed."""
         cfg = self.config
         order = np.argsort(costs, kind="stable")
         ranked = poses[order]
         keep = distinct(ranked, cfg.hypotheses, cfg.hypothesis_separation,
                         cfg.hypothesis_heading_separation)
         hyps = tuple(Pose.from_array(ranked[k]) for k in keep)
-        info = {"status": "ok", "mode": "global", "places": places,
+        info = {"status": "ok", "mode": "global", "places": len(places),
+                "proposed": np.round(np.asarray(places, dtype=float), 3).tolist(),
                 "cost": float(costs[order[0]]), "costs": [float(costs[order[k]]) for k in keep],
                 "signature_distance": float(sig_dist[0]) if len(sig_dist) else math.nan}
-        return Estimate(hyps[0], True, places, evaluations, info, hyps)
+        return Estimate(hyps[0], True, len(places), evaluations, info, hyps)
 
     def score(self, problem: Problem, pose: Pose | None) -> float:
         """``tf-plus``'s selection objective at ``pose`` (the root mean square of the truncated

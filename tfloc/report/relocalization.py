@@ -42,6 +42,14 @@ def relocalization_section(df: pd.DataFrame, maps: dict[str, object], out_dir: P
             "hypotheses within them (what a robot could tell apart by moving); ambiguous = a wrong answer "
             "the matcher's own score prefers to the truth; CPU per scan with the map's index or grids "
             "built beforehand (their build time is reported apart).\n", table]
+    placed = [x for x in summary if x.place_recall_all == x.place_recall_all]  # not NaN
+    if placed:
+        text.append("\nPlaces the index proposed (where the matcher records them): place recall @k = "
+                    "the share of scans with a proposed place within 0.5 m and 25° of the truth among "
+                    "its k best (the resolution's reach); what recall misses, the index never offered.\n")
+        text.append(md_table(["dataset", "matcher", "place recall @1 %", "@5 %", "all proposed %"],
+                             [[x.dataset, x.matcher, num(100 * x.place_recall1, 1), num(100 * x.place_recall5, 1),
+                               num(100 * x.place_recall_all, 1)] for x in placed]))
     if len(invalid):
         text.append("Local matchers given these problems got `invalid:` rows (nothing ran): "
                     + ", ".join(f"`{m}` {n}" for m, n in invalid.items()) + ".\n")
