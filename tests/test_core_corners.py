@@ -4,17 +4,11 @@ import math
 
 import numpy as np
 import pytest
+from _tf_oracles import is_line, merge_lines, straws
 from shapely.geometry import box
 
 from tfloc import LaserSpec, Pose, VectorMap
-from tfloc.paper.corners import (
-    corner_candidates,
-    is_line,
-    merge_lines,
-    resample,
-    shortstraw,
-    straws,
-)
+from tfloc.paper.corners import corner_candidates, resample, shortstraw
 
 
 def test_resample_is_equidistant_and_keeps_endpoints():

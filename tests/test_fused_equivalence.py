@@ -9,11 +9,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 from _tf_cases import TRUE, noisy_scan
+from _tf_oracles import step_by_step_tf
+from _tfplus_oracles import step_by_step_tfplus
 from numba import njit
 
 from tfloc.core.laser import LaserSpec
 from tfloc.core.pose import Pose
-from tfloc.tfplus import refine as refine_module
 from tfloc.tfplus.refine import RefineConfig, _virtual_geometry, refine
 from tfloc.tfplus.virtual_kernel import virtual_geometry_kernel
 
@@ -79,15 +80,15 @@ def test_fused_vector_refinement_is_bit_identical(config: RefineConfig, test_roo
         points = lms200.to_points(noisy_scan(test_room, lms200, TRUE, seed))
         poses = _poses(rng, 4)
         fused = refine(test_room, lms200, points, poses, config)
-        monkeypatch.setattr(refine_module, "_FUSED", False)
-        loop = refine(test_room, lms200, points, poses, config)
-        monkeypatch.setattr(refine_module, "_FUSED", True)
+        with monkeypatch.context() as mp:
+            step_by_step_tfplus(mp)
+            loop = refine(test_room, lms200, points, poses, config)
         assert fused.shape == loop.shape and fused.tobytes() == loop.tobytes()
 
 
 def test_grid_scores_kernel_equals_the_plain_sum(test_room, lms200) -> None:
     from tfloc.maps.fields import distance_field
-    from tfloc.tfplus.kernels import grid_scores_kernel
+    from tfloc.tfplus.coarse_kernel import grid_scores_kernel
 
     f = distance_field(test_room, 0.05, 0.3)
     points = np.ascontiguousarray(lms200.to_points(noisy_scan(test_room, lms200, TRUE))[::9])
@@ -114,7 +115,7 @@ def test_grid_scores_on_a_lattice_equal_the_plain_sum(test_room, lms200) -> None
     of cells (the plain path)."""
     from tfloc.maps.fields import distance_field
     from tfloc.tfplus.coarse import _offsets
-    from tfloc.tfplus.kernels import grid_scores_kernel
+    from tfloc.tfplus.coarse_kernel import grid_scores_kernel
 
     f = distance_field(test_room, 0.05, 0.3)
     table, (ox, oy) = f.distance, f.corner
@@ -150,14 +151,13 @@ def _office_problems(count: int):
 def test_compiled_tf_search_gives_the_python_answers(name: str,
                                                      monkeypatch: pytest.MonkeyPatch) -> None:
     from tfloc.core.matcher import get_matcher
-    from tfloc.paper import matcher as paper_matcher
 
     m = get_matcher(name)
     for problem in _office_problems(1):
         fast = m.localize(problem)
-        monkeypatch.setattr(paper_matcher, "_FUSED", False)
-        slow = m.localize(problem)
-        monkeypatch.setattr(paper_matcher, "_FUSED", True)
+        with monkeypatch.context() as mp:
+            step_by_step_tf(mp)
+            slow = m.localize(problem)
         assert (fast.pose, fast.converged, fast.iterations, fast.evaluations, fast.info) == \
             (slow.pose, slow.converged, slow.iterations, slow.evaluations, slow.info)
 
@@ -206,7 +206,7 @@ def _pairs_reference(points, delta, q, normal, angle_min, resolution, window, ga
 
 
 def test_pairs_kernel_equals_the_reference(test_room, lms200) -> None:
-    from tfloc.tfplus.kernels import pairs_kernel
+    from tfloc.tfplus.virtual_kernel import pairs_kernel
 
     rng = np.random.default_rng(11)
     points = lms200.to_points(noisy_scan(test_room, lms200, TRUE, 3))
@@ -265,7 +265,7 @@ def _rotation_cases(test_room, lms200):
 
 
 def test_fft_rotation_candidates_equal_the_step_by_step_histograms(test_room, lms200) -> None:
-    from tfloc.tfplus.headings import rotation_candidates_fft
+    from _tfplus_oracles import rotation_candidates_fft
 
     for real, virtual, skip in _rotation_cases(test_room, lms200):
         shifts, c, order = _fft_rotations(real, virtual, skip)
@@ -278,13 +278,9 @@ def test_fft_rotation_candidates_equal_the_step_by_step_histograms(test_room, lm
 def test_rotation_candidates_are_the_fft_peaks_above_rounding_noise(test_room, lms200) -> None:
     """The direct correlation gives the FFT's real peaks, in its order, and drops the local
     maxima of its rounding noise; the values agree to rounding."""
-    from tfloc.tfplus.headings import (
-        _NOISE,
-        _correlation,
-        _pair_kernel,
-        _raw_histograms,
-        rotation_candidates,
-    )
+    from _tfplus_oracles import rotation_candidates
+
+    from tfloc.tfplus.headings import _NOISE, _correlation, _pair_kernel, _raw_histograms
 
     fewer = 0
     for real, virtual, skip in _rotation_cases(test_room, lms200):
@@ -301,7 +297,7 @@ def test_rotation_candidates_are_the_fft_peaks_above_rounding_noise(test_room, l
 
 
 def test_smallest_kernel_orders_by_score_then_index() -> None:
-    from tfloc.tfplus.kernels import smallest_kernel
+    from tfloc.tfplus.coarse_kernel import smallest_kernel
 
     rng = np.random.default_rng(8)
     for n in (0, 1, 7, 64, 65, 500, 3000):
@@ -312,7 +308,9 @@ def test_smallest_kernel_orders_by_score_then_index() -> None:
 
 
 def test_coarse_candidates_are_the_shortlist_rescored_and_thinned(test_room, lms200) -> None:
-    from tfloc.tfplus.coarse import best_candidates, candidates, grid_scores, lattice, pose_scores
+    from _tfplus_oracles import grid_scores
+
+    from tfloc.tfplus.coarse import best_candidates, candidates, lattice, pose_scores
     from tfloc.tfplus.view import map_view
 
     field = map_view(test_room, 0.05, 0.3, 0.3)
@@ -367,8 +365,10 @@ def test_compiled_selection_cost_equals_the_numpy_steps(grid: bool, test_room, l
 def test_tf_plus_scan_rotations_equal_the_step_by_step_ones(test_room, lms200) -> None:
     """The seeds' fused call (both turning functions, histograms, correlation, peaks) gives the
     rotations of the step-by-step turning functions, and None where a polygon is degenerate."""
+    from _tfplus_oracles import rotation_candidates
+
     from tfloc.paper.shape import ShapeConfig, scan_turning_function
-    from tfloc.tfplus.headings import rotation_candidates, scan_rotations
+    from tfloc.tfplus.headings import scan_rotations
 
     rng = np.random.default_rng(6)
     for shape in (ShapeConfig(spacing=0.05), ShapeConfig(spacing=0.05, resampling="path"),
@@ -450,8 +450,8 @@ def test_compiled_tf_search_gives_up_to_python_near_boundaries(
             problem.ranges, problem.laser, m.config.shape))
         gave_up += m._search_compiled(problem, cost) is None
         fast = m.localize(problem)
-        monkeypatch.setattr(paper_matcher, "_FUSED", False)
-        slow = m.localize(problem)
-        monkeypatch.setattr(paper_matcher, "_FUSED", True)
+        with monkeypatch.context() as mp:
+            step_by_step_tf(mp)
+            slow = m.localize(problem)
         assert (fast.pose, fast.evaluations, fast.info) == (slow.pose, slow.evaluations, slow.info)
     assert gave_up > 0

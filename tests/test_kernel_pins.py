@@ -27,17 +27,14 @@ import os
 
 import numpy as np
 import pytest
+from _tf_oracles import _match_l1, resample_path
 from tfloc.baselines._corner_match import pair_hypotheses, search_hypotheses
 
 from tfloc.maps._gridcast import carve_grid, raycast_grid
-from tfloc.paper.corners import resample, resample_path
-from tfloc.paper.turning import _match, _match_l1, turning_function
-from tfloc.tfplus.kernels import (
-    face_depths_kernel,
-    field_pairs_kernel,
-    refine_field_kernel,
-    see_through_kernel,
-)
+from tfloc.paper.corners import resample
+from tfloc.paper.turning import _match, turning_function
+from tfloc.tfplus.cost_kernel import see_through_kernel
+from tfloc.tfplus.field_kernel import face_depths_kernel, field_pairs_kernel, refine_field_kernel
 
 pytestmark = pytest.mark.bitwise
 

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from _tf_oracles import merge_lines
 from numba import njit
 
 from tfloc.core.laser import LaserSpec
 from tfloc.core.pose import Pose
 from tfloc.maps.vector import VectorMap
-from tfloc.paper.corners import _resample_into, corner_candidates, merge_lines, resample, shortstraw
+from tfloc.paper.corners import _resample_into, corner_candidates, resample, shortstraw
 
 
 # --- oracles: the implementations before the numba rewrite, verbatim -------------------------

@@ -7,13 +7,14 @@ from __future__ import annotations
 
 import math
 
+import _tf_oracles
 import numpy as np
 import pytest
+from _tf_oracles import step_by_step_tf
 from test_kernels_corners import shortstraw_ref
 from test_kernels_turning import match_ref, turning_function_ref
 
 import tfloc.maps.vector
-import tfloc.paper.matcher
 import tfloc.paper.shape
 from tfloc import Pose, Problem
 from tfloc.maps._raycast import raycast_segments_bruteforce
@@ -37,11 +38,11 @@ def test_localize_matches_the_reference_pipeline(test_room, lms200, config, monk
     problems = list(_problems(test_room, lms200))
     fast = [matcher.localize(p) for p in problems]
     with monkeypatch.context() as mp:
-        mp.setattr(tfloc.paper.matcher, "_FUSED", False)  # step by step, through the oracles below
+        step_by_step_tf(mp)  # step by step, through the oracles below
         mp.setattr(tfloc.maps.vector, "raycast_segments", raycast_segments_bruteforce)
         mp.setattr(tfloc.paper.shape, "shortstraw", shortstraw_ref)
         mp.setattr(tfloc.paper.shape, "turning_function", turning_function_ref)
-        mp.setattr(tfloc.paper.matcher, "match", lambda real, virtual: match_ref(real, virtual)[0])
+        mp.setattr(_tf_oracles, "match", lambda real, virtual: match_ref(real, virtual)[0])
         ref = [matcher.localize(p) for p in problems]
     for f, r in zip(fast, ref, strict=True):
         np.testing.assert_allclose(f.pose.as_array(), r.pose.as_array(), rtol=0, atol=1e-9)

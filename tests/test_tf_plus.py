@@ -5,13 +5,13 @@ import math
 import numpy as np
 import pytest
 from _tf_cases import TRUE, corridor_problem, few_returns_problem, noisy_scan
+from _tfplus_oracles import rotation_candidates
 from shapely.geometry import box
 
 import tfloc
 from tfloc import Pose, Problem, VectorMap
 from tfloc.maps.fields import distance_field
 from tfloc.paper.shape import ShapeConfig, scan_turning_function
-from tfloc.tfplus.headings import rotation_candidates
 from tfloc.tfplus.matcher import TfPlusConfig, TurningFunctionPlusMatcher
 from tfloc.tfplus.refine import RefineConfig, refine
 

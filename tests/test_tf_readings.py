@@ -8,13 +8,14 @@ import math
 
 import numpy as np
 import pytest
+from _tf_oracles import match_l1, resample_path, step_by_step_tf
 
 import tfloc.paper.matcher
 from tfloc import Pose, Problem
 from tfloc.errors import MatcherError
-from tfloc.paper.corners import resample, resample_path
+from tfloc.paper.corners import resample
 from tfloc.paper.matcher import TfConfig, TurningFunctionMatcher
-from tfloc.paper.turning import TurningFunction, match, match_l1, turning_function
+from tfloc.paper.turning import TurningFunction, match, turning_function
 
 TRUE = Pose(3.0, 3.5, 0.4)
 
@@ -114,7 +115,7 @@ def test_fused_cost_equals_the_step_by_step_path(test_room, lms200, overrides, m
     problem = Problem(test_room, lms200, ranges, Pose(3.4, 3.2, 0.5))
     matcher = TurningFunctionMatcher(**overrides)
     fast = matcher.localize(problem)
-    monkeypatch.setattr(tfloc.paper.matcher, "_FUSED", False)
+    step_by_step_tf(monkeypatch)
     slow = matcher.localize(problem)
     assert fast.pose == slow.pose and fast.evaluations == slow.evaluations
 
@@ -137,7 +138,7 @@ def test_keep_best_returns_the_lowest_err_pose_not_the_last(test_room, lms200, m
     """A scripted outer loop: simplex ends at three positions whose Err is 0.5, 0.2, 0.4."""
     ends = iter([np.array([1.0, 1.0]), np.array([2.0, 2.0]), np.array([3.0, 3.0])])
     errs = {1.0: 0.5, 2.0: 0.2, 3.0: 0.4}
-    monkeypatch.setattr(tfloc.paper.matcher, "_FUSED", False)  # the Python driver (the compiled one runs the same steps)
+    step_by_step_tf(monkeypatch)  # the Python driver (the compiled one runs the same steps)
     monkeypatch.setattr(tfloc.paper.matcher, "simplex", lambda cost, pose, size, rng: (next(ends), 1))
     monkeypatch.setattr(tfloc.paper.matcher._Cost, "function1",
                         lambda self, xy, th: (errs.get(float(xy[0]), 0.9), th, 0.0))

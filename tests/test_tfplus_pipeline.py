@@ -9,13 +9,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 from _tf_cases import TRUE, few_returns_problem, noisy_scan
+from _tfplus_oracles import step_by_step_tfplus
 from shapely.geometry import box
 
 from tfloc import Pose, Problem, VectorMap
 from tfloc.harness.task import load_dataset, problem_of
 from tfloc.maps.build import rasterize
 from tfloc.tfplus import pipeline
-from tfloc.tfplus import refine as refine_module
 from tfloc.tfplus.matcher import TurningFunctionPlusMatcher
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -122,7 +122,7 @@ def test_switching_the_compiled_paths_off_switches_the_pipeline_off(test_room, l
     m = TurningFunctionPlusMatcher()
     m.prepare(p)
     assert pipeline.plan_for(p, m.config) is not None      # (and now remembered)
-    monkeypatch.setattr(refine_module, "_FUSED", False)
+    step_by_step_tfplus(monkeypatch)
     assert pipeline.plan_for(p, m.config) is None
 
 

@@ -18,8 +18,8 @@ Readings of the paper's text, each chosen because the literal text does not work
   towards the next input point (a chord); its sentence says P3 lies "exactly S Euclidian distance
   away from the P1 in the slop direction of the straight line from P(i−1) to P(i)", and Wolin et
   al.'s RESAMPLE-POINTS walks the *path* through P(i−1), P(i), emitting a point every S of path
-  length. :func:`resample` is the chord walk (the default), :func:`resample_path` the path walk
-  (``shortstraw(..., along_path=True)``). They differ only where the path turns within S.
+  length. :func:`resample` is the chord walk (the default), :func:`_resample_path_into` the path
+  walk (``shortstraw(..., along_path=True)``). They differ only where the path turns within S.
 * **Alg. 3 sums squared steps** (``PathD ← PathD + ‖p_i − p_{i+1}‖²``). For points resampled at
   spacing S that makes ``D/PathD`` scale as 1/S, so the test only means "straight" when S = 1.
   We sum the plain step lengths (ShortStraw's IS-LINE), which is identical at S = 1.
@@ -81,8 +81,11 @@ def _resample_into(points: np.ndarray, spacing: float, out: np.ndarray) -> int:
 
 @njit(cache=True, nogil=True)
 def _resample_path_into(points: np.ndarray, spacing: float, out: np.ndarray) -> int:
-    """The path walk of :func:`resample_path` written into ``out``; returns the number of points,
-    or -1 if ``out`` is too small (``out`` of shape ``(0, 2)`` just counts)."""
+    """Algorithm 1 read as Wolin et al.'s RESAMPLE-POINTS, written into ``out``: walk along the
+    path through the input points ``(N, 2)`` and emit a point every ``spacing`` metres of path
+    length, on the segment from P(i−1) to P(i) where that length is reached; the first input
+    point always, the last one as :func:`resample` does. Returns the number of points, or -1 if
+    ``out`` is too small (``out`` of shape ``(0, 2)`` just counts)."""
     n = points.shape[0]
     px, py = points[0, 0], points[0, 1]       # where the walk stands (last emitted or input point)
     lx, ly = px, py                           # last emitted point
@@ -122,11 +125,9 @@ def walk_room(points: np.ndarray, spacing: float) -> int:
     from within S of point *i − 1* and steps S towards it while farther than S, so point *i*
     gives at most ``|P(i) − P(i−1)| / S + 1`` points; the path walk emits one per S of path; the
     first and last points add two. (The walks still check their room, and the callers count
-    exactly and walk again should rounding ever exceed it.)
-
-    Until issue 26 the allocating walks took room for ``4N + 16`` points, which holds a walk at
-    ``tf``'s S = 1 m but never one at ``tf-plus``'s 5 cm (a 40 m scan path is 800 points for 181
-    beams): they walked part of the way, counted, and walked again, for every scan."""
+    exactly and walk again should rounding ever exceed it.) A bound by the point count alone
+    (``4N + 16``) holds a walk at ``tf``'s S = 1 m but not one at ``tf-plus``'s 5 cm (a 40 m scan
+    path is 800 points for 181 beams), whose every walk would then count and walk again."""
     path = 0.0
     for i in range(1, points.shape[0]):
         dx, dy = points[i, 0] - points[i - 1, 0], points[i, 1] - points[i - 1, 1]
@@ -162,33 +163,9 @@ def resample(points: np.ndarray, spacing: float) -> np.ndarray:
 
 
 @njit(cache=True, nogil=True)
-def resample_path(points: np.ndarray, spacing: float) -> np.ndarray:
-    """Algorithm 1 read as Wolin et al.'s RESAMPLE-POINTS: walk along the path through the input
-    points ``(N, 2)`` and emit a point every ``spacing`` metres of path length, on the segment
-    from P(i−1) to P(i) where that length is reached.
-
-    Returns ``(M, 2)``; the first input point is always kept, and the last input point is
-    appended when it lies more than ``spacing/2`` (straight distance) beyond the last emitted
-    point, as in :func:`resample`.
-    """
-    return _walk(points, spacing, True)
-
-
-def straws(points: np.ndarray, window: int = 1) -> np.ndarray:
-    """Eq. 7 / Alg. 2: squared straw ``‖p(i−w) − p(i+w)‖²`` for ``i = w … N−w−1`` (metres²)."""
-    d = points[2 * window:] - points[:-2 * window]
-    return np.einsum("ij,ij->i", d, d)
-
-
-@njit(cache=True, nogil=True)
-def _median(values: np.ndarray) -> float:
-    """``np.median`` of a 1-D array (the mean of the two middle values when the size is even)."""
-    return _median_into(values, np.empty(values.shape[0]))
-
-
-@njit(cache=True, nogil=True)
 def _median_into(values: np.ndarray, scratch: np.ndarray) -> float:
-    """:func:`_median`, sorting a copy in ``scratch`` (at least as long as ``values``)."""
+    """``np.median`` of a 1-D array (the mean of the two middle values when the size is even),
+    sorting a copy in ``scratch`` (at least as long as ``values``)."""
     n = values.shape[0]
     v = scratch[:n]
     v[:] = values
@@ -241,26 +218,15 @@ def corner_candidates(points: np.ndarray, window: int = 1, t: float = 0.99) -> n
 
 
 @njit(cache=True, nogil=True)
-def merge_lines(points: np.ndarray, corners: np.ndarray, threshold: float = 0.95) -> np.ndarray:
-    """Algorithm 3 applied to consecutive corner triples: drop the middle corner ``c_m``
-    whenever the path from ``c_l`` to ``c_n`` is a line, i.e. chord / path length > threshold.
-
-    One pass: the last kept corner, the pending middle corner and the next candidate form the
-    triple; a dropped middle is replaced by the next candidate (the same triples, in the same
-    order, as removing it from the list and testing again)."""
-    k = corners.shape[0]
-    if k < 3:
-        return corners.astype(np.int64)
-    keep = np.empty(k, dtype=np.int64)
-    m = _merge_lines_into(points, corners, threshold, np.empty(points.shape[0]), keep)
-    return keep[:m].copy()
-
-
-@njit(cache=True, nogil=True)
 def _merge_lines_into(points: np.ndarray, corners: np.ndarray, threshold: float, cum: np.ndarray,
                       keep: np.ndarray) -> int:
-    """:func:`merge_lines` into ``keep`` (as long as ``corners`` or more; at least 3 corners),
-    with the path lengths in ``cum`` (as long as ``points`` or more); returns the number kept."""
+    """Algorithm 3 applied to consecutive corner triples: drop the middle corner ``c_m`` whenever
+    the path from ``c_l`` to ``c_n`` is a line, i.e. chord / path length > ``threshold``. One
+    pass: the last kept corner, the pending middle corner and the next candidate form the triple;
+    a dropped middle is replaced by the next candidate (the same triples, in the same order, as
+    removing it from the list and testing again). The kept corners go into ``keep`` (as long as
+    ``corners`` or more; at least 3 corners), the path lengths into ``cum`` (as long as
+    ``points`` or more); returns the number kept."""
     n = points.shape[0]
     cum[0] = 0.0
     for i in range(1, n):
@@ -341,12 +307,6 @@ def _shortstraw_into(points: np.ndarray, spacing: float, window: int, t: float,
     for i in range(kk):
         out[offset + i, 0], out[offset + i, 1] = res[keep[i], 0], res[keep[i], 1]
     return kk
-
-
-def is_line(points: np.ndarray, a: int, b: int, threshold: float = 0.95) -> bool:
-    """Algorithm 3 (Is-Line): whether the resampled path ``points[a..b]`` is straight."""
-    path = np.sum(np.hypot(*np.diff(points[a:b + 1], axis=0).T))
-    return bool(path > 0 and np.hypot(*(points[b] - points[a])) / path > threshold)
 
 
 def shortstraw(points: np.ndarray, spacing: float, window: int = 1, t: float = 0.99,

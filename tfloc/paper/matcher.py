@@ -1,53 +1,37 @@
 """The paper's pose search: turning-function matching driven by a Nelder–Mead simplex.
 
-Sec. 4.4, Eq. 13 and Algorithm 5. One *cost evaluation* simulates the virtual scan (VSD) at a
-candidate pose, finds its ShortStraw corners (Algs. 1–3), builds its turning function (Alg. 4)
-and matches it against the real scan's (Sec. 4.3). ``Function1(P, θ_v)`` of Alg. 5 checks seven
-orientations around θ_v at position P (one batched virtual scan) and keeps the best.
+Sec. 4.4, Eq. 13 and Algorithm 5. A *cost evaluation* matches the turning function (ShortStraw
+corners, Algs. 1–4) of the virtual scan (VSD) at a candidate pose against the real scan's (Sec.
+4.3); Alg. 5's ``Function1(P, θ_v)`` keeps the best of seven orientations around θ_v at P.
 
 Readings (the text is ambiguous or wrong; each choice is the one that works):
 
 * **Scan polygon.** Alg. 4 needs a closed counter-clockwise polygon; a 180° scan is an open
-  polyline. We close it through the sensor origin (the scan's visibility polygon), which is
-  counter-clockwise and simple by construction; closing it directly from the last to the first
-  corner can self-intersect. ``close_through_origin=False`` gives the direct closure.
-* **No-return beams** are dropped and their neighbours joined (a dropout then changes the polygon
-  by one short chord; clipping to max range would add a spurious arc).
-* **Alg. 5's W** is "the point with 2nd maximum error", which for three points is NB; it is read
-  as the worst point.
-* **Alg. 5 has no shrink step**: it accepts a contraction even when it is no better than W. Then
-  W creeps onto the midpoint of B and NB while B and NB never move, and the simplex never
-  converges (observed: 60 iterations ending on one repeated point). We keep the paper's moves and
-  add Nelder–Mead's shrink towards B only when the contracted point is not better than W. Alg. 5
-  also has no convergence test; we stop when the simplex is smaller than ``xy_tol`` or after
-  ``max_iterations``.
-* **Function1(P, θ_v)** is a function of P only (θ_v is fixed while the simplex runs), so the
-  re-evaluations of B, NB, W in each loop of Alg. 5 return the same values; they are cached.
-* **Seven orientations**: θ_v + k·``orientation_step`` for k = −3…3 (the paper gives no step).
-* **Outer iterations** (Eq. 2, Δθ = Σδθ_k): after a simplex run the pose becomes the best vertex,
-  its heading the best of the seven corrected by the histogram's rotation offset (the
-  orientation-difference estimate of Sec. 4.3); the virtual scan is re-simulated and the simplex
-  restarts around it, its size halved each time, until Err ≤ ``err_threshold`` or the pose moves
-  less than ``xy_tol``/``theta_tol``.
-* **Initial simplex**: "three random points … covering the maximum position difference": the VP
+  polyline. We close it through the sensor origin (counter-clockwise and simple by
+  construction); closing it directly can self-intersect (``close_through_origin=False``).
+* **No-return beams** are dropped and their neighbours joined (one short chord per dropout;
+  clipping to max range would add a spurious arc).
+* **Alg. 5's W** is "the point with 2nd maximum error", i.e. NB of three: read as the worst.
+* **Alg. 5 has no shrink step**: it accepts a contraction no better than W, so W creeps onto the
+  midpoint of B and NB and the simplex never converges (observed: 60 iterations on one repeated
+  point). We add Nelder–Mead's shrink towards B for that case only, and stop when the simplex
+  is smaller than ``xy_tol`` or after ``max_iterations`` (Alg. 5 has no convergence test).
+* **Function1(P, θ_v)** depends on P only (θ_v is fixed while the simplex runs): cached. Its
+  seven orientations are θ_v + k·``orientation_step``, k = −3…3 (the paper gives no step).
+* **Outer iterations** (Eq. 2, Δθ = Σδθ_k): the pose becomes the best vertex, its heading the
+  best of the seven corrected by the histogram's rotation offset (Sec. 4.3); the simplex restarts
+  there, halved, until Err ≤ ``err_threshold`` or the pose moves less than the tolerances.
+* **Initial simplex** ("three random points … covering the maximum position difference"): the VP
   and two points ``simplex_size`` metres away at a seeded random direction, 60° apart.
-* **Invalid candidates** (inside a wall/obstacle, off the map, fewer than 2 corners in the
-  virtual scan) cost ``penalty`` instead of raising.
+* **Invalid candidates** (in a wall, off the map, < 2 corners) cost ``penalty``.
 
-Ambiguous readings are switches of :class:`TfConfig` (each quotes the sentence it reads); the
-defaults are the literal reading above, and ``tf-best`` (:mod:`tfloc.paper.best`) is the same
-search with the best-measured reading of each.
-
-Speed: one Function1 call is one batched raycast plus one compiled call
-(:func:`tfloc.paper.kernels.scan_errors`) for the corners, turning functions and matching of all
-its orientations; it runs the same kernels as the step-by-step functions of this module, so the
-answers are identical.
+Ambiguous readings are switches of :class:`TfConfig` (each quoting the sentence it reads);
+``tf-best`` (:mod:`tfloc.paper.best`) takes the best-measured reading of each.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import ClassVar
 
@@ -63,7 +47,7 @@ from tfloc.maps.vector import VectorMap
 from .kernels import function1_kernel, scan_errors
 from .search_kernel import search_kernel
 from .shape import ShapeConfig, scan_turning_function
-from .turning import Match, TurningFunction, match, match_l1
+from .turning import TurningFunction
 
 _NORMS = ("l2", "l1")
 
@@ -149,13 +133,6 @@ class TfConfig:
                                  ("heading_clamp",))
 
 
-def _match(config: TfConfig) -> Callable[[TurningFunction, TurningFunction], Match]:
-    return match_l1 if config.err_norm == "l1" else match
-
-
-_FUSED = True  # one compiled call per batch (tests switch it off to compare with the oracles)
-
-
 @dataclass
 class _Cost:
     """Cost evaluations of one problem (Eq. 13 with the seven-orientation check), cached by position."""
@@ -177,7 +154,7 @@ class _Cost:
             float(cfg.penalty))
         self._vector = None
         m = self.problem.map
-        if _FUSED and isinstance(m, VectorMap):   # Function1 in one compiled call
+        if isinstance(m, VectorMap):              # Function1 in one compiled call
             r = m.free_rings(build=True)            # hundreds of free tests per scan
             if r is not None:                       # (else shapely's geometry: the Python path)
                 self._vector = (self._offsets, r.kernel, SURE,
@@ -199,18 +176,10 @@ class _Cost:
         return float(err), float(heading), float(rot)
 
     def _scan_errors(self, scans: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Err and rotation offset (radians, in [-π, π)) of each virtual scan ``(P, n_beams)``."""
-        if _FUSED:
-            return scan_errors(scans, *self._kernel_args)
-        cfg, laser = self.config, self.problem.laser
-        errs, rots = np.full(len(scans), cfg.penalty), np.zeros(len(scans))
-        distance = _match(cfg)
-        for j, ranges in enumerate(scans):
-            tf_v = scan_turning_function(ranges, laser, cfg.shape)
-            if tf_v is not None:
-                m = distance(self.real, tf_v)
-                errs[j], rots[j] = m.distance, m.rotation
-        return errs, rots
+        """Err and rotation offset (radians, in [-π, π)) of each virtual scan ``(P, n_beams)``:
+        corners, turning functions and matching of all of them in one compiled call
+        (:func:`tfloc.paper.kernels.scan_errors`)."""
+        return scan_errors(scans, *self._kernel_args)
 
     def errors(self, poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Err and rotation offset (radians) at each of ``(N, 3)`` poses (one batched raycast)."""
@@ -243,7 +212,7 @@ class _Cost:
             poses[:, 0], poses[:, 1], poses[:, 2] = key[0], key[1], th
             prob = self.problem
             # errors(poses) gives the same answer; inlined because its general masking costs
-            # 3.6 ms per office scan (24.3 → 27.9 ms CPU, 54 scans) on this hot path
+            # about a seventh of tf's time on this hot path
             if prob.map.is_free(poses[:1, :2])[0]:  # the orientations share one position
                 errs, rots = self._scan_errors(prob.map.raycast(poses, prob.laser))
                 b = int(np.argmin(errs))

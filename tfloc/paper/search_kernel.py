@@ -49,12 +49,12 @@ def _stable_order3(keys: np.ndarray) -> tuple[int, int, int]:
 
 
 @njit(cache=True, nogil=True)
-def _f(cache, x: float, y: float, theta_v: float, args) -> tuple[int, float]:
-    """Function1's Err at ``(x, y)`` through the cache: ``(status, Err)``, status 1 a hit, 2 a
-    new evaluation, 0 gave up (see the module notes)."""
+def _f(cache, x: float, y: float, theta_v: float, args, misses: np.ndarray) -> float:
+    """Function1's Err at ``(x, y)`` through the cache, a new evaluation counted in
+    ``misses[0]``; NaN where it gave up (see the module notes)."""
     key = (x, y)
     if key in cache:
-        return 1, cache[key][0]
+        return cache[key][0]
     (offsets, rings, sure, rel_angles, segs, index, directions, max_range, spacing, window, t,
      line_threshold, close_through_origin, along_path, l1, real_breaks, real_angles,
      penalty) = args
@@ -63,52 +63,50 @@ def _f(cache, x: float, y: float, theta_v: float, args) -> tuple[int, float]:
                                      close_through_origin, along_path, l1, real_breaks,
                                      real_angles, penalty)
     if code < 0 or np.isnan(e):
-        return 0, e
+        return np.nan
     cache[key] = (e, h, r)
-    return 2, e
+    misses[0] += 1
+    return e
 
 
 @njit(cache=True, nogil=True)
 def _simplex(cache, x: float, y: float, th: float, size: float, phi: float, xy_tol: float,
-             err_threshold: float, max_iterations: int, args) -> tuple[int, float, float, int, int]:
-    """:func:`tfloc.paper.matcher.simplex` from ``(x, y)`` at heading ``th``: ``(status, best x,
-    best y, iterations, new evaluations)``; status 0: gave up."""
+             err_threshold: float, max_iterations: int, args,
+             misses: np.ndarray) -> tuple[bool, float, float, int]:
+    """:func:`tfloc.paper.matcher.simplex` from ``(x, y)`` at heading ``th``: ``(answered, best
+    x, best y, iterations)``, new evaluations counted in ``misses[0]``; not answered: gave up."""
     px = np.array([x, x + size * math.cos(phi), x + size * math.cos(phi + np.pi / 3)])
     py = np.array([y, y + size * math.sin(phi), y + size * math.sin(phi + np.pi / 3)])
     keys = np.empty(3)
-    misses = 0
     it = 0
     while True:
         for v in range(3):                      # f of each vertex, in list order
-            ok, keys[v] = _f(cache, px[v], py[v], th, args)
-            if ok == 0:
-                return 0, 0.0, 0.0, 0, 0
-            misses += ok - 1
+            keys[v] = _f(cache, px[v], py[v], th, args, misses)
+            if np.isnan(keys[v]):
+                return False, 0.0, 0.0, 0
         if it >= max_iterations:                # min(pts, key=f): the first lowest
             b = 0
             for v in range(1, 3):
                 if keys[v] < keys[b]:
                     b = v
-            return 1, px[b], py[b], it, misses
+            return True, px[b], py[b], it
         i, j, k = _stable_order3(keys)
         bx, by, nbx, nby, wx, wy = px[i], py[i], px[j], py[j], px[k], py[k]
         fb, fnb, fw = keys[i], keys[j], keys[k]
         if fb <= err_threshold or max(math.hypot(bx - nbx, by - nby),
                                       math.hypot(bx - wx, by - wy)) < xy_tol:
-            return 1, bx, by, it, misses        # sorted: b is the first lowest
+            return True, bx, by, it             # sorted: b is the first lowest
         it += 1
         cx, cy = 0.5 * (bx + nbx), 0.5 * (by + nby)
         rx, ry = cx + (cx - wx), cy + (cy - wy)
-        ok, fr = _f(cache, rx, ry, th, args)
-        if ok == 0:
-            return 0, 0.0, 0.0, 0, 0
-        misses += ok - 1
+        fr = _f(cache, rx, ry, th, args, misses)
+        if np.isnan(fr):
+            return False, 0.0, 0.0, 0
         if fr < fb:
             ex, ey = rx + (rx - cx), ry + (ry - cy)
-            ok, fe = _f(cache, ex, ey, th, args)
-            if ok == 0:
-                return 0, 0.0, 0.0, 0, 0
-            misses += ok - 1
+            fe = _f(cache, ex, ey, th, args, misses)
+            if np.isnan(fe):
+                return False, 0.0, 0.0, 0
             if fr < fe:
                 wx, wy = rx, ry
             else:
@@ -120,10 +118,9 @@ def _simplex(cache, x: float, y: float, th: float, size: float, phi: float, xy_t
                 ccx, ccy = 0.5 * (cx + rx), 0.5 * (cy + ry)
             else:
                 ccx, ccy = 0.5 * (cx + wx), 0.5 * (cy + wy)
-            ok, fc = _f(cache, ccx, ccy, th, args)
-            if ok == 0:
-                return 0, 0.0, 0.0, 0, 0
-            misses += ok - 1
+            fc = _f(cache, ccx, ccy, th, args, misses)
+            if np.isnan(fc):
+                return False, 0.0, 0.0, 0
             if fc < fw:
                 wx, wy = ccx, ccy
             else:                               # shrink towards B
@@ -146,21 +143,20 @@ def search_kernel(x0: float, y0: float, theta0: float, phis: np.ndarray, simplex
     Returns ``(status, x, y, theta, converged, iterations, new evaluations, err, outer)``; status
     1 answered, 0 gave up (the caller runs the Python search)."""
     cache = Dict.empty(key_type=_KEY, value_type=_VALUE)
+    misses = np.zeros(1, dtype=np.int64)
     x, y, th = x0, y0, theta0
-    ok, err = _f(cache, x, y, th, args)         # Function1 at the VP
-    if ok == 0:
+    err = _f(cache, x, y, th, args, misses)     # Function1 at the VP
+    if np.isnan(err):
         return 0, x, y, th, False, 0, 0, 0.0, 0
-    misses = ok - 1
     size = simplex_size
     iters, outer, converged = 0, 0, False
     have_best, best_err, best_x, best_y, best_th = False, 0.0, x, y, th
     while outer < max_outer:
         outer += 1
-        ok, sx, sy, n_it, new = _simplex(cache, x, y, th, size, phis[outer - 1], xy_tol,
-                                         err_threshold, max_iterations, args)
-        if ok == 0:
+        ok, sx, sy, n_it = _simplex(cache, x, y, th, size, phis[outer - 1], xy_tol,
+                                    err_threshold, max_iterations, args, misses)
+        if not ok:
             return 0, x, y, th, False, 0, 0, 0.0, 0
-        misses += new
         iters += n_it
         err, h, r = cache[(sx, sy)]             # evaluated by the simplex at this heading
         theta = _wrap(h - r) if rotation_correction else h
@@ -179,4 +175,4 @@ def search_kernel(x0: float, y0: float, theta0: float, phis: np.ndarray, simplex
             break
     if keep_best and have_best:
         err, x, y, th = best_err, best_x, best_y, best_th
-    return 1, x, y, th, converged, iters, misses, err, outer
+    return 1, x, y, th, converged, iters, misses[0], err, outer

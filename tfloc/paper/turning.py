@@ -20,8 +20,9 @@ the mean of ``Θ_R − Θ_V`` (Arkin et al. 1991), so the search over θ is exac
 Sec. 4.3's own words describe the area itself: "Rectangles are created between two graphs because
 they are in the form of histograms. Each rectangle's area is determined, and the area between the
 two graphs is calculated by adding the total areas together." That is the L1 distance
-``∫₀¹ |Θ_R − Θ_V − θ| ds``, :func:`match_l1`; its best θ for a fixed shift is the weighted
-median of ``Θ_R − Θ_V`` (weights = piece widths). ``tf`` uses Eq. 13 (L2) by default.
+``∫₀¹ |Θ_R − Θ_V − θ| ds`` (``err_norm="l1"``; :func:`_best_shift` with ``l1``); its best θ for
+a fixed shift is the weighted median of ``Θ_R − Θ_V`` (weights = piece widths). ``tf`` uses
+Eq. 13 (L2) by default.
 """
 
 from __future__ import annotations
@@ -318,8 +319,11 @@ def _weighted_median(values: np.ndarray, weights: np.ndarray) -> float:
 def _best_shift(rb: np.ndarray, ra: np.ndarray, vb: np.ndarray, va: np.ndarray,
                 l1: bool) -> tuple[float, float, int]:
     """The best cyclic shift of the virtual function and its rotation: (err², rot, shift) of
-    :func:`match` (the rotation is the mean difference), or with ``l1`` (area, rot, shift) of
-    :func:`match_l1` (the weighted median). One merge sweep per shift."""
+    :func:`match` (the rotation is the mean difference), or with ``l1`` (area, rot, shift) for
+    Sec. 4.3's area between the graphs (radians × unit arc length): for a fixed shift the area
+    is a convex, piecewise linear function of θ whose minimum lies at the weighted median of
+    ``Θ_R − Θ_V`` over the pieces (weights = piece widths), not at the mean, so the search over
+    θ is exact. One merge sweep per shift."""
     n_r, n_v = ra.shape[0], va.shape[0]
     g_n = n_r + 1 + n_v
     return _best_shift_into(rb, ra, vb, va, l1, np.empty(n_v), np.empty(g_n), np.empty(g_n - 1),
@@ -356,13 +360,6 @@ def _match(rb: np.ndarray, ra: np.ndarray, vb: np.ndarray, va: np.ndarray) -> tu
     return _best_shift(rb, ra, vb, va, False)
 
 
-@njit(cache=True, nogil=True)
-def _match_l1(rb: np.ndarray, ra: np.ndarray, vb: np.ndarray, va: np.ndarray) -> tuple[float, float, int]:
-    """(area, rot, shift) of :func:`match_l1`: for each cyclic shift, the weighted median of the
-    pieces' differences is the best rotation, and the area follows; O(n_v·n log n)."""
-    return _best_shift(rb, ra, vb, va, True)
-
-
 def match(real: TurningFunction, virtual: TurningFunction) -> Match:
     """Sec. 4.3: min over starting vertex (of ``virtual``) and rotation of the L2 distance.
 
@@ -373,16 +370,3 @@ def match(real: TurningFunction, virtual: TurningFunction) -> Match:
     err2, rot, k = _match(real.breaks, real.angles, virtual.breaks, virtual.angles)
     rotation = wrap_angle(float(rot))
     return Match(math.sqrt(max(err2, 0.0)), rotation, int(k))
-
-
-def match_l1(real: TurningFunction, virtual: TurningFunction) -> Match:
-    """Sec. 4.3 read as written: min over starting vertex and rotation of the *area* between the
-    two graphs, ``∫₀¹ |Θ_R − Θ_V − θ| ds`` (the sum of the rectangles between them).
-
-    The pieces are those of :func:`match`. For a fixed shift the area is a convex, piecewise
-    linear function of θ whose minimum lies at the weighted median of ``Θ_R − Θ_V`` over the
-    pieces (weights = piece widths), not at the mean; so the search over θ is exact here too.
-    ``Match.distance`` is the area (radians × unit arc length).
-    """
-    area, rot, k = _match_l1(real.breaks, real.angles, virtual.breaks, virtual.angles)
-    return Match(float(area), wrap_angle(float(rot)), int(k))

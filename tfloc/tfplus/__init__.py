@@ -1,3 +1,4 @@
 """``tf-plus``, the project's own turning-function localizer, one module per stage: heading seeds
 (``headings``), the coarse grid (``coarse``), point-to-line refinement (``refine``), the selection
-cost (``cost``), their compiled kernels (``kernels``) and the matcher (``matcher``)."""
+cost (``cost``), each stage's compiled kernels (``*_kernel``), the one-call pipeline
+(``pipeline``) and the matcher (``matcher``)."""

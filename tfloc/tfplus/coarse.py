@@ -21,10 +21,9 @@ from tfloc.maps.grid import GridMap
 from tfloc.maps.inside import SURE
 from tfloc.maps.vector import VectorMap
 
-from .kernels import (
+from .coarse_kernel import (
     candidates_kernel,
     grid_lattice_kernel,
-    grid_scores_kernel,
     lattice_kernel,
     pose_scores_kernel,
     separated_kernel,
@@ -77,15 +76,6 @@ def _offsets(radius: float, step: float) -> np.ndarray:
     return off
 
 
-def grid_scores(field: MapView, points: np.ndarray, positions: np.ndarray,
-                headings: np.ndarray) -> np.ndarray:
-    """Mean distance-field value ``(N, H)`` of ``points`` ``(M, 2)`` at every position × heading."""
-    return grid_scores_kernel(field.table, float(field.origin[0]), float(field.origin[1]),
-                              field.resolution, np.ascontiguousarray(points, dtype=float),
-                              np.ascontiguousarray(positions, dtype=float),
-                              np.ascontiguousarray(headings, dtype=float))
-
-
 def pose_scores(field: MapView, points: np.ndarray, poses: np.ndarray) -> np.ndarray:
     """Mean distance-field value ``(N,)`` of ``points`` ``(M, 2)`` at each of ``(N, 3)`` poses."""
     return pose_scores_kernel(field.table, float(field.origin[0]), float(field.origin[1]),
@@ -101,14 +91,13 @@ def candidates(field: MapView, points: np.ndarray, positions: np.ndarray, headin
     ``separation`` metres apart are returned: ``(C, 3)`` poses, their scores ``(C,)`` and the
     number of poses rescored. ``step``: the spacing (metres) of the lattice the positions lie on
     (:func:`lattice`'s; 0 if none), which saves a cell index per look-up. One compiled call
-    (:func:`~tfloc.tfplus.kernels.candidates_kernel`).
+    (:func:`~tfloc.tfplus.coarse_kernel.candidates_kernel`).
 
     The shortlist is ordered by the first level's score, ties for a place by lower index
-    (position-major; :func:`~tfloc.tfplus.kernels.smallest_kernel`). Until issue 26 it was
-    ``np.argpartition``'s, which leaves ties to its selection algorithm: the first level's
-    scores are means of a few float32 distances of ~20 distinct values, and the last place
-    was tied in about one scan in five, so a rule of its own makes the answer independent of
-    numpy's internals."""
+    (position-major; :func:`~tfloc.tfplus.coarse_kernel.smallest_kernel`): the first level's
+    scores are means of a few float32 distances of ~20 distinct values, so the last place is
+    often tied (about one scan in five), and a rule of its own, rather than a selection
+    algorithm's, decides which pose takes it."""
     return candidates_kernel(field.table, float(field.origin[0]), float(field.origin[1]),
                              field.resolution, np.ascontiguousarray(points, dtype=float),
                              int(stride), np.ascontiguousarray(positions, dtype=float),

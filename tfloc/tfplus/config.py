@@ -118,7 +118,7 @@ def heading_offsets(offsets: tuple[float, ...]) -> np.ndarray:
 
 
 def coarse_search(map_: Map, cfg: TfPlusConfig) -> tuple:
-    """What :func:`~tfloc.tfplus.kernels.coarse_kernel` takes of ``cfg`` and of the view it
+    """What :func:`~tfloc.tfplus.coarse_kernel.coarse_kernel` takes of ``cfg`` and of the view it
     scores on (:func:`coarse_view`): the table, its corner and cell size, the points' count or
     stride, the shortlist, the candidates, their separation and the lattice step."""
     pooled = coarse_view(map_, cfg)

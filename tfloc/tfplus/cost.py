@@ -18,13 +18,9 @@ The cost is the mean over all beams. Without the beam check two poses that see t
 (a bare corner, a corridor) tie even when one of them would see through a wall; the check is
 the beam model's free-space evidence, which point-to-line matching ignores.
 
-Why the far side on grids: measured at the true poses of the development logs
-(``scripts/tfplus_real_diagnostics.py``), the rule "more than 5 cm beyond the first occupied
-cell" counted 23 % (Intel) and 24 % (CSAIL) of all beams as seen through a wall, and 75–98 % with
-the walls thickened by one or two cells, so it penalised the truth about as much as any wrong
-pose. Beyond the far side + 10 cm: 8 % and 11 % (14–24 % thickened), of which 4 % and 3 % are
-beams with no return where the map has a wall (glass, black or distant surfaces) and the rest
-returns beyond thin or partly carved walls (doors that stood open, things that moved).
+Why the far side on grids: a return lies inside the thick wall it hit, and the rule "beyond the
+first occupied cell" counted about a quarter of all beams at the true poses as seen through a
+wall, penalising the truth as much as a wrong pose (measured: ``docs/tf-plus.md``, "Real logs").
 """
 
 from __future__ import annotations
@@ -36,8 +32,7 @@ from tfloc.core.map import Map
 from tfloc.maps.grid import GridMap
 from tfloc.maps.vector import VectorMap
 
-from .cost_kernel import grid_cost_kernel, vector_cost_kernel
-from .kernels import see_through_kernel
+from .cost_kernel import grid_cost_kernel, see_through_kernel, vector_cost_kernel
 from .refine import field_pairs, residuals_to
 from .view import MapView
 
@@ -97,11 +92,9 @@ def see_through(map_: Map, laser: LaserSpec, ranges: np.ndarray, poses: np.ndarr
                 virtual: np.ndarray | None = None) -> np.ndarray:
     """Which beams ``(K, n_beams)`` the map says cannot be at each of ``(K, 3)`` poses (see the
     module docstring). On a grid map "beyond the wall" means beyond its far side
-    (:func:`~tfloc.tfplus.kernels.see_through_kernel`): the real returns of a wall drawn several
-    cells thick lie anywhere inside it, and measured at the true poses of the Intel and CSAIL logs
-    19–21 % of all beams lay more than 5 cm beyond the first occupied cell, which counted them as
-    seen through the wall. On other maps, beyond the ray-cast range (``virtual``, computed if not
-    given)."""
+    (:func:`~tfloc.tfplus.cost_kernel.see_through_kernel`): the real returns of a wall drawn
+    several cells thick lie anywhere inside it. On other maps, beyond the ray-cast range
+    (``virtual``, computed if not given)."""
     poses = np.reshape(poses, (-1, 3))
     if isinstance(map_, GridMap):
         return see_through_kernel(map_.occupied, map_.origin[0], map_.origin[1], map_.resolution,

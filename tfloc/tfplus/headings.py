@@ -85,7 +85,11 @@ def _pair_kernel(bins: int, smoothing: float) -> np.ndarray:
 def _correlation(raw: np.ndarray, g2: np.ndarray, k_max: int) -> np.ndarray:
     """``c[s + k_max]`` for ``|s| ≤ k_max``: the circular cross-correlation of the smoothed
     histograms of ``raw`` ``(2, bins)`` (row 0 real, row 1 virtual) at shift ``s``,
-    ``Σₙ h_real[n + s] · h_virtual[n]``, summed over pairs of occupied raw bins with ``G₂``."""
+    ``Σₙ h_real[n + s] · h_virtual[n]``, summed over pairs of occupied raw bins with ``G₂``.
+
+    Summed directly rather than by FFTs: the same values within rounding, but where fewer real
+    peaks lie in the window than are asked for, the FFTs' rounding noise (~1e-17 of the peaks)
+    makes local maxima of its own, which :func:`_peaks` would take as seeds (``docs/speed.md``)."""
     bins = raw.shape[1]
     reach = (g2.shape[0] - 1) // 2
     real = np.flatnonzero(raw[0])
@@ -120,27 +124,6 @@ def _peaks(c: np.ndarray, count: int) -> np.ndarray:
     return idx[np.argsort(-c[idx], kind="mergesort")][:count]
 
 
-def rotation_candidates(real: TurningFunction, virtual: TurningFunction, max_rotation: float,
-                        count: int = 2, bins: int = 720, smoothing: float = np.radians(1.0),
-                        skip_closure: bool = True) -> np.ndarray:
-    """Up to ``count`` rotation offsets (radians, real = virtual rotated by it), best first:
-    the highest local maxima of the histograms' circular cross-correlation within ±max_rotation.
-
-    Computed directly, over the pairs of occupied bins of the two raw histograms
-    (:func:`_correlation`), in one compiled call. Until issue 26 the correlation came from
-    FFTs of the smoothed histograms (:func:`rotation_candidates_fft`, kept as the reference): the
-    same values within rounding, but where fewer than ``count`` real peaks lie in the window
-    the FFT's rounding noise (~1e-17 of the peaks) made spurious local maxima, which were
-    taken as seeds (about one scan in five of the paper protocol and the real logs). A local
-    maximum below ``_NOISE`` of the largest value is no peak here."""
-    raw = _raw_histograms(real.breaks, real.angles, virtual.breaks, virtual.angles, bins,
-                          skip_closure)
-    width = 2 * np.pi / bins
-    k = int(np.floor(max_rotation / width))
-    c = _correlation(raw, _pair_kernel(bins, float(smoothing)), k)
-    return (_peaks(c, count) - k) * width
-
-
 @njit(cache=True, nogil=True)
 def _scan_rotations(real_ranges: np.ndarray, virtual_ranges: np.ndarray, directions: np.ndarray,
                     max_range: float, spacing: float, window: int, t: float, line_threshold: float,
@@ -163,10 +146,12 @@ def _scan_rotations(real_ranges: np.ndarray, virtual_ranges: np.ndarray, directi
 def scan_rotations(real_ranges: np.ndarray, virtual_ranges: np.ndarray, laser, shape,
                    max_rotation: float, count: int, bins: int = 720,
                    smoothing: float = np.radians(1.0), skip_closure: bool = True) -> np.ndarray | None:
-    """:func:`rotation_candidates` of the turning functions of a real and a virtual scan
-    (ranges, metres; a :class:`~tfloc.core.laser.LaserSpec` and a
-    :class:`~tfloc.paper.shape.ShapeConfig`), in one compiled call; ``None`` when either scan's
-    polygon has fewer than 3 edges (no turning function)."""
+    """Up to ``count`` rotation offsets (radians, real = virtual rotated by it), best first,
+    between a real and a virtual scan (ranges, metres; a :class:`~tfloc.core.laser.LaserSpec`
+    and a :class:`~tfloc.paper.shape.ShapeConfig`): the highest local maxima within
+    ±``max_rotation`` of their turning functions' edge-direction histograms' circular
+    cross-correlation, in one compiled call; ``None`` when either scan's polygon has fewer than
+    3 edges (no turning function)."""
     width = 2 * np.pi / bins
     rots, ok = _scan_rotations(
         np.asarray(real_ranges, dtype=float), np.asarray(virtual_ranges, dtype=float),
@@ -175,27 +160,3 @@ def scan_rotations(real_ranges: np.ndarray, virtual_ranges: np.ndarray, laser, s
         shape.resampling == "path", bins, skip_closure, _pair_kernel(bins, float(smoothing)),
         int(np.floor(max_rotation / width)), int(count))
     return rots if ok else None
-
-
-def rotation_candidates_fft(real: TurningFunction, virtual: TurningFunction, max_rotation: float,
-                            count: int = 2, bins: int = 720, smoothing: float = np.radians(1.0),
-                            skip_closure: bool = True) -> np.ndarray:
-    """:func:`rotation_candidates` as it was until issue 26, by FFTs (the reference of the
-    tests; rounding-noise maxima count as peaks here)."""
-    # edge_histogram of both at once: the raw histograms compiled, the two rows' FFTs in one call
-    raw = _raw_histograms(real.breaks, real.angles, virtual.breaks, virtual.angles, bins,
-                          skip_closure)
-    smooth = np.real(np.fft.ifft(np.fft.fft(raw) * _kernel_spectrum(bins, float(smoothing))))
-    spectrum_r, spectrum_v = np.fft.fft(smooth)
-    corr = np.real(np.fft.ifft(spectrum_r * np.conj(spectrum_v)))   # corr[k]: hv shifted by k
-    width = 2 * np.pi / bins
-    k = int(np.floor(max_rotation / width))
-    shifts = np.arange(-k, k + 1)
-    c = corr[shifts % bins]
-    peak = (c >= np.roll(c, 1)) & (c >= np.roll(c, -1))
-    peak[0] = peak[-1] = False
-    order = np.argsort(-np.where(peak, c, -np.inf))[:count]
-    order = order[peak[order]]
-    if len(order) == 0:
-        order = np.array([int(np.argmax(c))])
-    return shifts[order] * width

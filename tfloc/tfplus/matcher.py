@@ -1,50 +1,31 @@
 """``tf-plus``: the project's own turning-function localizer, built to win the convergence basin.
 
-It keeps what the paper's turning function is good at and replaces what holds the faithful
-``tf`` back (its Eq. 13 cost is rugged at the centimetre scale, because ShortStraw's corner set
-changes discretely as the virtual pose moves, so its simplex stalls in local optima, and it
-needs ~1800 cost evaluations per scan). Stages:
+It keeps what the paper's turning function is good at and replaces what holds the faithful ``tf``
+back: Eq. 13's cost is rugged at the centimetre scale (ShortStraw's corner set changes discretely
+as the virtual pose moves), so ``tf``'s simplex stalls in local optima. Stages:
 
-1. **Headings.** A sweep θ_VP ± ``heading_span`` (``heading_sweep``) plus turning-function
-   seeds (``tf_seed``): the real and virtual (at the VP) scans' turning functions are compared
-   as edge-direction histograms (:mod:`tfloc.tfplus.headings`), which gives rotation offsets
-   that need no position and no common starting vertex: ``θ = θ_VP − rotation``. (The rotation
-   of Sec. 4.3's ``match`` was measured to be too unreliable for a seed.) Measured: the seeds
-   alone are as good as the sweep alone within 0–15°, and add nothing on top of it (see
-   ``docs/tf-plus.md``).
-2. **Coarse grid over position.** Every free lattice position within ``search_radius`` of the
-   VP × those headings is scored on a truncated distance field of the map
-   (:mod:`tfloc.tfplus.coarse`, :mod:`tfloc.tfplus.view`): smooth, cheap and free of the corner
-   set's discreteness. The field is pooled over ± half a lattice step (``coarse_bound``), so a
-   lattice pose scores at least as well as any translation within its cell (Olson's bound): in
-   a corridor on a real grid, the lattice point nearest the truth can lie 10 cm across the
-   corridor and score worse than points aligned across it but metres off along it. Two levels:
-   about ``coarse_points`` points (whatever the beam count) for all candidates, all points for
-   the best ``shortlist``; the best ``candidates`` (at least ``separation`` apart) go on.
-3. **Point-to-line refinement** of every candidate (:mod:`tfloc.tfplus.refine`), batched, with a
-   shrinking outlier gate: on a grid map against the map itself (nearest occupied cell, then
-   also the walls' surfaces with the returns' depth behind them as a fourth unknown), on a
-   vector map against ray-cast virtual scans (``refine_to="auto"``). A grid drawn from real
-   scans has walls several cells thick, and a ray cast in it stops at the first occupied cell:
-   fitting to that virtual scan biased the answer by the wall's thickness.
-4. **Selection** of the refined candidate with the lowest per-beam cost (truncated point-to-line
-   residual to the map, plus see-through beams judged against the far side of the first wall,
-   :mod:`tfloc.tfplus.cost`; ``select="residual"``), or the lowest turning-function Err
-   (``select="tf"``); candidates
-   within ``tie_tolerance`` of the best (the scan sees the same geometry from both places, e.g.
-   a bare corner) are a tie, broken in favour of the one nearest the VP.
+1. **Headings** (:func:`heading_seeds`): a sweep θ_VP ± ``heading_span`` (``heading_sweep``)
+   plus turning-function seeds (``tf_seed``, :mod:`tfloc.tfplus.headings`): rotation offsets
+   between the real and the virtual scan at the VP that need no position and no common
+   starting vertex, ``θ = θ_VP − rotation``.
+2. **Coarse grid** (:mod:`tfloc.tfplus.coarse`): every free lattice position within
+   ``search_radius`` of the VP × those headings, scored on a truncated distance field of the
+   map, smooth and free of the corner set's discreteness; pooled over ± half a lattice step
+   (``coarse_bound``, Olson's bound) so that the lattice pose nearest the truth is not
+   outscored for lying a few cm off a wall. The best ``candidates``, ``separation`` apart, go on.
+3. **Point-to-line refinement** of every candidate (:mod:`tfloc.tfplus.refine`), with a
+   shrinking outlier gate: on a grid map against the map itself (its walls are drawn several
+   cells thick, and a virtual scan in it stops short), on a vector map against ray-cast
+   virtual scans (``refine_to="auto"``).
+4. **Selection** (:mod:`tfloc.tfplus.cost`): the lowest per-beam cost (``select="residual"``) or
+   turning-function Err (``select="tf"``); candidates within ``tie_tolerance`` of the best (the
+   scan sees the same geometry from both places) are a tie, won by the one nearest the VP.
 
 In the default configuration on vector and grid maps the stages run in one compiled call per
-scan (:mod:`tfloc.tfplus.pipeline`: the same kernels and answers, without the Python between
-them).
-
-Each stage can be switched off or put back as it was before the real logs (``tf_seed``,
-``heading_sweep``, ``grid``, ``coarse_bound``, ``refine``, ``refine_to="virtual"``,
-``select="virtual"``, ``beam_check``, ``tie_tolerance=0``) for the ablations in
-``benchmarks/tfplus-ablation.toml`` (simulated) and ``scripts/tfplus_ablation_real.py`` (real
-logs); ``docs/tf-plus.md`` has the measurements. It uses the :class:`~tfloc.core.map.Map`
-protocol, on a :class:`~tfloc.maps.grid.GridMap` also its occupied cells (walls have thickness
-there), and never the true pose.
+scan (:mod:`tfloc.tfplus.pipeline`, the same answers). Each stage can be switched off or put back
+as it was before the real logs, for the ablations; the measurements are in ``docs/tf-plus.md``.
+It uses the :class:`~tfloc.core.map.Map` protocol, on a :class:`~tfloc.maps.grid.GridMap` also
+its occupied cells, and never the true pose.
 """
 
 from __future__ import annotations
@@ -63,6 +44,7 @@ from tfloc.paper.turning import match
 
 from . import pipeline
 from .coarse import lattice, pose_scores
+from .coarse_kernel import coarse_kernel
 from .config import TfPlusConfig, coarse_search
 from .config import coarse_view as _coarse_field
 from .config import field_view as _field
@@ -70,7 +52,6 @@ from .config import heading_offsets as _heading_offsets
 from .config import sweep as _sweep
 from .cost import scan_cost
 from .headings import scan_rotations
-from .kernels import coarse_kernel
 from .refine import refine, refine_to_field
 
 

@@ -1,14 +1,11 @@
 """``tf-plus``'s default configuration in one compiled call per scan, on vector and grid maps.
 
-:meth:`~tfloc.tfplus.matcher.TurningFunctionPlusMatcher.localize` runs its stages
-(:mod:`~tfloc.tfplus.headings`, :mod:`~tfloc.tfplus.coarse`, :mod:`~tfloc.tfplus.refine`,
-:mod:`~tfloc.tfplus.cost`) as a dozen compiled kernels glued by Python: map-view look-ups,
-property reads, argument conversions, small arrays. Measured on the paper protocol (issue 26)
-that glue was ~0.15 ms of a 1.2 ms call with warm caches and ~0.4 ms of 1.7 ms once other
-matchers had run in between (as in the timing pass): the interpreter's own objects are then cold.
-Here the same kernels run in one compiled call, fed by a :class:`Plan` of everything that depends
-on the map, the laser and the configuration alone (built once per map), so per scan there is
-one dispatch from Python and the answer's assembly.
+The staged path (:meth:`~tfloc.tfplus.matcher.TurningFunctionPlusMatcher.localize`) runs a dozen
+compiled kernels glued by Python (map-view look-ups, argument conversions, small arrays), and that
+glue costs a good part of a call once other matchers have run in between and the interpreter's
+own objects are cold (measured: ``docs/tf-plus.md``, "The one-call pipeline"). Here the same
+kernels run in one compiled call, fed by a :class:`Plan` of everything that depends on the map,
+the laser and the configuration alone (built once per map): per scan, one dispatch from Python.
 
 Same arithmetic, same order, same kernels: the poses and costs are those of the staged path bit
 for bit (``tests/test_tfplus_pipeline.py`` runs both). The plan covers the default stage
@@ -38,11 +35,11 @@ from tfloc.maps.vector import VectorMap
 
 from . import refine as refine_module
 from .coarse import _offsets
+from .coarse_kernel import coarse_kernel, grid_lattice_kernel, lattice_kernel
 from .config import TfPlusConfig, coarse_search, field_view, heading_offsets, sweep
 from .cost_kernel import grid_cost_kernel, vector_cost_kernel
 from .field_kernel import refine_to_field_kernel
 from .headings import _pair_kernel, _scan_rotations
-from .kernels import coarse_kernel, grid_lattice_kernel, lattice_kernel
 from .virtual_kernel import refine_vector_kernel
 
 if TYPE_CHECKING:
@@ -71,8 +68,6 @@ def plan_for(problem: Problem, cfg: TfPlusConfig) -> Plan | None:
     """The plan of ``problem``'s map and laser under ``cfg`` (built once per map, laser and
     configuration), or ``None`` where the staged path must serve (see the module docstring)."""
     global _last
-    if not refine_module._FUSED:             # tests turn the compiled paths off
-        return None
     last = _last
     if (last is not None and last[1] is problem.laser and last[2] is cfg
             and last[0]() is problem.map):
@@ -187,6 +182,20 @@ def _seeded_headings(ranges: np.ndarray, virtual: np.ndarray, theta: float, beam
 
 
 @njit(cache=True, nogil=True)
+def _at(x: float, y: float, theta: float) -> np.ndarray:
+    """The pose ``(x, y, theta)`` as a ``(1, 3)`` array, for a ray cast."""
+    pose = np.empty((1, 3))
+    pose[0, 0], pose[0, 1], pose[0, 2] = x, y, theta
+    return pose
+
+
+@njit(cache=True, nogil=True)
+def _no_poses(status: int, returns: int, rotations: np.ndarray, seeded: bool) -> tuple:
+    """:func:`run`'s answer with no candidates (status :data:`TOO_FEW` or :data:`UNDECIDED`)."""
+    return status, returns, np.empty((0, 3)), np.empty(0), rotations, seeded, 0
+
+
+@njit(cache=True, nogil=True)
 def vector_pipeline_kernel(ranges: np.ndarray, x: float, y: float, theta: float, beams: tuple,
                            rotation: tuple, headings: tuple, lattice: tuple, coarse: tuple,
                            view: tuple, min_returns: int, iterations: int, inlier: float,
@@ -195,18 +204,15 @@ def vector_pipeline_kernel(ranges: np.ndarray, x: float, y: float, theta: float,
     """:func:`run` on a vector map (``Plan.args``; see :func:`_build`)."""
     angles, directions, cos_a, sin_a, angle_min, resolution, max_range = beams
     points = _returns_to_points(ranges, directions, max_range)
-    nothing = np.empty((0, 3))
     if points.shape[0] < min_returns:
-        return TOO_FEW, points.shape[0], nothing, np.empty(0), np.empty(0), False, 0
-    vp = np.empty((1, 3))
-    vp[0, 0], vp[0, 1], vp[0, 2] = x, y, theta
-    virtual = raycast_segments(vp, angles, segs, max_range, index)[0]
+        return _no_poses(TOO_FEW, points.shape[0], np.empty(0), False)
+    virtual = raycast_segments(_at(x, y, theta), angles, segs, max_range, index)[0]
     rots, heads, seeded = _seeded_headings(ranges, virtual, theta, beams, rotation, headings)
     offsets, table, corner_x, corner_y, res, clearance = lattice
     positions, decided = lattice_kernel(x, y, offsets, table, corner_x, corner_y, res, clearance,
                                         free[0], free[1], free[2])
     if not decided:
-        return UNDECIDED, points.shape[0], nothing, np.empty(0), rots, seeded, 0
+        return _no_poses(UNDECIDED, points.shape[0], rots, seeded)
     cands, evaluations = coarse_kernel(points, positions, x, y, heads, coarse)
     gates, inner, window, damping, prune_after, keep = refine
     cands = refine_vector_kernel(cands, points, angles, cos_a, sin_a, angle_min, resolution,
@@ -228,12 +234,9 @@ def grid_pipeline_kernel(ranges: np.ndarray, x: float, y: float, theta: float, b
     angles, directions, cos_a, sin_a, angle_min, resolution, max_range = beams
     occupied, gx, gy, cell, free, distance = grid
     points = _returns_to_points(ranges, directions, max_range)
-    nothing = np.empty((0, 3))
     if points.shape[0] < min_returns:
-        return TOO_FEW, points.shape[0], nothing, np.empty(0), np.empty(0), False, 0
-    vp = np.empty((1, 3))
-    vp[0, 0], vp[0, 1], vp[0, 2] = x, y, theta
-    virtual = raycast_grid(vp, angles, occupied, gx, gy, cell, max_range)[0]
+        return _no_poses(TOO_FEW, points.shape[0], np.empty(0), False)
+    virtual = raycast_grid(_at(x, y, theta), angles, occupied, gx, gy, cell, max_range)[0]
     rots, heads, seeded = _seeded_headings(ranges, virtual, theta, beams, rotation, headings)
     offsets, table, corner_x, corner_y, res, clearance = lattice
     positions = grid_lattice_kernel(x, y, offsets, table, corner_x, corner_y, res, clearance,

@@ -1,47 +1,32 @@
 """Point-to-line refinement of poses (``tf-plus``'s last stage): against the map itself
 (:func:`refine_to_field`, used on grid maps) or against ray-cast virtual scans (:func:`refine`,
-used on vector maps).
+used on vector maps). Both make Gauss–Newton steps on the point-to-line distances (metres) of
+the pairs closer than a gate that shrinks from ``gate_start`` to ``gate_end``.
 
 **Against the map** (:func:`refine_to_field`). Each scan point, placed at the candidate pose,
 takes the nearest map point of its cell and that point's normal
-(:class:`~tfloc.tfplus.view.MapView`, built once per map), and Gauss–Newton steps
-minimise the point-to-line distances of the pairs closer than a gate that shrinks from
-``gate_start`` to ``gate_end``. No scan is simulated, and pairing by nearest point has no beam
-window, so nothing depends on the scanner's beam count or spacing. On a grid map two phases:
+(:class:`~tfloc.tfplus.view.MapView`, built once per map): no scan is simulated and there is no
+beam window, so nothing depends on the scanner's beam count or spacing. On a grid map two phases:
 
 1. while the gate is wider than ``offset_gate``, the pose alone against the occupied cells'
-   centres: robust, but a wall drawn several cells thick holds a return equally well anywhere
-   inside it, so this alone leaves the scan free to slide across the wall;
-2. then, the pose and a fourth unknown, the **depth** (metres) at which the scan's returns lie
-   behind the walls' surfaces: each point is also measured from the surface of its wall on its
-   sensor's side (:mod:`tfloc.maps.walls`), weighted ``face_weight``, with the cell term kept at
-   ``cell_weight``. The depth starts at the median over the points and has a weak prior
-   (``offset_prior``, ``offset_weight``, in units of one point), so a scan that sees walls from
-   one side only keeps it near the prior.
+   centres: robust, but free to slide across a wall drawn several cells thick;
+2. then the pose and a fourth unknown, the **depth** (metres) of the scan's returns behind the
+   walls' surfaces (:mod:`tfloc.maps.walls`): each point is also measured from its wall's
+   surface on the sensor's side, weighted ``face_weight`` against ``cell_weight``. The depth
+   starts at the median over the points, with a weak prior (``offset_prior``,
+   ``offset_weight``, in units of one point) for a scan that sees walls from one side only.
 
-Why: a grid map built from real scans draws walls several cells thick, and where in that band
-the returns lie is a property of how the map was built. Measured at the true poses (5 cm grids
-built by ``tfloc real-data``, 180 scans per log; ``results/tf-plus-real-diagnostics.md``): the
-returns lie 2.7 cm (median; interquartile range over scans 2.3–3.2 cm) behind the surface on the
-Intel grid, 2.8 cm on the CSAIL grid, 7.5 and 12.4 cm on the Intel grid with its walls thickened
-by one and two cells, and within a map the depth varies little from scan to scan. Started at
-10 cm / 1° from the truth, this refinement settles 2.1, 2.0 and 2.2 cm from the truth on those
-three Intel grids (median), the refinement against the occupied cells alone 2.7, 5.6 and 8.8 cm,
-and the one against virtual scans 2.0, 8.7 and 16.1 cm (a ray stops at the first occupied
-cell, so the virtual scan is 1.5, 7.9 and 14.2 cm short there).
+Why: where in a thick wall the returns lie is a property of how the map was built (a few cm,
+nearly the same for every scan of a map); fitted as an unknown, it keeps the answer within about
+2 cm of the truth where the cells alone, or virtual scans that stop at a wall's first cell, drift
+by the walls' thickness (measured: ``docs/tf-plus.md``, "Real logs").
 
-**Against virtual scans** (:func:`refine`; ``refine_to="virtual"``; the only refinement before
-the real logs). Each iteration simulates the virtual scan at every candidate pose (one batched
-:meth:`Map.raycast`, so it works for any map), associates each real point with the nearest
-virtual point within ``window`` beams of the same bearing, takes the virtual scan's local line
-direction there (from its neighbouring points), and makes Gauss–Newton steps on SE(2) that
-minimise the point-to-line distances of the associated pairs, gated as above. On a vector map
-the virtual scan is exact (walls have no thickness) and it pairs points only with surfaces the
-sensor can see; there it is what ``tf-plus`` uses (on the simulated paper protocol subset it is
-also more precise than the map-point pairing: 0.13 cm / 0.017° against 0.14 cm / 0.021°).
-The pose update is in the frame of the current virtual scan: with ``δ = (tx, ty, φ)`` mapping
-real points ``p`` (sensor frame) to ``R(φ) p + t`` in the virtual pose's frame, the new pose is
-``pose ⊕ δ``.
+**Against virtual scans** (:func:`refine`, ``refine_to="virtual"``). Each iteration ray-casts the
+candidates' virtual scans (:meth:`Map.raycast`, any map) and pairs each real point with the
+nearest virtual point within ``window`` beams of its bearing, along the virtual scan's local line
+there. On a vector map the virtual scan is exact and pairs only with surfaces the sensor sees.
+With ``δ = (tx, ty, φ)`` mapping real points ``p`` (sensor frame) to ``R(φ) p + t`` in the
+virtual pose's frame, the new pose is ``pose ⊕ δ``.
 """
 
 from __future__ import annotations
@@ -57,12 +42,9 @@ from tfloc.core.map import Map
 from tfloc.core.pose import wrap_angle
 from tfloc.maps.vector import VectorMap
 
-from .field_kernel import refine_to_field_kernel
-from .kernels import face_depths_kernel, field_pairs_kernel, pairs_kernel
+from .field_kernel import field_pairs_kernel, refine_to_field_kernel
 from .view import MapView
-from .virtual_kernel import refine_vector_kernel
-
-_FUSED = True  # refine on vector maps in compiled runs (tests switch it off to compare)
+from .virtual_kernel import pairs_kernel, refine_vector_kernel
 
 
 @dataclass(frozen=True)
@@ -76,9 +58,7 @@ class RefineConfig:
             against virtual scans).
         inlier_distance: truncation of the residual used to rank candidates (metres). 10 cm:
             on real grid maps the residuals at the true pose spread over a few cm (the map's own
-            registration error), and 5 cm (chosen on simulated scans with 1 cm noise) cut
-            into them; measured on the development logs, 10 cm gave 2 more successes on Intel
-            (of 910) and none fewer on CSAIL or on the simulated protocol subset.
+            registration error), which 5 cm (chosen on simulated scans) cut into.
         prune_after: after this many iterations only the ``keep`` candidates with the lowest
             truncated residual go on, duplicates (within 5 cm of a better one) dropped
             (0: never prune).
@@ -171,13 +151,19 @@ def refine(map_: Map, laser: LaserSpec, points: np.ndarray, poses: np.ndarray,
     """Refine ``(K, 3)`` poses so the real ``points`` ``(M, 2)`` (sensor frame) lie on the map.
 
     Returns the refined poses: all ``K``, or the ``keep`` best if pruning is on (see
-    :class:`RefineConfig`)."""
+    :class:`RefineConfig`). On a vector map one compiled call (:func:`_refine_vector`), on
+    any other map :func:`_refine_steps`: the same poses."""
     poses = np.array(poses, dtype=float).reshape(-1, 3)
     points = np.ascontiguousarray(points, dtype=float)
-    cfg = config
-    gates = _gates(cfg)
-    if _FUSED and isinstance(map_, VectorMap):
-        return _refine_vector(map_, laser, points, poses, cfg, gates)
+    refine_with = _refine_vector if isinstance(map_, VectorMap) else _refine_steps
+    return refine_with(map_, laser, points, poses, config, _gates(config))
+
+
+def _refine_steps(map_: Map, laser: LaserSpec, points: np.ndarray, poses: np.ndarray,
+                  cfg: RefineConfig, gates: np.ndarray) -> np.ndarray:
+    """:func:`refine` on any map, step by step: per iteration one batched ray cast, the virtual
+    scans' geometry, ``inner`` pairings and Gauss–Newton steps, and the pruning after
+    ``prune_after`` iterations."""
     for it in range(cfg.iterations):
         q, normal = _virtual_geometry(map_.raycast(poses, laser), laser)
         delta = np.zeros_like(poses)
@@ -240,7 +226,7 @@ def _prune_index(poses: np.ndarray, cost: np.ndarray, keep: int, same: float = 0
 def field_pairs(field: MapView, points: np.ndarray, poses: np.ndarray, gate: float,
                 offsets: np.ndarray | None = None, face_weight: float = 0.0,
                 cell_weight: float = 1.0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`~tfloc.tfplus.kernels.field_pairs_kernel` on a field: ``H`` ``(K, 4, 4)``, ``g``
+    """:func:`~tfloc.tfplus.field_kernel.field_pairs_kernel` on a field: ``H`` ``(K, 4, 4)``, ``g``
     ``(K, 4)``, residuals ``(K, M)`` to the nearest map points (NaN: farther than ``gate``) and
     ranking residuals ``(K, M)`` (metres) of scan ``points`` ``(M, 2)`` at world ``poses``
     ``(K, 3)``. On a grid map the system weighs the residuals to the walls' surfaces by
@@ -254,16 +240,6 @@ def field_pairs(field: MapView, points: np.ndarray, poses: np.ndarray, gate: flo
                               field.face_minus, np.ascontiguousarray(points, dtype=float), poses,
                               offsets, gate, field.resolution, cell_weight if faces else 1.0,
                               face_weight if faces else 0.0)
-
-
-def face_depths(field: MapView, points: np.ndarray, poses: np.ndarray,
-                gate: float) -> np.ndarray:
-    """How deep (metres) each scan point lies behind its wall's surface on the sensor's side,
-    ``(K, M)`` at ``(K, 3)`` poses; NaN where the nearest map point is farther than ``gate``."""
-    return face_depths_kernel(field.nearest, float(field.origin[0]), float(field.origin[1]),
-                              field.resolution, field.points, field.normals, field.face_plus,
-                              field.face_minus, np.ascontiguousarray(points, dtype=float),
-                              np.ascontiguousarray(np.reshape(poses, (-1, 3)), dtype=float), gate)
 
 
 def field_refinement(field: MapView, cfg: RefineConfig) -> tuple:

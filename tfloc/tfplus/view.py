@@ -4,13 +4,13 @@
 
 Why the map's own points, and not a ray-cast virtual scan: a grid map built from real scans draws
 walls several cells thick (the scans' registration error, range noise), and a ray stops at the
-first occupied cell, so the virtual scan is short (measured at the true poses: median −1.5 cm on
-the Intel grid, −7.9 and −14.2 cm on it with the walls thickened by one and two cells). A return
-lies *inside* the wall it hit; the walls are followed across so that a return can be measured
-from the wall's surface. On a vector map the nearest sample point lies on the wall's line, its
-normal is the wall's, and walls have no thickness.
+first occupied cell, so the virtual scan is short, the more so the thicker the walls are drawn
+(measured: ``docs/tf-plus.md``, "Real logs"). A return lies *inside* the wall it hit; the walls
+are followed across so that a return can be measured from the wall's surface. On a vector map
+the nearest sample point lies on the wall's line, its normal is the wall's, and walls have no
+thickness.
 
-The attribute names are those the compiled kernels take (:mod:`tfloc.tfplus.kernels`): ``table``
+The attribute names are those the compiled kernels take (``tfloc.tfplus.*_kernel``): ``table``
 (distances, metres), ``origin`` (the outer corner of cell ``(0, 0)``), ``resolution``,
 ``points``/``normals``/``nearest``, ``face_plus``/``face_minus``, ``faces``.
 """

@@ -1,13 +1,12 @@
-"""The refinement against virtual scans on a vector map (:func:`tfloc.tfplus.refine.refine`),
-fused into one compiled call per run of iterations.
+"""Compiled kernels of the refinement against virtual scans (:func:`tfloc.tfplus.refine.refine`).
 
-Each iteration of :func:`~tfloc.tfplus.refine.refine` ray-casts the candidates' virtual scans,
-derives their points and line normals, and makes ``inner`` Gauss–Newton steps; from Python that
-is some 20 numpy calls and temporaries per iteration, more than the arithmetic itself. Here the
-same steps run in one numba call, with the same arithmetic in the same order (the ray cast is
-:func:`tfloc.maps._raycast.raycast_segments` itself; the beam directions' cos/sin come from
-numpy, computed once by the caller), so the refined poses are identical
-(``tests/test_fused_equivalence.py`` compares them with the step-by-step path bit for bit).
+:func:`pairs_kernel` pairs scan points with a virtual scan's points and sums one Gauss–Newton
+system (on any map); on a vector map :func:`refine_vector_kernel` runs the whole refinement, ray
+casts and pruning included, in one call. From Python an iteration was some 20 numpy calls and
+temporaries, more than its arithmetic. The same arithmetic in the same order (the ray cast is
+:func:`tfloc.maps._raycast.raycast_segments` itself; the beams' cos/sin come from numpy, computed
+once by the caller), so the poses are those of the step-by-step loop bit for bit
+(``tests/test_fused_equivalence.py``).
 """
 
 from __future__ import annotations
@@ -17,12 +16,126 @@ import math
 import numpy as np
 from numba import njit
 
-from tfloc.maps._raycast import raycast_segments
+from tfloc.maps._raycast import _atan2, raycast_segments
 from tfloc.paper.turning import _pairwise_sum
 
-from .kernels import pairs_kernel
-
 _SURE = 1e-12  # relative: squared lengths this far apart order their hypot()s the same way
+
+
+@njit(cache=True, nogil=True)
+def _beam_of(x: float, y: float, v: float, angle_min: float, resolution: float) -> int:
+    """``round((atan2(y, x) − angle_min) / resolution)``, the beam nearest the bearing of
+    ``(x, y)``, given ``v``, that bearing in beams from the cheap
+    :func:`~tfloc.maps._raycast._atan2` (error below 1e-5 rad): from ``v`` itself, and from
+    ``math.atan2`` where the two could round differently (within 1e-4 rad of a half step)."""
+    if abs(v - math.floor(v) - 0.5) > 1e-4 / resolution:
+        return int(math.floor(v + 0.5))
+    return int(round((math.atan2(y, x) - angle_min) / resolution))
+
+
+_SHRINK = 1.0 - 1e-9  # a line's squared distance, less 1e-9 of it and 1e-18 m² for rounding, bounds a pair's
+
+
+@njit(cache=True, nogil=True)
+def pairs_kernel(points: np.ndarray, delta: np.ndarray, q: np.ndarray, normal: np.ndarray,
+                 angle_min: float, resolution: float, window: int, gate: float,
+                 cos_a: np.ndarray, sin_a: np.ndarray,
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Point-to-line pairs of each candidate and one Gauss–Newton system.
+
+    ``points`` ``(M, 2)`` real points (sensor frame), ``delta`` ``(K, 3)`` current corrections
+    ``(tx, ty, φ)``, ``q``/``normal`` ``(K, n, 2)`` virtual points/unit normals (NaN: none),
+    ``cos_a``/``sin_a`` ``(n,)`` the beams' directions (the virtual points lie on them).
+    Each transformed point ``R(φ) p + t`` is paired with the nearest virtual point within
+    ``window`` beams of its bearing if closer than ``gate`` (metres). Returns the normal
+    equations ``H`` ``(K, 3, 3)``, ``g`` ``(K, 3)`` and the signed residuals ``(K, M)`` (NaN:
+    unpaired).
+    """
+    k_n, m = delta.shape[0], points.shape[0]
+    n = q.shape[1]
+    hh = np.zeros((k_n, 3, 3))
+    gg = np.zeros((k_n, 3))
+    res = np.full((k_n, m), np.nan)
+    vx = np.empty(n)          # a candidate's virtual points, +inf where there is none (never
+    vy = np.empty(n)          # nearer than the gate: the same pairs as skipping them)
+    stops = (window + 1.0) * resolution < 0.5 * math.pi - 0.01   # the lines' distances grow
+    place = np.empty((m, 4))     # a point rotated (x, y), then moved (x, y)
+    bearing = np.empty(m)        # its bearing in beams (cheap), and its beam
+    beam = np.empty(m, dtype=np.int64)
+    for k in range(k_n):
+        for j in range(n):
+            if math.isnan(q[k, j, 0]) or math.isnan(normal[k, j, 0]):
+                vx[j], vy[j] = np.inf, 0.0
+            else:
+                vx[j], vy[j] = q[k, j, 0], q[k, j, 1]
+        c, s = math.cos(delta[k, 2]), math.sin(delta[k, 2])
+        # first every point's place and bearing (the cheap bearing, then its beam), so that the
+        # search's branches below do not wait on a bearing's long chain of arithmetic
+        for i in range(m):
+            rx = c * points[i, 0] - s * points[i, 1]
+            ry = s * points[i, 0] + c * points[i, 1]
+            place[i, 0], place[i, 1] = rx, ry
+            place[i, 2], place[i, 3] = rx + delta[k, 0], ry + delta[k, 1]
+            bearing[i] = (_atan2(place[i, 3], place[i, 2]) - angle_min) / resolution
+        for i in range(m):
+            beam[i] = _beam_of(place[i, 2], place[i, 3], bearing[i], angle_min, resolution)
+        # the sums in registers, each in point order as it was in hh/gg (H is symmetric exactly:
+        # a·b and b·a are the same float)
+        h00 = h01 = h02 = h11 = h12 = h22 = g0 = g1 = g2 = 0.0
+        for i in range(m):
+            rx, ry, x, y = place[i, 0], place[i, 1], place[i, 2], place[i, 3]
+            j0, v = beam[i], bearing[i]
+            lo, hi = max(j0 - window, 0), min(j0 + window, n - 1)
+            if lo > hi:
+                continue
+            # the nearest virtual point within the window (the lowest beam among equals), searched
+            # outwards from the bearing: each side stops at a beam whose line lies farther from
+            # the point than the best so far (on that side, past the bearing and within 90° of
+            # it, every later beam's line lies farther still)
+            best, bj = gate * gate, -1
+            left = min(max(j0, lo), hi)
+            right = left + 1
+            while left >= lo or right <= hi:
+                if left >= lo:
+                    off = cos_a[left] * y - sin_a[left] * x      # signed distance to the line
+                    if stops and off * off * _SHRINK - 1e-18 > best and left < v - 0.01:
+                        left = lo - 1
+                    else:
+                        dx, dy = x - vx[left], y - vy[left]
+                        d2 = dx * dx + dy * dy
+                        if d2 < best or (d2 == best and left < bj):
+                            best, bj = d2, left
+                        left -= 1
+                if right <= hi:
+                    off = cos_a[right] * y - sin_a[right] * x
+                    if stops and off * off * _SHRINK - 1e-18 > best and right > v + 0.01:
+                        right = hi + 1
+                    else:
+                        dx, dy = x - vx[right], y - vy[right]
+                        d2 = dx * dx + dy * dy
+                        if d2 < best:
+                            best, bj = d2, right
+                        right += 1
+            if bj < 0:
+                continue
+            nx, ny = normal[k, bj, 0], normal[k, bj, 1]
+            r = nx * (x - q[k, bj, 0]) + ny * (y - q[k, bj, 1])
+            res[k, i] = r
+            j0_, j1_, j2_ = nx, ny, -nx * ry + ny * rx
+            g0 += j0_ * r
+            g1 += j1_ * r
+            g2 += j2_ * r
+            h00 += j0_ * j0_
+            h01 += j0_ * j1_
+            h02 += j0_ * j2_
+            h11 += j1_ * j1_
+            h12 += j1_ * j2_
+            h22 += j2_ * j2_
+        gg[k, 0], gg[k, 1], gg[k, 2] = g0, g1, g2
+        hh[k, 0, 0], hh[k, 0, 1], hh[k, 0, 2] = h00, h01, h02
+        hh[k, 1, 0], hh[k, 1, 1], hh[k, 1, 2] = h01, h11, h12
+        hh[k, 2, 0], hh[k, 2, 1], hh[k, 2, 2] = h02, h12, h22
+    return hh, gg, res
 
 
 @njit(cache=True, nogil=True)
