@@ -51,9 +51,10 @@ from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose, wrap_angle
 from tfloc.core.problem import Estimate
 from tfloc.errors import InvalidProblemError, ParameterError
-from tfloc.maps.build import rasterize
 from tfloc.maps.cache import cached
 from tfloc.maps.grid import GridMap
+
+from ._amcl_map import VECTOR_MAP_RESOLUTION, amcl_grid  # noqa: F401 - shared with the port (amcl)
 
 try:
     import amcl as _amcl
@@ -61,9 +62,6 @@ try:
 except ImportError as _exc:  # one line saying why, reported by tfloc.get_matcher
     raise ImportError("amcl (AMCL Python bindings, GPL-3.0) is not installed (pip install 'tfloc[amcl]')",
                       name="amcl") from _exc
-
-#: Grid resolution (m) a vector map is rasterised at, as a user would export it for Nav2
-VECTOR_MAP_RESOLUTION = 0.05
 
 _libc = ctypes.CDLL(None)  # the process's C library: the wheel draws from its drand48 stream
 
@@ -140,13 +138,6 @@ def _occupancy_grid(grid: GridMap):  # noqa: ANN202 - an amcl.OccupancyGrid
     out = _amcl.OccupancyGrid(W, H, grid.resolution, grid.origin[0], grid.origin[1])
     out.data = data.ravel()
     return out
-
-
-def amcl_grid(map_: Map) -> GridMap:
-    """The grid AMCL runs on: ``map_`` itself if it is a grid, else rasterised at 5 cm (cached per map)."""
-    if isinstance(map_, GridMap):
-        return map_
-    return cached(map_, ("amcl-grid", VECTOR_MAP_RESOLUTION), lambda: rasterize(map_, VECTOR_MAP_RESOLUTION))
 
 
 def _vec(p: Pose):  # noqa: ANN202 - an amcl.Vector3D
@@ -292,8 +283,3 @@ class AmclWheelTracker:
         scan.ranges = np.column_stack((r, self._bearings)).tolist()
         return scan
 
-
-class AmclTracker(AmclWheelTracker):
-    """``amcl`` until the Nav2 port (:mod:`tfloc.baselines.amcl`) replaces it."""
-
-    name = "amcl"
