@@ -43,3 +43,25 @@ def test_tables_and_figures(tmp_path):
     assert any(x.startswith("| odometry") for x in text.splitlines())
     figs = sorted(p.name for p in (tmp_path / "figures" / "tracking").iterdir())
     assert "seq-rate-1hz-b-trajectories.png" in figs and "seq-quick-error.png" in figs
+
+
+def test_a_sequence_with_relations_gets_the_relation_errors_and_a_set_of_buildings_per_log_tables():
+    from tfloc.io.scenario import read_scans, read_scenario
+    from tfloc.report.tracking import relations_tables, sequence_scores, tracking_tables
+
+    root = Path(__file__).resolve().parents[1] / "data" / "scenarios"
+    rows, datasets = [], {}
+    for name in ("real-csail-native", "real-aces-native"):
+        sc = read_scenario(root / name)
+        datasets[name] = sc
+        for s in read_scans(sc)[:300]:
+            pose = s.true if s.true is not None else s.odom     # truth where known
+            rows.append(result_row(name, "perfect", s.scan_id, s.group, true=s.true, init=pose, est=pose,
+                                   status="ok", wall_s=0.001, cpu_s=0.001, info={}))
+    df = pd.DataFrame(rows).astype(str)
+    text = relations_tables(df, datasets)
+    assert "real-csail-native: relation errors" in text and "Cartographer (Hess et al. 2016" in text
+    assert "real-aces-native: relation" not in text                      # no relations file named
+    s = sequence_scores(df, datasets)
+    t = tracking_tables(s, datasets)
+    assert "**real-native: real-csail-native**" in t and "**real-native**" in t   # two buildings: per log too

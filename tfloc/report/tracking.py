@@ -91,17 +91,26 @@ def condition_table(s: pd.DataFrame) -> str:
                   "jumps > 1 m (largest, m)", "CPU ms/scan (median)"], rows)
 
 
-def tracking_tables(s: pd.DataFrame) -> str:
-    """One table per sequence set, each headed with its sequences, scans and metres."""
+def tracking_tables(s: pd.DataFrame, datasets: dict[str, Scenario] | None = None) -> str:
+    """One table per sequence set, each headed with its sequences, scans and metres; a set whose
+    sequences run on different maps (different buildings) also gets one table per sequence."""
     parts = []
     for cond, g in s.groupby("condition", sort=True):
-        seqs = g.drop_duplicates("dataset")
-        scored, steps = int(seqs["n_truth"].sum()), int(seqs["n_scans"].sum())
-        scans = f"{scored} scans" if scored == steps else f"{steps} scans, {scored} of them with truth (scored)"
-        parts.append(f"**{cond}** ({len(seqs)} sequence{'s' * (len(seqs) != 1)}: "
-                     f"{', '.join(seqs['dataset'])}; {scans}, "
-                     f"{seqs['distance_m'].sum():.0f} m)\n\n" + condition_table(g))
+        maps = {str(datasets[d].map_path) for d in g["dataset"] if datasets and d in datasets}
+        if len(maps) > 1:
+            for ds, one in g.groupby("dataset", sort=False):
+                parts.append(_set_table(f"{cond}: {ds}", one))
+        parts.append(_set_table(cond, g))
     return "\n".join(parts)
+
+
+def _set_table(cond: str, g: pd.DataFrame) -> str:
+    """The heading and table of one sequence set (or one sequence)."""
+    seqs = g.drop_duplicates("dataset")
+    scored, steps = int(seqs["n_truth"].sum()), int(seqs["n_scans"].sum())
+    scans = f"{scored} scans" if scored == steps else f"{steps} scans, {scored} of them with truth (scored)"
+    return (f"**{cond}** ({len(seqs)} sequence{'s' * (len(seqs) != 1)}: {', '.join(seqs['dataset'])}; "
+            f"{scans}, {seqs['distance_m'].sum():.0f} m)\n\n" + condition_table(g))
 
 
 def kidnap_events(df: pd.DataFrame, datasets: dict[str, Scenario],
@@ -243,6 +252,50 @@ def own_score_table(df: pd.DataFrame, thresholds: Thresholds = DEFAULT) -> str:
                      "score min / p1 / p10 / p50"], rows, "lrlrl") + "\n")
 
 
+#: Cartographer on the MIT CSAIL relations (Hess et al., ICRA 2016, Table II; data/real/README.md)
+CARTOGRAPHER_CSAIL = ("Cartographer (Hess et al. 2016, Table II)", 0.0319, 0.0363, 0.369, 0.365)
+
+
+def relations_tables(df: pd.DataFrame, datasets: dict[str, Scenario]) -> str:
+    """For every sequence that names a relations file (``scenario.json`` ``"relations"``), the
+    relation errors of each matcher's tracked trajectory (Kümmerle et al. 2009; mean ± sample
+    std, every relation whose two stamps are rows), beside the published figures."""
+    from tfloc.evaluation.relations import relations_path, tracked_relation_stats
+    from tfloc.io.relations import read_relations
+    from tfloc.io.scenario import read_scans
+
+    from .relations_note import PUBLISHED_CSAIL
+
+    parts = []
+    for ds, g in df.groupby("dataset", sort=False):
+        sc = datasets.get(ds)
+        path = relations_path(sc) if sc is not None else None
+        if path is None:
+            continue
+        relations = read_relations(path)
+        stamp = {s.scan_id: s.stamp for s in read_scans(sc)}
+        rows = []
+        for m in _order(g["matcher"]):
+            r = g[g["matcher"] == m]
+            st = r["scan_id"].map(stamp).to_numpy(float)
+            est = r[["est_x", "est_y", "est_theta"]].apply(pd.to_numeric, errors="coerce").to_numpy(float)
+            x = tracked_relation_stats(st, est, relations)
+            rows.append([f"`{m}`", f"{x['n']} of {x['n_relations']}", f"{x['trans_mean_m']:.3f} ± {x['trans_std_m']:.3f}",
+                         num(x["trans_max_m"], 2), f"{x['rot_mean_deg']:.2f} ± {x['rot_std_deg']:.2f}",
+                         num(x["rot_max_deg"], 1)])
+        label, tm, ts, rm, rs = CARTOGRAPHER_CSAIL
+        rows.append([label, "published", f"{tm:.4f} ± {ts:.4f}", "–", f"{rm:.3f} ± {rs:.3f}", "–"])
+        for label, tm, ts, mx in PUBLISHED_CSAIL:
+            rows.append([label, "published", f"{tm:.3f} ± {ts:.3f}", num(mx, 2) if mx else "–", "–", "–"])
+        parts.append(f"\n**{ds}: relation errors of the tracked trajectory** (the relations of "
+                     f"`{path.name}`: each estimated relative pose between the two stamps against the "
+                     "relation; translational m, rotational °, mean ± std; the published rows are SLAM "
+                     "systems' trajectories, which use every scan and loop closures)\n\n"
+                     + table(["matcher", "relations", "translational (m)", "max (m)", "rotational (°)",
+                              "max (°)"], rows, "llrrrr"))
+    return "\n".join(parts)
+
+
 def tracking_section(df: pd.DataFrame, datasets: dict[str, Scenario], maps: dict[str, object],
                      out_dir: Path, thresholds: Thresholds = DEFAULT,
                      figures: bool = True) -> str:
@@ -257,7 +310,7 @@ def tracking_section(df: pd.DataFrame, datasets: dict[str, Scenario], maps: dict
             "evo with no alignment (map frame), over the scans with truth; a jump = an estimate more "
             "than 1 m from the prediction it started from (every scan); `odometry` = dead reckoning, "
             "the floor.\n",
-            tracking_tables(s), own_score_table(df, thresholds)]
+            tracking_tables(s, datasets), relations_tables(df, datasets), own_score_table(df, thresholds)]
     ev = kidnap_events(df, datasets, thresholds)
     if len(ev):
         ev.to_csv(Path(out_dir) / "kidnap.csv", index=False, float_format="%.6g")
