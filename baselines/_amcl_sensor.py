@@ -47,6 +47,12 @@ def likelihood_table(occ_dist: np.ndarray, z_hit: float, z_rand: float, sigma_hi
     return out, pz * pz * pz
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _laser_pose(poses: np.ndarray, j: int) -> tuple[float, float, float]:
+    """Particle ``j``'s pose with its heading normalised (the laser sits at the robot's origin)."""
+    return poses[j, 0], poses[j, 1], math.atan2(math.sin(poses[j, 2]), math.cos(poses[j, 2]))
+
+
 @njit(cache=True, nogil=True, error_model="numpy")
 def likelihood_field(poses: np.ndarray, weights: np.ndarray, ranges: np.ndarray, bearings: np.ndarray,
                      step: int, range_max: float, table: np.ndarray, off_map: float, origin_x: float,
@@ -56,9 +62,7 @@ def likelihood_field(poses: np.ndarray, weights: np.ndarray, ranges: np.ndarray,
     half_x = size_x // 2
     half_y = size_y // 2
     for j in range(poses.shape[0]):
-        x = poses[j, 0]
-        y = poses[j, 1]
-        theta = math.atan2(math.sin(poses[j, 2]), math.cos(poses[j, 2]))
+        x, y, theta = _laser_pose(poses, j)
         p = 1.0
         for i in range(0, ranges.shape[0], step):
             r = ranges[i]
@@ -133,9 +137,7 @@ def beam_model(poses: np.ndarray, weights: np.ndarray, ranges: np.ndarray, beari
     """``BeamModel::sensorFunction``: ``weights`` ``(n,)`` multiplied in place; their sum."""
     total = 0.0
     for j in range(poses.shape[0]):
-        x = poses[j, 0]
-        y = poses[j, 1]
-        theta = math.atan2(math.sin(poses[j, 2]), math.cos(poses[j, 2]))
+        x, y, theta = _laser_pose(poses, j)
         p = 1.0
         for i in range(0, ranges.shape[0], step):
             obs_range = ranges[i]

@@ -38,6 +38,8 @@ from tfloc.core.thresholds import Thresholds
 from tfloc.errors import ConfigError
 from tfloc.harness.config import RunConfig, check_imports, load_config, parse_matchers
 
+from ._options import add_progress
+
 HELP = "run matchers over scenario datasets (resumable), writing RUN/estimates.csv"
 QUICK_PER_GROUP = 3
 
@@ -78,10 +80,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--allow-import", action="store_true",
                    help="allow matchers named module:Class: they are imported, which runs the module's "
                         "code; only for configurations you trust")
-    prog = p.add_mutually_exclusive_group()
-    prog.add_argument("--progress", dest="progress", action="store_true", default=None,
-                      help="always show the progress bar (default: only on a terminal)")
-    prog.add_argument("--no-progress", dest="progress", action="store_false")
+    add_progress(p)
 
 
 def config_from_args(args: argparse.Namespace) -> RunConfig:

@@ -35,6 +35,8 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
+from ._options import add_progress
+
 HELP = "the scaling study: CPU per scan against map area, beam count and offset (README.md)"
 
 
@@ -70,10 +72,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--regenerate", action="store_true",
                    help="if OUT holds a complete study, or one of another configuration, discard it and run "
                         "again (an interrupted study of the same configuration is still resumed)")
-    prog = p.add_mutually_exclusive_group()
-    prog.add_argument("--progress", dest="progress", action="store_true", default=None,
-                      help="always show the progress bar (default: only on a terminal)")
-    prog.add_argument("--no-progress", dest="progress", action="store_false")
+    add_progress(p)
 
 
 def config_from_args(args: argparse.Namespace):

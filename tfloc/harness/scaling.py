@@ -47,7 +47,6 @@ import gc
 import hashlib
 import json
 import math
-import os
 import platform
 import resource
 import time
@@ -74,7 +73,7 @@ from tfloc.datasets.tiling import (
 )
 from tfloc.errors import ConfigError, LibraryMissingError, ResultsError
 from tfloc.evaluation.scaling import PREP_COLUMNS, SCAN_COLUMNS, SKIP_COLUMNS, over_budget
-from tfloc.io.estimates import sync_dir
+from tfloc.io.atomic import replace_atomically
 from tfloc.io.geojson import read_vector_map
 from tfloc.maps.build import rasterize
 from tfloc.maps.grid import GridMap
@@ -393,18 +392,8 @@ def study_differences(old: dict | None, new: dict) -> list[str]:
 
 # -- the output directory -----------------------------------------------------------------------
 def _write_atomic(path: Path, text: str) -> None:
-    """``text`` into ``path`` through a temporary file, fsynced and renamed (a kill leaves the old
-    or the new file)."""
-    tmp = path.with_name(path.name + ".tmp")
-    try:
-        with tmp.open("w") as fh:
-            fh.write(text)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-        sync_dir(path.parent)
-    except OSError as exc:
-        raise ResultsError(f"{path}: cannot write ({exc.strerror or exc})") from None
+    """``text`` into ``path`` atomically (:func:`tfloc.io.atomic.replace_atomically`)."""
+    replace_atomically(path, lambda fh: fh.write(text))
 
 
 @dataclass(frozen=True)

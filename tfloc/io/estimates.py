@@ -21,6 +21,7 @@ import pandas as pd
 
 from tfloc.errors import ResultsError
 
+from .atomic import replace_atomically
 from .text import csv_rows
 
 COLUMNS = ["dataset", "scan_id", "group", "matcher",
@@ -138,28 +139,13 @@ def drop_rows(path: Path, keep: set[tuple[str, str, str]]) -> int:
     kept = [r for _, r in rows if tuple(r[k] for k in KEY) in keep]
     if len(kept) == len(rows):
         return 0
-    tmp = path.with_name(path.name + ".tmp")
-    try:
-        with tmp.open("w", newline="") as fh:
-            w = csv.DictWriter(fh, fieldnames=header, extrasaction="ignore")
-            w.writeheader()
-            w.writerows(kept)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-        sync_dir(path.parent)
-    except OSError as exc:
-        raise ResultsError(f"{path}: cannot rewrite ({exc.strerror or exc}); the file is unchanged") from None
+    def write(fh) -> None:
+        w = csv.DictWriter(fh, fieldnames=header, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(kept)
+
+    replace_atomically(path, write, "cannot rewrite; the file is unchanged")
     return len(rows) - len(kept)
-
-
-def sync_dir(directory: Path) -> None:
-    """fsync a directory, so that a rename in it survives a crash."""
-    fd = os.open(directory, os.O_RDONLY)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
 
 
 class ResultWriter:

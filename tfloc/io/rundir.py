@@ -17,7 +17,6 @@ ended, load averages) and ``fingerprint`` (what decides the rows).
 from __future__ import annotations
 
 import json
-import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,7 +27,8 @@ import pandas as pd
 from tfloc.core.thresholds import Thresholds
 from tfloc.errors import ResultsError, TflocError
 
-from .estimates import REQUIRED, read_estimates, sync_dir
+from .atomic import replace_atomically
+from .estimates import REQUIRED, read_estimates
 from .scenario import SINGLE, read_scenario
 from .text import parse_text
 
@@ -202,16 +202,7 @@ class RunDir:
 
     def write(self, doc: dict[str, Any]) -> None:
         """Write ``run.json`` atomically (a temporary file, fsynced, renamed)."""
-        tmp = self.run_json.with_name(RUN_JSON + ".tmp")
-        try:
-            with tmp.open("w") as fh:
-                fh.write(json.dumps(doc, indent=2) + "\n")
-                fh.flush()
-                os.fsync(fh.fileno())
-            os.replace(tmp, self.run_json)
-            sync_dir(self.path)
-        except OSError as exc:
-            raise ResultsError(f"{self.run_json}: cannot write ({exc.strerror or exc})") from None
+        replace_atomically(self.run_json, lambda fh: fh.write(json.dumps(doc, indent=2) + "\n"))
 
     def start_session(self, doc: dict[str, Any], n_tasks: int, n_done: int, loadavg: list | None) -> None:
         """Write ``run.json`` for a new session: ``doc`` (configuration, environment, datasets,
