@@ -100,7 +100,10 @@ class Config:
 
 class AmclTracker:
     """Nav2's AMCL as a :class:`~tfloc.core.tracker.Tracker` (no single-scan mode). See the module
-    docstring and ``docs/baselines/amcl.md``."""
+    docstring and ``docs/baselines/amcl.md``. For reports, untimed and read-only: :meth:`belief`
+    (the weighed particles), :meth:`likelihood` (the laser model's factor at any pose) and
+    :meth:`last_motion`; with ``global_localization`` the first step's ``info["start"]`` is
+    ``"global"`` (the start pose the harness passed was ignored)."""
 
     name = "amcl"
 
@@ -113,6 +116,7 @@ class AmclTracker:
         if c.max_beams < 2:  # Nav2 then skips the sensor update without a word
             raise ParameterError(f"max_beams must be >= 2, got {c.max_beams}", ("max_beams",))
         self._nav: NavMap | None = None
+        self._weighed = self._scan_used = self._motion = None  # what the accessors read (start resets them)
         self.reproducible = True  #: runs with the same seed repeat bit for bit
 
     # -- the Tracker protocol ------------------------------------------------------------------
@@ -158,6 +162,10 @@ class AmclTracker:
         self._est, self._est_odom = pose, self._odom  # last published pose and its odometry
         self._pending: tuple[Pose, Pose] | None = None
         self.updates = 0
+        self._weighed: tuple[np.ndarray, np.ndarray] | None = None  # for belief(): the last weighed set
+        self._scan_used: np.ndarray | None = None                      # ... and its scan (likelihood())
+        self._motion: tuple[np.ndarray, np.ndarray, Pose] | None = None  # ... and its motion (last_motion())
+        self._say_global = c.global_localization  # the first step's info says the start pose was ignored
         if c.global_localization:  # Nav2's reinitialize_global_localization
             self._rng = self._stream()
             self._set = pf.init_uniform(self._rng, nav.free_cells, nav.geometry, c.max_particles)
@@ -232,7 +240,41 @@ class AmclTracker:
                 "cluster_cov_trace": float(np.trace(s.cluster_cov[k])) if k >= 0 else None,
                 "sigma_xy_m": float(math.sqrt(max(s.cov[0, 0] + s.cov[1, 1], 0.0))),
                 "sigma_theta_rad": float(math.sqrt(max(s.cov[2, 2], 0.0))), "injected": injected}
+        if self._say_global:  # the harness passed the first row's pose; a global start ignored it
+            info["start"] = "global"
+            self._say_global = False
         return Estimate(est, bool(s.converged), 1 if update else 0, s.count if update else 0, info)
+
+    # -- what the filter believes: read-only accessors for reports (untimed, no state change) ----
+    def belief(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The particles ``(N, 3)`` (metres, radians, headings unwrapped) and their normalised
+        weights ``(N,)`` as the last sensor update weighed them, before it resampled; ``None``
+        before the first update. Copies: what a picture of the belief draws."""
+        if self._weighed is None:
+            return None
+        poses, weights = self._weighed
+        return poses.copy(), weights.copy()
+
+    def likelihood(self, poses: np.ndarray) -> np.ndarray:
+        """The laser model's factor ``p = 1 + Σ pz³`` for the last weighed scan at each of
+        ``poses`` ``(M, 3)``: what a particle there was or would have been multiplied by (the
+        weights of :meth:`belief` are these, normalised, when the set's weights were uniform)."""
+        if self._scan_used is None:
+            raise RuntimeError("AmclTracker.likelihood before the first filter update")
+        poses = np.ascontiguousarray(np.asarray(poses, dtype=float).reshape(-1, 3))
+        factors = np.ones(poses.shape[0])
+        self._model(poses, factors, self._scan_used)
+        return factors
+
+    def last_motion(self) -> tuple[np.ndarray, np.ndarray, Pose] | None:
+        """The last motion update: the particles before and after it (``(N, 3)`` each, the same
+        order) and the odometry increment it applied (robot frame at the previous update); the
+        noise the model added is each particle's pose after minus before ⊕ increment. ``None``
+        before the first update with motion."""
+        if self._motion is None:
+            return None
+        before, after, delta = self._motion
+        return before.copy(), after.copy(), delta
 
     # -- the filter ------------------------------------------------------------------------------
     def _stream(self) -> np.ndarray:
@@ -261,22 +303,28 @@ class AmclTracker:
             motion.omni(self._rng, poses, pose, delta, c.alpha1, c.alpha2, c.alpha3, c.alpha4, c.alpha5)
         else:
             motion.differential(self._rng, poses, pose, delta, c.alpha1, c.alpha2, c.alpha3, c.alpha4)
+        self._motion = (self._set.poses, poses, Pose.from_array(self._pf_odom).between(Pose.from_array(pose)))
         self._set = dataclasses.replace(self._set, poses=poses)
 
     def _sense(self, scan: np.ndarray) -> None:
         """``pf_update_sensor`` with the configured laser model, on a copy of the weights."""
-        c, s, nav = self.config, self._set, self._nav
+        c, s = self.config, self._set
         weights = s.weights.copy()
-        if c.laser_model_type == "beam":
-            total = sensor.beam_model(s.poses, weights, scan, self._bearings, self._step, self._range_max,
-                                      nav.occ_state, *nav.geometry, c.z_hit, c.z_short, c.z_max, c.z_rand,
-                                      c.sigma_hit, c.lambda_short)
-        else:
-            total = sensor.likelihood_field(s.poses, weights, scan, self._bearings, self._step,
-                                            self._range_max, self._table, self._off_map, *nav.geometry)
+        total = self._model(s.poses, weights, scan)
         self._w_slow, self._w_fast = pf.normalise(weights, total, self._w_slow, self._w_fast,
                                                   c.recovery_alpha_slow, c.recovery_alpha_fast)
         self._set = dataclasses.replace(s, weights=weights)
+        self._weighed, self._scan_used = (s.poses, weights), scan
+
+    def _model(self, poses: np.ndarray, weights: np.ndarray, scan: np.ndarray) -> float:
+        """The configured laser model: ``weights`` multiplied in place by each pose's factor; their sum."""
+        c, nav = self.config, self._nav
+        if c.laser_model_type == "beam":
+            return sensor.beam_model(poses, weights, scan, self._bearings, self._step, self._range_max,
+                                     nav.occ_state, *nav.geometry, c.z_hit, c.z_short, c.z_max, c.z_rand,
+                                     c.sigma_hit, c.lambda_short)
+        return sensor.likelihood_field(poses, weights, scan, self._bearings, self._step,
+                                       self._range_max, self._table, self._off_map, *nav.geometry)
 
     def _scan(self, ranges: np.ndarray, where: str) -> np.ndarray:
         """The ranges as ``AmclNode::updateFilter`` hands them over: a no-return (inf, NaN, ≥ the

@@ -10,8 +10,17 @@ the prediction alone (dead reckoning).
 
 Output (--out): scan_id, est_x, est_y, est_theta, status, cpu_s; one row per scan, in order.
 
+--draw-at SCAN_ID (or first-loss: the first scan with truth whose estimate is more than 0.5 m or
+10 deg off) looks at the tracker right after that scan's step: --figure PATH draws the map around
+the robot, the truth (if known), the prediction, the estimate and the tracker's belief if it
+exposes one (AMCL's particles, coloured by weight); --explain prints the step's info and the
+belief's weights (effective sample size, the sensor factor at the truth, the estimate and half a
+metre off, the spread the motion model added). Drawing and summary: tfloc/report/belief.py.
+
 Example:
   tfloc track --dataset data/scenarios/seq-quick --matcher tf-plus --out est.csv
+  tfloc track --dataset data/scenarios/real-csail-native --matcher amcl --draw-at first-loss \
+      --figure loss.png --explain
 """
 
 from __future__ import annotations
@@ -23,7 +32,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from tfloc.errors import ResultsError
+from tfloc.errors import ConfigError, ResultsError
 
 HELP = "track a sequence dataset with one matcher (guess = last estimate ⊕ odometry)"
 COLUMNS = ["scan_id", "est_x", "est_y", "est_theta", "status", "cpu_s"]
@@ -37,23 +46,40 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
                    help="a matcher parameter, VALUE in TOML syntax (repeatable)")
     p.add_argument("--out", type=Path, default=Path("est.csv"), help="output CSV (default: est.csv)")
+    p.add_argument("--draw-at", metavar="SCAN_ID",
+                   help="look at the tracker after this scan's step ('first-loss': the first scan lost)")
+    p.add_argument("--figure", type=Path, metavar="PATH",
+                   help="with --draw-at: write the picture there (.png, .pdf or .svg)")
+    p.add_argument("--explain", action="store_true",
+                   help="with --draw-at: print the step's info and the belief's weights")
 
 
 def run(args: argparse.Namespace) -> int:
+    from tfloc.core.tracker import as_tracker
     from tfloc.harness.threads import limit_threads
     from tfloc.harness.track import check_sequence, track
     from tfloc.io.scenario import read_scans, read_scenario
+    from tfloc.report.belief import Watch
 
     from ._matcher import matcher_from_args
 
+    check_draw_options(args)
     limit_threads(1)
     scenario = read_scenario(args.dataset)
     scans = read_scans(scenario)
     check_sequence(scenario, scans)
-    matcher = matcher_from_args(args.matcher, args.param, "track")
+    target = draw_target(args.draw_at, scans, scenario.scans_path)
+    tracker = as_tracker(matcher_from_args(args.matcher, args.param, "track"))
+    watch = Watch(tracker, scans, scenario.laser.angles, target) if target is not None else None
     with tqdm(total=len(scans), desc=args.matcher, unit="scan", disable=not sys.stderr.isatty()) as bar:
-        rows = track(scenario, scans, matcher, progress=lambda _k: bar.update(1))
+        def progress(k: int) -> None:
+            bar.update(1)
+            if watch is not None:
+                watch(k)
+        rows = track(scenario, scans, tracker, progress=progress)
     write_track(args.out, rows)
+    if watch is not None:
+        show(args, watch.result(rows), scenario, scans[0])
     counts: dict[str, int] = {}
     for r in rows:
         kind = r["status"].partition(":")[0]
@@ -61,6 +87,54 @@ def run(args: argparse.Namespace) -> int:
     print(f"wrote {args.out}: {len(rows)} scans; " + ", ".join(f"{k} {v}" for k, v in counts.items()),
           file=sys.stderr)
     return 3 if counts.get("error") else 0
+
+
+def check_draw_options(args: argparse.Namespace) -> None:
+    """One line naming the option for a bad combination or file type (before any work)."""
+    if args.draw_at is None:
+        for given, name in ((args.figure is not None, "--figure"), (args.explain, "--explain")):
+            if given:
+                raise ConfigError(f"{name} needs --draw-at SCAN_ID (or --draw-at first-loss)")
+        return
+    if args.figure is None and not args.explain:
+        raise ConfigError(f"--draw-at {args.draw_at}: give --figure PATH and/or --explain")
+    if args.figure is not None and args.figure.suffix.lower() not in (".png", ".pdf", ".svg"):
+        raise ConfigError(f"--figure {args.figure}: the picture's name must end in .png, .pdf or .svg")
+
+
+def draw_target(draw_at: str | None, scans: list, where: Path) -> int | str | None:
+    """The scan index ``--draw-at`` names, :data:`~tfloc.report.belief.FIRST_LOSS`, or ``None``."""
+    from tfloc.report.belief import FIRST_LOSS
+
+    if draw_at is None:
+        return None
+    if draw_at == FIRST_LOSS:
+        if not any(s.true is not None for s in scans):
+            raise ConfigError(f"--draw-at {FIRST_LOSS}: {where} has no truth to tell a loss")
+        return FIRST_LOSS
+    ids = [str(s.scan_id) for s in scans]
+    if draw_at not in ids:
+        raise ConfigError(f"--draw-at {draw_at}: no such scan_id in {where} (first {ids[0]}, last {ids[-1]})")
+    return ids.index(draw_at)
+
+
+def show(args: argparse.Namespace, snap, scenario, first_scan) -> None:
+    """Print and draw the snapshot ``--draw-at`` asked for (or say that no scan was lost)."""
+    from tfloc.io.scenario import map_for
+    from tfloc.report.belief import explain, fig_belief
+
+    if snap is None:
+        print(f"--draw-at {args.draw_at}: no scan with truth was lost; nothing drawn", file=sys.stderr)
+        return
+    if args.explain:
+        print(f"{args.matcher} on {scenario.name}, " + explain(snap), flush=True)
+    if args.figure is not None:
+        the_map = map_for(scenario, first_scan, {})
+        try:
+            fig_belief(snap, the_map, args.figure, f"{args.matcher} on {scenario.name}", scenario.laser.max_range)
+        except OSError as exc:
+            raise ResultsError(f"--figure {args.figure}: cannot write ({exc.strerror or exc})") from None
+        print(f"wrote {args.figure}", file=sys.stderr)
 
 
 def write_track(path: Path, rows: list[dict]) -> None:

@@ -12,7 +12,9 @@ sequences, the longest lost stretch, APE translation RMSE pooled over scans (cm)
 :mod:`tfloc.evaluation.trajectory`. Figures: each sequence's trajectories drawn on the map per
 matcher, and the distance error over distance travelled. Sets whose sequences have kidnap events
 (``scenario.json`` ``"kidnaps"``) get a kidnap table too (:func:`kidnap_tables`;
-:mod:`tfloc.evaluation.kidnap`), their events one row each in ``kidnap.csv``.
+:mod:`tfloc.evaluation.kidnap`), their events one row each in ``kidnap.csv``. Sets where a
+tracker starts without a pose (its first row's ``info`` says so) get a start table
+(:func:`start_tables`; :mod:`tfloc.evaluation.global_start`), one row per sequence in ``start.csv``.
 """
 
 from __future__ import annotations
@@ -28,7 +30,8 @@ from matplotlib.figure import Figure
 
 from tfloc.core.thresholds import Thresholds
 from tfloc.core.tracker import DeadReckoning
-from tfloc.evaluation.kidnap import WITHIN, median_scans, score_kidnaps
+from tfloc.evaluation.global_start import SETTLE_M, SETTLE_SCANS, score_start, starts_without_pose
+from tfloc.evaluation.kidnap import HOLD, WITHIN, median_scans, score_kidnaps
 from tfloc.evaluation.trajectory import (
     LOST_DIST_M,
     LOST_ORIENT_DEG,
@@ -158,6 +161,60 @@ def kidnap_tables(ev: pd.DataFrame) -> str:
                          ["matcher", "events", f"relocalized within {WITHIN} scans",
                           "median scans to relocalize", "false relocalizations",
                           "tracked % (mean over sequences)"], rows))
+    return "\n".join(parts)
+
+
+def start_scores(df: pd.DataFrame, datasets: dict[str, Scenario],
+                 thresholds: Thresholds = DEFAULT) -> pd.DataFrame:
+    """One row per (dataset, matcher) of a set where some matcher starts without a pose: its set,
+    whether it did (``info["start"]`` of its first row), the start window (to the first kidnap
+    scan, else the end), scans to converge (NaN = never), the scan it first settled at and
+    whether that place was wrong. Empty when no matcher starts without a pose."""
+    out = []
+    for (ds, m), g in df.groupby(["dataset", "matcher"], sort=False):
+        sc = datasets.get(ds)
+        pos = {str(sid): i for i, sid in enumerate(g["scan_id"].astype(str))}
+        kid = [pos[k] for k in map(str, (sc.extra.get("kidnaps") or []) if sc is not None else []) if k in pos]
+        st = score_start(_poses(g, "est"), _poses(g, "true"), min(kid, default=len(g)), thresholds)
+        first = g["info"].iloc[0] if "info" in g else ""
+        out.append({"dataset": ds, "matcher": m, "set": condition_of(sc, g),
+                    "no_pose": starts_without_pose(json.loads(first) if isinstance(first, str) and first else {}),
+                    "window": st.window,
+                    "scans_to_converge": math.nan if st.scans_to_converge is None else st.scans_to_converge,
+                    "settled": math.nan if st.settled is None else st.settled, "settled_wrong": st.wrong})
+    st = pd.DataFrame(out)
+    if not len(st) or not st["no_pose"].any():
+        return st.iloc[0:0]
+    sets = set(st.loc[st["no_pose"], "set"])
+    return st[st["set"].isin(sets)].reset_index(drop=True)
+
+
+def start_tables(st: pd.DataFrame) -> str:
+    """One markdown table per set of :func:`start_scores`: per matcher its start (no pose or
+    given), the sequences it converged on within the start window, scans to converge per
+    sequence and their median ("never" counted as infinitely many), and the sequences where it
+    first settled on a wrong place."""
+    parts = []
+    for cond, g in st.groupby("set", sort=True):
+        seqs = sorted(g["dataset"].unique())
+        rows = []
+        for m in _order(g["matcher"]):
+            h = g[g["matcher"] == m].set_index("dataset").reindex(seqs)
+            n = [None if not np.isfinite(v) else int(v) for v in h["scans_to_converge"].to_numpy(float)]
+            med = median_scans(n)
+            wrong = [d for d, w, s in zip(seqs, h["settled_wrong"], h["settled"], strict=True)
+                     if bool(w) and np.isfinite(s)]
+            rows.append([m, "none" if bool(h["no_pose"].fillna(False).any()) else "given",
+                         f"{sum(v is not None for v in n)}/{len(n)}",
+                         " / ".join("never" if v is None else str(v) for v in n),
+                         "never" if math.isinf(med) else num(med, 0),
+                         f"{len(wrong)}/{len(n)}" + (f" ({', '.join(wrong)})" if wrong else "")])
+        window = ", ".join(f"{d} {int(w)}" for d, w in g.drop_duplicates("dataset").sort_values("dataset")[
+            ["dataset", "window"]].to_numpy())
+        parts.append(f"**{cond}: the start** ({len(seqs)} sequence{'s' * (len(seqs) != 1)}; start window in "
+                     f"scans, to the first kidnap or the end: {window})\n\n" + table(
+                         ["matcher", "start pose", "converged", "scans to converge (per sequence, as listed)",
+                          "median scans to converge", "first settled on a wrong place"], rows, "llrrrl"))
     return "\n".join(parts)
 
 
@@ -319,6 +376,17 @@ def tracking_section(df: pd.DataFrame, datasets: dict[str, Scenario], maps: dict
                  "there for 3 scans (never: not before the next event or the end); a false "
                  "relocalization = the estimate jumps > 1 m from its prediction, away from a "
                  "correct pose to a wrong one. Per event: `kidnap.csv`.\n", kidnap_tables(ev)]
+    st = start_scores(df, datasets, thresholds)
+    if len(st):
+        st.to_csv(Path(out_dir) / "start.csv", index=False, float_format="%.6g")
+        text += [f"\nThe start, for sets where a tracker starts without a pose (its first row says "
+                 "`\"start\": \"global\"`: it ignored the first row's pose; the others, given it, are "
+                 "the reference): converged = the first scan within the thresholds that stays there "
+                 f"for {HOLD} scans, before the first kidnap (never: not before it); settled = the "
+                 f"estimate stays within {SETTLE_M:g} m of one place (carried along by the robot's true "
+                 f"motion) for {SETTLE_SCANS} scans; on a wrong place when that place is more than "
+                 f"{LOST_DIST_M:g} m or {LOST_ORIENT_DEG:g}° off. Per sequence: `start.csv`.\n",
+                 start_tables(st)]
     if figures:
         fig_dir = Path(out_dir) / "figures" / "tracking"
         for ds, g in df.groupby("dataset", sort=False):
