@@ -36,6 +36,7 @@ from tfloc.core.map import Map
 from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate
+from tfloc.core.tracker import GLOBAL_START, START_KEY
 from tfloc.errors import InvalidProblemError, ParameterError
 from tfloc.maps.cache import cached
 
@@ -241,7 +242,7 @@ class AmclTracker:
                 "sigma_xy_m": float(math.sqrt(max(s.cov[0, 0] + s.cov[1, 1], 0.0))),
                 "sigma_theta_rad": float(math.sqrt(max(s.cov[2, 2], 0.0))), "injected": injected}
         if self._say_global:  # the harness passed the first row's pose; a global start ignored it
-            info["start"] = "global"
+            info[START_KEY] = GLOBAL_START
             self._say_global = False
         return Estimate(est, bool(s.converged), 1 if update else 0, s.count if update else 0, info)
 

@@ -29,6 +29,9 @@ from .problem import Estimate, Problem
 
 #: ``info["status"]`` of a step whose estimate is the prediction (the matcher declined)
 PREDICTED = "predicted"
+#: ``info[START_KEY] == GLOBAL_START`` on a tracker's first step: it started without a pose
+#: (ignoring the one the harness passed), so its first scans are a global search
+START_KEY, GLOBAL_START = "start", "global"
 
 
 @runtime_checkable

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tfloc.core.thresholds import Thresholds
+from tfloc.core.tracker import GLOBAL_START, START_KEY
 
 from .kidnap import DEFAULT, HOLD, correct, scans_to_relocalize
 from .trajectory import LOST_DIST_M, LOST_ORIENT_DEG, errors
@@ -34,8 +35,6 @@ from .trajectory import LOST_DIST_M, LOST_ORIENT_DEG, errors
 SETTLE_M = 0.5
 #: ... for this many scans in a row
 SETTLE_SCANS = 10
-#: ``info[START_KEY] == GLOBAL_START``: the tracker started without a pose
-START_KEY, GLOBAL_START = "start", "global"
 
 
 @dataclass(frozen=True)
