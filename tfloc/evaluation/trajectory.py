@@ -211,7 +211,7 @@ def pooled_share(k, n, n_boot: int = 2000, seed: int = 20261122) -> tuple[float,
     interval is NaN with fewer than two sequences (scans of one sequence are not independent)."""
     k, n = np.asarray(k, dtype=float), np.asarray(n, dtype=float)
     share = float(k.sum() / n.sum()) if n.sum() > 0 else math.nan
-    if len(k) < 2:
+    if len(k) < 2 or not n.sum() > 0:
         return share, math.nan, math.nan
     idx = np.random.default_rng(seed).integers(0, len(k), size=(n_boot, len(k)))
     boot = k[idx].sum(axis=1) / n[idx].sum(axis=1)
