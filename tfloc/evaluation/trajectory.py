@@ -214,6 +214,7 @@ def pooled_share(k, n, n_boot: int = 2000, seed: int = 20261122) -> tuple[float,
     if len(k) < 2 or not n.sum() > 0:
         return share, math.nan, math.nan
     idx = np.random.default_rng(seed).integers(0, len(k), size=(n_boot, len(k)))
-    boot = k[idx].sum(axis=1) / n[idx].sum(axis=1)
-    lo, hi = np.percentile(boot, [2.5, 97.5])
+    with np.errstate(invalid="ignore", divide="ignore"):   # a draw of unscored sequences only
+        boot = k[idx].sum(axis=1) / n[idx].sum(axis=1)
+    lo, hi = np.nanpercentile(boot, [2.5, 97.5])
     return share, float(lo), float(hi)
