@@ -41,10 +41,17 @@ def _guesses(rng: np.random.Generator, n: int) -> list[Pose]:
                  TRUE.theta + rng.uniform(-0.25, 0.25)) for _ in range(n)]
 
 
+CHANGED = {"free_distance": 0.05, "short_residual": 0.05, "see_through_share": 0.05, "short_refine": True,
+           "object_extent": 1.2}
+
+
 @pytest.mark.parametrize("overrides", [{}, {"beam_check": False},
                                        {"refinement": {"prune_after": 0}},
                                        {"refinement": {"iterations": 3, "prune_after": 3, "keep": 1}},
-                                       {"coarse_points": 0, "candidates": 2}])
+                                       {"coarse_points": 0, "candidates": 2},
+                                       {"refine_to": "field"}, CHANGED,
+                                       {**CHANGED, "refine_to": "field", "beam_check": False},
+                                       {"short_residual": 0.0, "see_through_share": 0.0, "short_margin": 0.1}])
 def test_pipeline_equals_the_stages_on_a_vector_map(overrides, test_room, lms200, monkeypatch):
     m = TurningFunctionPlusMatcher(**overrides)
     rng = np.random.default_rng(7)
@@ -58,7 +65,8 @@ def test_pipeline_equals_the_stages_on_a_vector_map(overrides, test_room, lms200
 
 
 @pytest.mark.parametrize("overrides", [{}, {"refinement": {"faces": False}},
-                                       {"refinement": {"prune_after": 0}}])
+                                       {"refinement": {"prune_after": 0}}, CHANGED,
+                                       {**CHANGED, "beam_check": False}])
 def test_pipeline_equals_the_stages_on_a_grid_map(overrides, test_room, lms200, monkeypatch):
     grid = rasterize(test_room, 0.05)
     m = TurningFunctionPlusMatcher(**overrides)
@@ -70,11 +78,14 @@ def test_pipeline_equals_the_stages_on_a_grid_map(overrides, test_room, lms200, 
         assert _same(fused, staged), (overrides, seed)
 
 
-@pytest.mark.parametrize("name", ["office-pool", "real-intel-scan-to-map", "real-csail-scan-to-map"])
-def test_pipeline_equals_the_stages_on_bundled_scans(name, monkeypatch):
+@pytest.mark.parametrize(("name", "overrides"), [
+    ("office-pool", {}), ("real-intel-scan-to-map", {}), ("real-csail-scan-to-map", {}),
+    ("changed-clutter-25", {**CHANGED, "refine_to": "field"}),
+    ("real-intel-scan-to-map", CHANGED)])
+def test_pipeline_equals_the_stages_on_bundled_scans(name, overrides, monkeypatch):
     scenario, scans = load_dataset(str(ROOT / "data" / "scenarios" / name))
     items = list(scans.values())
-    m = TurningFunctionPlusMatcher()
+    m = TurningFunctionPlusMatcher(**overrides)
     m.prepare(problem_of(scenario, items[0]))
     for scan in items[::max(1, len(items) // 8)][:8]:
         p = problem_of(scenario, scan)
@@ -94,7 +105,7 @@ def test_too_few_returns_is_the_same_no_answer(lms200, monkeypatch):
 
 @pytest.mark.parametrize("overrides", [{"tf_seed": False}, {"heading_sweep": False},
                                        {"grid": False}, {"refine": False}, {"select": "tf"},
-                                       {"select": "virtual"}, {"refine_to": "field"}])
+                                       {"select": "virtual"}])
 def test_other_configurations_go_the_staged_way(overrides, test_room, lms200):
     p = Problem(test_room, lms200, noisy_scan(test_room, lms200, TRUE), TRUE)
     m = TurningFunctionPlusMatcher(**overrides)
@@ -150,5 +161,7 @@ def test_the_memo_follows_the_map_and_the_configuration(test_room, lms200):
     a.prepare(pv)
     plans = [pipeline.plan_for(q, m.config) for q, m in ((pv, a), (pg, a), (pv, b), (pv, a))]
     assert [p.kind for p in plans] == ["vector", "grid", "vector", "vector"]
+    c = TurningFunctionPlusMatcher(refine_to="field")
+    assert pipeline.plan_for(pv, c.config).kind == "vector-field"
     assert plans[0] is plans[3] and plans[0] is not plans[2]
     assert plans[0].args[9] is True and plans[2].args[9] is False     # beam_check

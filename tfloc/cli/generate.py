@@ -7,7 +7,9 @@ labelled conditions: tfloc.datasets.sequences; the kidnapped sequences OUT/scena
 tfloc.datasets.kidnap) and the changed-world datasets
 OUT/scenarios/changed-{clutter-0,clutter-10,clutter-25,furniture-gone} (the furnished office's
 map, scans with unmapped people and boxes or without the furniture; tfloc.datasets.changed_world),
-and the global-localization datasets OUT/scenarios/global-office-{1,2,3} (evaluation) and
+the second changed-world generator's OUT/scenarios/changed-{doors,moved,carts,months} (the crowded
+office's map, scans after doors, movable objects, carts and people changed;
+tfloc.datasets.rearranged), and the global-localization datasets OUT/scenarios/global-office-{1,2,3} (evaluation) and
 global-dev-office-{1,2,3} (development; tfloc.datasets.global_sets). The same seeds give the
 same bytes.
 """
@@ -46,6 +48,7 @@ def run(args: argparse.Namespace) -> int:
     from tfloc.datasets.changed_world import generate_changed_world
     from tfloc.datasets.global_sets import generate_global_offices
     from tfloc.datasets.noise import NoiseModel
+    from tfloc.datasets.rearranged import generate_rearranged
     from tfloc.datasets.synthetic import BundleSpec, generate_bundle
 
     detail = args.detail_per_cell if args.detail_per_cell is not None else max(1, args.per_cell // 3)
@@ -61,5 +64,6 @@ def run(args: argparse.Namespace) -> int:
 
         generate_kidnap_sequences(args.out, SimSpec(noise=spec.noise), log=print)
     generate_changed_world(args.out, spec, log=print)
+    generate_rearranged(args.out, spec, log=print)
     generate_global_offices(args.out, args.global_seed, args.global_scans, noise=spec.noise, log=print)
     return 0

@@ -43,15 +43,40 @@ class TfPlusConfig:
         tie_tolerance: candidates whose cost is within this fraction of the best are a tie
             (the scan sees the same geometry from both, e.g. a bare corner), broken by
             distance to the VP (0: no tie-break).
+        free_distance: coarse search: a scan point in the map's known free space counts at most
+            this far from the map (metres; a return from an unmapped object in front of a wall
+            looks like a wrong pose's point to a distance field,
+            :func:`tfloc.tfplus.view.free_capped`); ``None``: every point up to
+            ``field_truncation``.
+        short_margin: a return that ends more than this short of the map's surface along its beam
+            (metres; the map clear of walls that far beyond it) is **short**: an object the map
+            lacks stopped it, not a pose error of a few cm (:func:`tfloc.tfplus.cost.short_beams`).
+        short_residual: selection: a short return counts at most this residual (metres;
+            :mod:`tfloc.tfplus.cost`); ``None``: like any other return.
+        object_extent: with it, short returns count as an unmapped object (in the selection and
+            the refinement) only as a whole group of consecutive returns of the scan at most this
+            long from first to last point (metres; a person, a box, a cart): a wall's worth of
+            short returns, or a part of a group, says the pose is wrong
+            (:func:`tfloc.tfplus.cost.object_groups`); ``None``: each short return on its own.
+        short_refine: refinement against the map itself (grid maps, ``refine_to="field"``):
+            short returns at a candidate's coarse pose are left out of its refinement, each
+            candidate refined on its own returns and none pruned (:mod:`tfloc.tfplus.unmapped`).
+        see_through_share: selection: see-through beams count ``inlier_distance²`` each up to
+            this share of the beams; beyond it their penalty is scaled down so that together
+            they weigh that share (a map whose furniture is gone makes many beams pass where it
+            has obstacles, at the true pose too). 1: every see-through beam in full.
         shape: the scan-shape parameters (ShortStraw, polygon closure) of the turning-function
             seed and of the ``select="tf"`` Err; the resampling distance is 5 cm (the paper's
             S = 1 m gives edges too coarse for their directions to be a heading estimate).
     """
 
     RULES: ClassVar[dict] = {  # rule → parameters it applies to (core.params)
-        "> 0": ("grid_step", "heading_step", "field_resolution", "field_truncation"),
+        "> 0": ("grid_step", "heading_step", "field_resolution", "field_truncation",
+                "short_margin"),
         ">= 0": ("search_radius", "clearance", "rotation_seeds", "max_rotation", "heading_span",
-                 "separation", "tie_tolerance", "wall_thickness", "coarse_points"),
+                 "separation", "tie_tolerance", "wall_thickness", "coarse_points",
+                 "free_distance", "short_residual", "object_extent"),
+        "[0, 1]": ("see_through_share",),
         ">= 1": ("scan_stride", "shortlist", "candidates", "min_returns"),
         "finite": ("heading_offsets",),
         ("residual", "virtual", "tf"): ("select",),
@@ -84,8 +109,25 @@ class TfPlusConfig:
     min_returns: int = 10  #: fewer valid returns than this is a no-answer
     tie_tolerance: float = 0.1
     beam_check: bool = True  #: count see-through beams in the selection cost (.cost)
+    free_distance: float | None = None
+    short_margin: float = 0.3
+    short_residual: float | None = None
+    object_extent: float | None = None
+    short_refine: bool = False
+    see_through_share: float = 1.0
     refinement: RefineConfig = RefineConfig()  #: the point-to-line refinement's parameters
     shape: ShapeConfig = ShapeConfig(spacing=0.05)
+
+
+#: ``tf-plus``'s changed-world configuration (``docs/robustness.md``): overrides of
+#: :class:`TfPlusConfig` for a world that has changed since it was mapped (people, carts, doors,
+#: furniture moved or gone). Chosen on the development split of the ``changed-clutter-*`` and
+#: ``changed-furniture-gone`` scans (``benchmarks/dev/changed-world.toml``); not the default: on
+#: the paper protocol and the real logs it gives other (not worse) answers at more CPU per scan.
+#: ``TurningFunctionPlusMatcher(**CHANGED_WORLD)``; in a run configuration, the same as ``params``.
+CHANGED_WORLD = {"refine_to": "field", "free_distance": 0.05, "short_margin": 0.3,
+                 "short_residual": 0.05, "object_extent": 1.0, "short_refine": True,
+                 "see_through_share": 0.05, "shortlist": 128, "candidates": 6}
 
 
 def field_view(map_: Map, cfg: TfPlusConfig) -> MapView:
@@ -95,9 +137,9 @@ def field_view(map_: Map, cfg: TfPlusConfig) -> MapView:
 
 def coarse_view(map_: Map, cfg: TfPlusConfig) -> MapView:
     """The view the coarse search scores on: pooled over ± half a lattice step
-    (``coarse_bound``), else the view itself."""
+    (``coarse_bound``), else the view itself; capped in free space (``free_distance``)."""
     return map_view(map_, cfg.field_resolution, cfg.field_truncation, cfg.wall_thickness,
-                    cfg.grid_step / 2.0 if cfg.coarse_bound else 0.0)
+                    cfg.grid_step / 2.0 if cfg.coarse_bound else 0.0, cfg.free_distance)
 
 
 @lru_cache(maxsize=16)

@@ -50,9 +50,10 @@ from .config import coarse_view as _coarse_field
 from .config import field_view as _field
 from .config import heading_offsets as _heading_offsets
 from .config import sweep as _sweep
-from .cost import scan_cost
+from .cost import object_groups, scan_cost
 from .headings import scan_rotations
 from .refine import refine, refine_to_field
+from .unmapped import refine_each_to_field
 
 
 def heading_seeds(problem: Problem, cfg: TfPlusConfig) -> tuple[np.ndarray, dict]:
@@ -175,7 +176,14 @@ class TurningFunctionPlusMatcher(Configured):
             to = cfg.refine_to
             if to == "auto":
                 to = "field" if isinstance(problem.map, GridMap) else "virtual"
-            if to == "field":
+            if to == "field" and cfg.short_refine:
+                cands = refine_each_to_field(problem.map, problem.laser, problem.ranges,
+                                             _field(problem.map, cfg), cands, cfg.refinement,
+                                             cfg.short_margin, cfg.min_returns,
+                                             object_groups(problem.laser, problem.ranges,
+                                                           cfg.object_extent),
+                                             lambda poses: self._cost(problem, poses))
+            elif to == "field":
                 cands = refine_to_field(_field(problem.map, cfg), points, cands, cfg.refinement)
             else:
                 cands = refine(problem.map, problem.laser, points, cands, cfg.refinement)
@@ -196,7 +204,9 @@ class TurningFunctionPlusMatcher(Configured):
         cfg = self.config
         field = _field(problem.map, cfg) if cfg.select != "virtual" else None
         return scan_cost(problem.map, problem.laser, problem.ranges, poses, cfg.refinement.window,
-                         cfg.refinement.inlier_distance, cfg.beam_check, field)
+                         cfg.refinement.inlier_distance, cfg.beam_check, field,
+                         cfg.short_residual,
+                         cfg.see_through_share, cfg.short_margin, cfg.object_extent)
 
 
 __all__ = ["TfPlusConfig", "TurningFunctionPlusMatcher", "heading_seeds", "pick", "tf_errs"]

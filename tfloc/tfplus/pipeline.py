@@ -9,11 +9,12 @@ the laser and the configuration alone (built once per map): per scan, one dispat
 
 Same arithmetic, same order, same kernels: the poses and costs are those of the staged path bit
 for bit (``tests/test_tfplus_pipeline.py`` runs both). The plan covers the default stage
-switches only (turning-function seeds and the heading sweep, the coarse grid, the refinement
-``refine_to="auto"`` or its map's own kind, ``select="residual"``); every other configuration,
-another kind of map, or a vector map whose free-space tests are not built, goes the staged way
-(:func:`plan_for` returns ``None``), and so does a scan whose lattice the compiled free-space
-test cannot decide (status :data:`UNDECIDED`).
+switches only (turning-function seeds and the heading sweep, the coarse grid, the refinement,
+``select="residual"``; on a vector map against virtual scans or the map itself, on a grid map
+against the map itself); every other configuration, another kind of map, or a vector map whose
+free-space tests are not built, goes the staged way (:func:`plan_for` returns ``None``), and so
+does a scan whose lattice the compiled free-space test cannot decide (status
+:data:`UNDECIDED`).
 """
 
 from __future__ import annotations
@@ -34,13 +35,22 @@ from tfloc.maps.inside import SURE
 from tfloc.maps.vector import VectorMap
 
 from . import refine as refine_module
+from . import unmapped as unmapped_module
 from .coarse import _offsets
 from .coarse_kernel import coarse_kernel, grid_lattice_kernel, lattice_kernel
 from .config import TfPlusConfig, coarse_search, field_view, heading_offsets, sweep
-from .cost_kernel import grid_cost_kernel, vector_cost_kernel
+from .cost_kernel import (
+    beam_flags_kernel,
+    grid_cost_kernel,
+    object_groups_kernel,
+    unmapped_kernel,
+    vector_cost_kernel,
+    vector_short_mask,
+)
 from .field_kernel import refine_to_field_kernel
 from .headings import _pair_kernel, _scan_rotations
-from .virtual_kernel import refine_vector_kernel
+from .unmapped import refine_each_kernel
+from .virtual_kernel import prune_index_kernel, refine_vector_kernel
 
 if TYPE_CHECKING:
     from tfloc.core.problem import Problem
@@ -53,7 +63,8 @@ _SMOOTHING = float(np.radians(1.0))  # :func:`tfloc.tfplus.headings.scan_rotatio
 
 @dataclass(frozen=True, eq=False)
 class Plan:
-    """What :func:`run` passes to its kernel besides the scan: ``kind`` ``"vector"`` or
+    """What :func:`run` passes to its kernel besides the scan: ``kind`` ``"vector"`` (refined
+    against virtual scans), ``"vector-field"`` (a vector map, refined against the map itself) or
     ``"grid"``, and the kernel's static arguments (arrays and numbers of the map's views, the
     laser and the configuration; metres, radians)."""
 
@@ -89,11 +100,9 @@ def _plan_of(map_: object, laser: LaserSpec, cfg: TfPlusConfig) -> Plan | None:
             and cfg.select == "residual"):
         return None
     if isinstance(map_, VectorMap):
-        if cfg.refine_to not in ("auto", "virtual"):
-            return None
         if map_.area_rings() is None or map_.free_rings() is None:
             return None                      # not built (a map used once): the staged path
-        kind = "vector"
+        kind = "vector-field" if cfg.refine_to == "field" else "vector"
     elif isinstance(map_, GridMap):
         if cfg.refine_to not in ("auto", "field"):
             return None
@@ -127,13 +136,22 @@ def _build(map_: VectorMap | GridMap, laser: LaserSpec, cfg: TfPlusConfig, kind:
     gates = refine_module._gates(r)
     view = (field.nearest, float(field.origin[0]), float(field.origin[1]), field.resolution,
             field.points, field.normals)
+    select = (-1.0 if cfg.short_residual is None else float(cfg.short_residual),  # -1: off
+              float(cfg.see_through_share), float(cfg.short_margin),
+              -1.0 if cfg.object_extent is None else float(cfg.object_extent))      # -1: off
+    gate = float(cfg.short_margin) if cfg.short_refine else -1.0                   # -1: off
+    gate_parts = unmapped_module.split(refine_module.field_refinement(field, r), int(r.prune_after))
     common = (beams, rotation, headings, lattice, coarse, view, int(cfg.min_returns),
-              int(r.iterations), float(r.inlier_distance), bool(cfg.beam_check))
-    if kind == "vector":
+              int(r.iterations), float(r.inlier_distance), bool(cfg.beam_check), select, gate,
+              gate_parts + (int(r.keep),))
+    if kind != "grid":
+        free = (map_.area_rings().kernel, map_.free_rings().kernel, SURE)
+        vector = (free, map_.segments, map_.segment_index(max_range))
+        if kind == "vector-field":
+            return Plan(kind, common + (refine_module.field_refinement(field, r),) + vector)
         refine = (gates, int(r.inner), int(r.window), float(r.damping), int(r.prune_after),
                   int(r.keep))
-        free = (map_.area_rings().kernel, map_.free_rings().kernel, SURE)
-        return Plan(kind, common + (refine, free, map_.segments, map_.segment_index(max_range)))
+        return Plan(kind, common + (refine,) + vector)
     refine = refine_module.field_refinement(field, r)
     grid = (map_.occupied, float(map_.origin[0]), float(map_.origin[1]), float(map_.resolution),
             map_.free, map_.distance)
@@ -147,8 +165,7 @@ def run(plan: Plan, ranges: np.ndarray, x: float, y: float, theta: float) -> tup
     ``seeded`` false: no turning function) and the evaluations counted as the staged path counts
     them. Status :data:`TOO_FEW`: fewer than ``min_returns`` returns; :data:`UNDECIDED`: the
     lattice needs the map's own free-space test (nothing else is computed then)."""
-    kernel = vector_pipeline_kernel if plan.kind == "vector" else grid_pipeline_kernel
-    return kernel(ranges, x, y, theta, *plan.args)
+    return _KERNELS[plan.kind](ranges, x, y, theta, *plan.args)
 
 
 @njit(cache=True, nogil=True)
@@ -196,32 +213,100 @@ def _no_poses(status: int, returns: int, rotations: np.ndarray, seeded: bool) ->
 
 
 @njit(cache=True, nogil=True)
-def vector_pipeline_kernel(ranges: np.ndarray, x: float, y: float, theta: float, beams: tuple,
-                           rotation: tuple, headings: tuple, lattice: tuple, coarse: tuple,
-                           view: tuple, min_returns: int, iterations: int, inlier: float,
-                           beam_check: bool, refine: tuple, free: tuple, segs: np.ndarray,
-                           index: tuple) -> tuple:
-    """:func:`run` on a vector map (``Plan.args``; see :func:`_build`)."""
+def _vector_coarse(ranges: np.ndarray, x: float, y: float, theta: float, beams: tuple,
+                   rotation: tuple, headings: tuple, lattice: tuple, coarse: tuple,
+                   min_returns: int, free: tuple, segs: np.ndarray, index: tuple) -> tuple:
+    """The pipeline on a vector map up to the coarse candidates: ``(status, points, rotations,
+    seeded, candidates, evaluations)``."""
     angles, directions, cos_a, sin_a, angle_min, resolution, max_range = beams
     points = _returns_to_points(ranges, directions, max_range)
     if points.shape[0] < min_returns:
-        return _no_poses(TOO_FEW, points.shape[0], np.empty(0), False)
+        return TOO_FEW, points, np.empty(0), False, np.empty((0, 3)), 0
     virtual = raycast_segments(_at(x, y, theta), angles, segs, max_range, index)[0]
     rots, heads, seeded = _seeded_headings(ranges, virtual, theta, beams, rotation, headings)
     offsets, table, corner_x, corner_y, res, clearance = lattice
     positions, decided = lattice_kernel(x, y, offsets, table, corner_x, corner_y, res, clearance,
                                         free[0], free[1], free[2])
     if not decided:
-        return _no_poses(UNDECIDED, points.shape[0], rots, seeded)
+        return UNDECIDED, points, rots, seeded, np.empty((0, 3)), 0
     cands, evaluations = coarse_kernel(points, positions, x, y, heads, coarse)
+    return OK, points, rots, seeded, cands, evaluations
+
+
+@njit(cache=True, nogil=True)
+def _groups(ranges: np.ndarray, beams: tuple, select: tuple) -> np.ndarray:
+    """:func:`tfloc.tfplus.cost.object_groups` of the scan."""
+    return object_groups_kernel(ranges, beams[1], beams[6], beams[5], select[3])
+
+
+@njit(cache=True, nogil=True)
+def _vector_cost(ranges: np.ndarray, cands: np.ndarray, beams: tuple, view: tuple, inlier: float,
+                 beam_check: bool, select: tuple, groups: np.ndarray, segs: np.ndarray,
+                 index: tuple) -> np.ndarray:
+    """The selection cost of the refined candidates on a vector map."""
+    angles, directions, max_range = beams[0], beams[1], beams[6]
+    nearest, fx, fy, fres, map_points, map_normals = view
+    return vector_cost_kernel(nearest, fx, fy, fres, map_points, map_normals, ranges, directions,
+                              angles, max_range, cands, segs, index, inlier, beam_check,
+                              select[0], select[1], select[2], groups)
+
+
+@njit(cache=True, nogil=True)
+def vector_pipeline_kernel(ranges: np.ndarray, x: float, y: float, theta: float, beams: tuple,
+                           rotation: tuple, headings: tuple, lattice: tuple, coarse: tuple,
+                           view: tuple, min_returns: int, iterations: int, inlier: float,
+                           beam_check: bool, select: tuple, gate: float, gate_parts: tuple,
+                           refine: tuple, free: tuple, segs: np.ndarray, index: tuple) -> tuple:
+    """:func:`run` on a vector map, refined against virtual scans (``Plan.args``; see
+    :func:`_build`)."""
+    status, points, rots, seeded, cands, evaluations = _vector_coarse(
+        ranges, x, y, theta, beams, rotation, headings, lattice, coarse, min_returns, free, segs,
+        index)
+    if status != OK:
+        return _no_poses(status, points.shape[0], rots, seeded)
+    angles, directions, cos_a, sin_a, angle_min, resolution, max_range = beams
     gates, inner, window, damping, prune_after, keep = refine
     cands = refine_vector_kernel(cands, points, angles, cos_a, sin_a, angle_min, resolution,
                                  segs, index, max_range, gates, inner, window, damping,
                                  prune_after, keep, inlier)
     evaluations += cands.shape[0] * iterations
-    nearest, fx, fy, fres, map_points, map_normals = view
-    cost = vector_cost_kernel(nearest, fx, fy, fres, map_points, map_normals, ranges, directions,
-                              angles, max_range, cands, segs, index, inlier, beam_check)
+    cost = _vector_cost(ranges, cands, beams, view, inlier, beam_check, select,
+                        _groups(ranges, beams, select), segs, index)
+    return OK, points.shape[0], cands, cost, rots, seeded, evaluations
+
+
+@njit(cache=True, nogil=True)
+def vector_field_pipeline_kernel(ranges: np.ndarray, x: float, y: float, theta: float,
+                                 beams: tuple, rotation: tuple, headings: tuple, lattice: tuple,
+                                 coarse: tuple, view: tuple, min_returns: int, iterations: int,
+                                 inlier: float, beam_check: bool, select: tuple, gate: float,
+                                 gate_parts: tuple, refine: tuple, free: tuple, segs: np.ndarray,
+                                 index: tuple) -> tuple:
+    """:func:`run` on a vector map, refined against the map itself (``refine_to="field"``)."""
+    status, points, rots, seeded, cands, evaluations = _vector_coarse(
+        ranges, x, y, theta, beams, rotation, headings, lattice, coarse, min_returns, free, segs,
+        index)
+    if status != OK:
+        return _no_poses(status, points.shape[0], rots, seeded)
+    groups = _groups(ranges, beams, select)
+    if gate >= 0.0:                       # unmapped returns left out (tfplus.unmapped)
+        angles, max_range = beams[0], beams[6]
+        first, second, more, keep = gate_parts
+        for part in range(2 if more else 1):
+            if part == 1 and cands.shape[0] > keep:
+                cost = _vector_cost(ranges, cands, beams, view, inlier, beam_check, select,
+                                    groups, segs, index)
+                cands = cands[prune_index_kernel(cands, cost, keep, 0.05)]
+            virtual = raycast_segments(cands, angles, segs, max_range, index)
+            short = unmapped_kernel(vector_short_mask(ranges, virtual, max_range, gate), groups)
+            cands = refine_each_kernel(view, points, ranges, cands, inlier,
+                                       first if part == 0 else second, short, max_range,
+                                       min_returns, gate)
+    else:
+        cands = refine_to_field_kernel(view, points, cands, inlier, refine)
+    evaluations += cands.shape[0] * iterations
+    cost = _vector_cost(ranges, cands, beams, view, inlier, beam_check, select, groups, segs,
+                        index)
     return OK, points.shape[0], cands, cost, rots, seeded, evaluations
 
 
@@ -229,7 +314,8 @@ def vector_pipeline_kernel(ranges: np.ndarray, x: float, y: float, theta: float,
 def grid_pipeline_kernel(ranges: np.ndarray, x: float, y: float, theta: float, beams: tuple,
                          rotation: tuple, headings: tuple, lattice: tuple, coarse: tuple,
                          view: tuple, min_returns: int, iterations: int, inlier: float,
-                         beam_check: bool, refine: tuple, grid: tuple) -> tuple:
+                         beam_check: bool, select: tuple, gate: float, gate_parts: tuple,
+                         refine: tuple, grid: tuple) -> tuple:
     """:func:`run` on a grid map (``Plan.args``; see :func:`_build`)."""
     angles, directions, cos_a, sin_a, angle_min, resolution, max_range = beams
     occupied, gx, gy, cell, free, distance = grid
@@ -242,9 +328,31 @@ def grid_pipeline_kernel(ranges: np.ndarray, x: float, y: float, theta: float, b
     positions = grid_lattice_kernel(x, y, offsets, table, corner_x, corner_y, res, clearance,
                                     gx, gy, cell, free, distance, 0.5 * cell)
     cands, evaluations = coarse_kernel(points, positions, x, y, heads, coarse)
-    cands = refine_to_field_kernel(view, points, cands, inlier, refine)
-    evaluations += cands.shape[0] * iterations
+    groups = _groups(ranges, beams, select)
     nearest, fx, fy, fres, map_points, map_normals = view
+    if gate >= 0.0:                       # unmapped returns left out (tfplus.unmapped)
+        first, second, more, keep = gate_parts
+        for part in range(2 if more else 1):
+            if part == 1 and cands.shape[0] > keep:
+                cost = grid_cost_kernel(nearest, fx, fy, fres, map_points, map_normals, ranges,
+                                        directions, angles, max_range, cands, occupied, gx, gy,
+                                        cell, inlier, beam_check, free, select[0], select[1],
+                                        select[2], groups)
+                cands = cands[prune_index_kernel(cands, cost, keep, 0.05)]
+            short = unmapped_kernel(beam_flags_kernel(occupied, free, gx, gy, cell, cands, angles,
+                                                      ranges, max_range, inlier, gate, False,
+                                                      groups >= 0)[1], groups)
+            cands = refine_each_kernel(view, points, ranges, cands, inlier,
+                                       first if part == 0 else second, short, max_range,
+                                       min_returns, gate)
+    else:
+        cands = refine_to_field_kernel(view, points, cands, inlier, refine)
+    evaluations += cands.shape[0] * iterations
     cost = grid_cost_kernel(nearest, fx, fy, fres, map_points, map_normals, ranges, directions,
-                            angles, max_range, cands, occupied, gx, gy, cell, inlier, beam_check)
+                            angles, max_range, cands, occupied, gx, gy, cell, inlier, beam_check,
+                            free, select[0], select[1], select[2], groups)
     return OK, points.shape[0], cands, cost, rots, seeded, evaluations
+
+
+_KERNELS = {"vector": vector_pipeline_kernel, "vector-field": vector_field_pipeline_kernel,
+            "grid": grid_pipeline_kernel}

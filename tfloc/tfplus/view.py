@@ -17,7 +17,7 @@ The attribute names are those the compiled kernels take (``tfloc.tfplus.*_kernel
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -69,13 +69,17 @@ class MapView:
 
 
 def map_view(map_: Map, resolution: float, truncation: float, wall_thickness: float,
-             pool: float = 0.0) -> MapView:
+             pool: float = 0.0, free_cap: float | None = None) -> MapView:
     """The view of ``map_`` (field cells of ``resolution``, distances truncated at ``truncation``,
     walls followed up to ``wall_thickness`` metres across on a grid map), built once per map; with
     ``pool`` > 0 its distances are pooled over ± ``pool`` metres (a lower bound over that square,
-    :func:`tfloc.maps.fields.pooled`, for the coarse search)."""
+    :func:`tfloc.maps.fields.pooled`, for the coarse search); with ``free_cap`` (metres) capped
+    there in the map's free space (:func:`free_capped`)."""
     key = ("tf-plus-view", round(resolution, 9), round(truncation, 9), round(wall_thickness, 9),
-           round(pool, 9))
+           round(pool, 9), None if free_cap is None else round(free_cap, 9))
+    if free_cap is not None:
+        base = map_view(map_, resolution, truncation, wall_thickness, pool)
+        return cached(map_, key, lambda: free_capped(map_, base, free_cap))
     if pool > 0:
         base = map_view(map_, resolution, truncation, wall_thickness)
         return cached(map_, key, lambda: MapView(pooled(base.field, pool), base.face_plus,
@@ -94,3 +98,28 @@ def map_view(map_: Map, resolution: float, truncation: float, wall_thickness: fl
                        np.ascontiguousarray(minus + half_step), True)
 
     return cached(map_, key, build)
+
+
+
+def free_capped(map_: Map, view: MapView, cap: float) -> MapView:
+    """``view`` with every cell whose centre lies in the map's known free space (``in_bounds``
+    and ``is_free``) holding at most ``cap`` metres.
+
+    Why: a scan point far from every wall is a wrong pose's point *or* a return from an object
+    the map lacks (a person, a cart) standing in free space; the coarse search cannot tell the
+    two apart without a ray per point, and the full penalty for both lets a quarter of the beams
+    on unmapped objects push the true pose out of the shortlist. A point outside free space (in
+    an obstacle, in unknown space, outside the building) keeps its full distance: no unmapped
+    object explains it (measured: ``docs/robustness.md``)."""
+    table = view.table
+    h, w = table.shape
+    x0, y0 = view.field.origin                      # the centre of cell (0, 0)
+    res = view.resolution
+    gx, gy = np.meshgrid(x0 + res * np.arange(w), y0 + res * np.arange(h))
+    xy = np.column_stack((gx.ravel(), gy.ravel()))
+    free = np.zeros(len(xy), dtype=bool)
+    inside = map_.in_bounds(xy)
+    free[inside] = map_.is_free(xy[inside])
+    capped = np.where(free.reshape(h, w), np.minimum(table, table.dtype.type(cap)), table)
+    return MapView(replace(view.field, distance=np.ascontiguousarray(capped, dtype=table.dtype)),
+                   view.face_plus, view.face_minus, view.faces)
