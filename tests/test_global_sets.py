@@ -12,9 +12,9 @@ from _committed import assert_same_file
 from tfloc.core.matcher import check_solvable, get_matcher
 from tfloc.core.problem import Problem
 from tfloc.datasets.global_sets import (
+    DEV_EVERY,
     DEV_SCANS,
     OFFICE_SCANS,
-    REAL_MIN_SCANS,
     generate_global_offices,
 )
 from tfloc.errors import InvalidProblemError
@@ -40,13 +40,18 @@ def test_dev_office_sets_regenerate(office_maps) -> None:
         assert mine[:3] == bundled[:3]
 
 
+#: corrected scans per real log (every one of them is in exactly one of its two real sets)
+REAL_SCANS = {"intel": 910, "csail": 406, "aces": 440}
+
+
 @pytest.mark.parametrize("name, n_min", [("global-office-1", OFFICE_SCANS), ("global-office-2", OFFICE_SCANS),
                                          ("global-office-3", OFFICE_SCANS),
-                                         ("real-intel-global", REAL_MIN_SCANS),
-                                         ("real-csail-global", REAL_MIN_SCANS),
-                                         ("real-aces-global", REAL_MIN_SCANS),
+                                         ("real-intel-global", 728), ("real-csail-global", 324),
+                                         ("real-aces-global", 352),
+                                         ("global-dev-real-intel", 182), ("global-dev-real-csail", 82),
+                                         ("global-dev-real-aces", 88),
                                          ("global-dev-office-2", DEV_SCANS),
-                                         ("global-dev-real-csail", DEV_SCANS)])
+                                         ("global-dev-real-csail-sim", DEV_SCANS)])
 def test_bundled_global_sets(name, n_min) -> None:
     sc = read_scenario(SCEN / name)
     assert sc.mode == GLOBAL
@@ -56,15 +61,26 @@ def test_bundled_global_sets(name, n_min) -> None:
     m = map_for(sc, scans[0])
     xy = np.array([[s.true.x, s.true.y] for s in scans])
     assert m.in_bounds(xy).all()
-    sim = np.array([s.group == "sim" for s in scans])
-    assert m.is_free(xy[sim], 0.3).all()  # simulated poses keep their clearance
-    assert {s.group for s in scans} <= {"sim", "real"}
-    if name.startswith("real-"):
-        assert sum(s.group == "real" for s in scans) >= 400
+    groups = {s.group for s in scans}
+    real = name.startswith("real-") or (name.startswith("global-dev-real-") and not name.endswith("-sim"))
+    # a real set holds real scans only, grouped by the fifth of the log they lie in
+    assert groups == ({f"real-{q}" for q in range(1, 6)} if real else {"sim"})
+    if real:
+        return
+    assert m.is_free(xy, 0.3).all()  # simulated poses keep their clearance
     headings = np.array([s.true.theta for s in scans])
-    if sim.sum() >= 50:  # spread over the free space and all headings
-        assert np.ptp(xy[sim, 0]) > 0.6 * (m.bounds[2] - m.bounds[0])
-        assert np.histogram(headings[sim], bins=4, range=(-np.pi, np.pi))[0].min() > 0.1 * sim.sum()
+    if len(scans) >= 50:  # spread over the free space and all headings
+        assert np.ptp(xy[:, 0]) > 0.6 * (m.bounds[2] - m.bounds[0])
+        assert np.histogram(headings, bins=4, range=(-np.pi, np.pi))[0].min() > 0.1 * len(scans)
+
+
+@pytest.mark.parametrize("key", sorted(REAL_SCANS))
+def test_real_scans_split_into_development_and_held_out(key) -> None:
+    """Every corrected scan once: every DEV_EVERY-th in development, the rest held out."""
+    held = [s.scan_id for s in read_scans(read_scenario(SCEN / f"real-{key}-global"))]
+    dev = [s.scan_id for s in read_scans(read_scenario(SCEN / f"global-dev-real-{key}"))]
+    assert sorted(held + dev) == [f"r{k:04d}" for k in range(REAL_SCANS[key])]
+    assert dev == [f"r{k:04d}" for k in range(0, REAL_SCANS[key], DEV_EVERY)]
 
 
 def test_dev_and_evaluation_sets_are_disjoint() -> None:

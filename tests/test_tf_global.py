@@ -148,6 +148,9 @@ def test_hypotheses_are_distinct() -> None:
     ({"index": {"signature": {"range_cap": -1.0}}}, r"index.signature.range_cap must be > 0"),
     ({"resolver": {"search_radius": math.nan}}, r"resolver.search_radius must be a finite number"),
     ({"placess": 3}, r"unknown parameter\(s\) placess"),
+    ({"no_return": "maybe"}, r"no_return must be one of 'unknown', 'far'"),
+    ({"profile_truncation": 0.0}, r"profile_truncation must be > 0"),
+    ({"index": {"profile": {"sectors": 0}}}, r"index.profile.sectors must be >= 1"),
 ])
 def test_bad_parameters_are_refused(params, message) -> None:
     with pytest.raises(ParameterError, match=rf"matcher 'tf-global': {message}"):
@@ -243,3 +246,47 @@ def test_a_grid_map_is_keyed_by_its_cells() -> None:
     assert map_digest(GridMap(moved, 0.1, (0.0, 0.0))) != map_digest(a)
     assert map_digest(GridMap(occ, 0.1, (0.5, 0.0))) != map_digest(a)
     assert map_digest(GridMap(occ, 0.05, (0.0, 0.0))) != map_digest(a)
+
+
+def test_a_range_profile_is_the_sector_median_and_a_real_no_return_is_unknown(lms200) -> None:
+    from tfloc.relocalize.profile import ProfileConfig, index_profiles, query_profiles
+
+    cfg = ProfileConfig(sectors=6, margin=0.0, cap=10.0)
+    ranges = np.full(lms200.n_beams, 4.0)
+    ranges[10:13] = 0.5                                   # a chair leg in three beams
+    ranges[-40:] = np.inf                                 # the last sector (30 beams) and more return nothing
+    real = query_profiles(ranges, lms200, cfg, np.zeros(1))[0]
+    assert real[0] == pytest.approx(0.4) and np.isnan(real[-1])   # the median ignores the leg
+    virtual = index_profiles(ranges[None, :], lms200, cfg)[0]
+    assert virtual[-1] == 1.0 and virtual[0] == pytest.approx(0.4)  # the map's no-return is open space
+    far = query_profiles(ranges, lms200, cfg, np.zeros(1), no_return="far")[0]
+    assert far[-1] == 1.0
+
+
+def test_the_profile_distance_is_a_truncated_mean_over_known_sectors_at_the_best_shift() -> None:
+    from tfloc.relocalize.profile_kernel import place_distances
+
+    rng = np.random.default_rng(5)
+    profiles = rng.random((8, 50)).astype(np.float32)      # sector-major: 8 sectors x 50 entries
+    queries = rng.random((3, 8)).astype(np.float32)
+    queries[1, [2, 5]] = np.nan
+    base = rng.random(50)
+    got = place_distances(base, profiles, queries, 0.3, 2.0)
+    diff = np.minimum(np.abs(queries[:, :, None] - profiles[None]), np.float32(0.3))
+    rho = np.nanmean(np.where(np.isnan(queries)[:, :, None], np.nan, diff), axis=1).min(axis=0)
+    np.testing.assert_allclose(got, base + 2.0 * rho, rtol=1e-6)
+
+
+def test_the_profile_ranks_the_true_place_first(test_room, lms200, tmp_path) -> None:
+    cfg = IndexConfig(step=0.5, headings=8)
+    idx = load_or_build(test_room, lms200, cfg, tmp_path)
+    assert idx.profiles.shape == (cfg.profile.sectors, len(idx.poses))
+    again = load_or_build(test_room, lms200, cfg, tmp_path)
+    np.testing.assert_array_equal(again.profiles, idx.profiles)
+    from tfloc.relocalize.profile import query_profiles, query_shifts
+
+    entry = 37
+    ranges = test_room.raycast(Pose.from_array(idx.poses[entry]), lms200)
+    prof = query_profiles(ranges, lms200, cfg.profile, query_shifts(cfg.headings, 5))
+    d = idx.distances(np.zeros(idx.signatures.shape[1]), prof, 1.0, 0.1) - np.sqrt(idx.norms)
+    assert int(np.argmin(d)) == entry

@@ -5,18 +5,21 @@ the whole map.
   office floor, true poses uniform over the free space (≥ 0.3 m from geometry,
   :func:`~tfloc.datasets.synthetic.sample_free_pose`), heading uniform, the protocol's range
   noise (:class:`~tfloc.datasets.noise.NoiseModel`, σ = 1 cm).
-* ``real-{intel,csail,aces}-global`` (evaluation): every real scan of the SLAM-corrected log with
-  its corrected pose as truth (group ``real``), topped up to :data:`REAL_MIN_SCANS` = 500 with
-  scans ray-cast in the log's grid map at poses uniform over its known free space (group
-  ``sim``, same noise). CSAIL has 406 and ACES 440 real scans: the real scans are kept whole
-  (they are the point of a real map), and the simulated ones, reported apart by their group,
-  spread the poses over rooms the robot's path only passed by. Intel (910 scans) is all real.
-* ``global-dev-office-{1,2,3}`` and ``global-dev-real-{intel,csail,aces}`` (development, for
-  tuning): :data:`DEV_SCANS` = 50 simulated scans each from other seeds; the real maps' dev sets
-  are simulated only, so no real scan an evaluation set holds is ever tuned on.
+* ``real-{intel,csail,aces}-global`` (evaluation) and ``global-dev-real-{intel,csail,aces}``
+  (development): the SLAM-corrected logs' real scans only (truth = the corrected pose, scan
+  ``r<k>`` = the log's k-th corrected scan, group ``real-<q>`` = the q-th of :data:`REAL_PARTS`
+  parts of the log in time order, so that a run taking the first scans of each group samples the
+  whole path, not its beginning), split by :func:`real_split`: every
+  :data:`DEV_EVERY`-th corrected scan is development, the rest held out, so no real scan of an
+  evaluation set is tuned on (Intel 910 → 182 + 728, MIT CSAIL 406 → 82 + 324, ACES 440 → 88 +
+  352). A real-map figure comes from real scans alone: nothing simulated is mixed in.
+* ``global-dev-office-{1,2,3}`` and ``global-dev-real-{intel,csail,aces}-sim`` (development,
+  simulated): :data:`DEV_SCANS` = 50 simulated scans each from other seeds; the latter are ray-cast
+  in the real logs' grid maps, so that a real scan's effect (clutter, people, glass) can be told
+  from the map's and the index's on the same map.
 
-Every dataset draws from its own generator (``SeedSequence([seed, split, index])``), so the
-datasets regenerate bit for bit and adding one leaves the others unchanged.
+Every simulated dataset draws from its own generator (``SeedSequence([seed, split, index])``), so
+the datasets regenerate bit for bit and adding one leaves the others unchanged.
 """
 
 from __future__ import annotations
@@ -38,7 +41,8 @@ from .synthetic import sample_free_pose
 
 GLOBAL_SEED = 20261201
 OFFICE_SCANS = 500
-REAL_MIN_SCANS = 500
+DEV_EVERY = 5  # every 5th corrected scan of a real log is development
+REAL_PARTS = 5  # a real log's scans are grouped by the fifth of the log (time order) they lie in
 DEV_SCANS = 50
 CLEARANCE_M = 0.3
 EVAL, DEV = 0, 1  # the split, part of every dataset's seed
@@ -96,49 +100,59 @@ def generate_global_offices(out: str | Path, seed: int = GLOBAL_SEED, n: int = O
     return dirs
 
 
-def real_global_scans(log_path: Path, laser: LaserSpec, no_return: float, grid: Map,
-                      min_scans: int, rng: np.random.Generator, noise: NoiseModel) -> list[Scan]:
-    """Every front-laser scan of a corrected log (truth = its corrected pose, group ``real``),
-    then simulated scans in ``grid`` (group ``sim``) up to ``min_scans``."""
+def real_global_scans(log_path: Path, laser: LaserSpec, no_return: float) -> list[Scan]:
+    """Every front-laser scan of a corrected log, truth = its corrected pose (scan ``r<k>`` for
+    the k-th, group ``real-<q>`` for the q-th of :data:`REAL_PARTS` parts of the log)."""
     records = front_scans(read_carmen(log_path), laser)
-    rows = [Scan(f"r{k:04d}", "real", clean_ranges(s.ranges, no_return), None, s.pose)
-            for k, s in enumerate(records)]
-    rows += simulated_scans(grid, laser, noise, max(0, min_scans - len(rows)), rng, prefix="s")
-    return rows
+    n = len(records)
+    return [Scan(f"r{k:04d}", f"real-{k * REAL_PARTS // n + 1}", clean_ranges(s.ranges, no_return),
+                 None, s.pose) for k, s in enumerate(records)]
+
+
+def real_split(scans: list[Scan], every: int = DEV_EVERY) -> tuple[list[Scan], list[Scan]]:
+    """(development, held-out): every ``every``-th scan (the 0th, ``every``-th, …) and the rest."""
+    return scans[::every], [s for k, s in enumerate(scans) if k % every]
 
 
 def build_global_real(real: str | Path, out: str | Path, seed: int = GLOBAL_SEED,
-                      min_scans: int = REAL_MIN_SCANS, n_dev: int = DEV_SCANS,
-                      noise: NoiseModel = NOISE, log=None) -> list[Path]:
-    """Write ``out/scenarios/real-{key}-global`` (evaluation) and ``global-dev-real-{key}``
-    (development, simulated only) for the Intel, MIT CSAIL and ACES logs, on their grid maps
-    ``out/maps/real-{key}.yaml`` (written by :func:`~tfloc.datasets.real.build_all`)."""
+                      n_dev: int = DEV_SCANS, noise: NoiseModel = NOISE, every: int = DEV_EVERY,
+                      log=None) -> list[Path]:
+    """Write ``out/scenarios/real-{key}-global`` (evaluation: the held-out real scans),
+    ``global-dev-real-{key}`` (development: every ``every``-th real scan) and
+    ``global-dev-real-{key}-sim`` (development: ``n_dev`` scans ray-cast in the grid) for the
+    Intel, MIT CSAIL and ACES logs, on their grid maps ``out/maps/real-{key}.yaml`` (written by
+    :func:`~tfloc.datasets.real.build_all`)."""
     real, out = Path(real), Path(out)
     dirs = []
     for index, (key, log_rel, laser, no_return) in enumerate(REAL_LOGS, start=1):
         map_yaml = out / "maps" / f"real-{key}.yaml"
+        rows = real_global_scans(real / log_rel, laser, no_return)
+        dev, held = real_split(rows, every)
+        source = {"files": [f"data/real/{log_rel}"], "provenance": "data/real/*/PROVENANCE.md"}
+        split = (f"of its {len(rows)} SLAM-corrected scans (truth = corrected pose, scan r<k> = the "
+                 f"k-th, group real-<q> = the q-th of {REAL_PARTS} parts of the log in time order); "
+                 f"every {every}th (k % {every} == 0) is development, the rest held out")
+        for name, scans, which, use in ((f"real-{key}-global", held, EVAL, "evaluation split: the "
+                                         f"{len(held)} held-out real scans"),
+                                        (f"global-dev-real-{key}", dev, DEV, "development split, tuning "
+                                         f"only: the {len(dev)} development real scans")):
+            dirs.append(write_scenario(
+                out / "scenarios" / name, name, map_yaml, laser, scans, mode=GLOBAL,
+                description=(f"Global localization on the {key} grid map ({use} {split}); real scans "
+                             "only, no initial guess."),
+                generator={"split": "evaluation" if which == EVAL else "development",
+                           "dev_every": every, "parts": REAL_PARTS, "command": "tfloc real-data"},
+                source=source))
         grid = load_map(map_yaml)
-        rows = real_global_scans(real / log_rel, laser, no_return, grid, min_scans,
-                                 _rng(seed, EVAL, 10 + index), noise)
-        n_real = sum(r.group == "real" for r in rows)
-        name = f"real-{key}-global"
-        dirs.append(write_scenario(
-            out / "scenarios" / name, name, map_yaml, laser, rows, mode=GLOBAL,
-            description=(f"Global localization on the {key} grid map (evaluation split): all {n_real} "
-                         "real scans of the SLAM-corrected log (group 'real', truth = corrected pose), "
-                         f"plus {len(rows) - n_real} scans ray-cast in the grid at poses uniform over its "
-                         f"known free space (group 'sim', >= {CLEARANCE_M:g} m from occupied cells, "
-                         f"noise sigma {noise.sigma_m:g} m); no initial guess."),
-            generator=_generator(seed, EVAL, 10 + index, noise, command="tfloc real-data"),
-            source={"files": [f"data/real/{log_rel}"], "provenance": "data/real/*/PROVENANCE.md"}))
-        dev = f"global-dev-real-{key}"
+        sim = f"global-dev-real-{key}-sim"
         scans = simulated_scans(grid, laser, noise, n_dev, _rng(seed, DEV, 10 + index))
         dirs.append(write_scenario(
-            out / "scenarios" / dev, dev, map_yaml, laser, scans, mode=GLOBAL,
+            out / "scenarios" / sim, sim, map_yaml, laser, scans, mode=GLOBAL,
             description=(f"Global localization on the {key} grid map (development split, tuning only): "
-                         f"{n_dev} scans ray-cast in the grid at poses uniform over its known free space; "
-                         "no real scan (those are all in the evaluation set)."),
+                         f"{n_dev} scans ray-cast in the grid at poses uniform over its known free space "
+                         f"(>= {CLEARANCE_M:g} m from occupied cells, noise sigma {noise.sigma_m:g} m); "
+                         "no real scan."),
             generator=_generator(seed, DEV, 10 + index, noise, command="tfloc real-data")))
         if log:
-            log(f"{dirs[-2]}: {len(rows)} scans ({n_real} real); {dirs[-1]}: {n_dev}")
+            log(f"{key}: {len(held)} held-out and {len(dev)} development real scans; {sim}: {n_dev}")
     return dirs

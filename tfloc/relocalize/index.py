@@ -3,15 +3,17 @@ once per map and laser, kept in memory per map object and on disk under the map'
 
 Every free lattice position (``step`` metres apart, ``clearance`` from the walls) is seen at
 ``headings`` evenly spaced headings: a scanner with a field of view under 360° sees different
-walls when it turns, so one signature per position cannot stand for all of them. A query finds
-the entries whose signatures lie nearest the real scan's and returns the best ``count`` distinct
-places. The search is brute force, one matrix-vector product: in 97 dimensions a KD-tree
-(scipy's ``cKDTree``) visits most of its leaves anyway, and was slower (``docs/tf-global.md``).
-The disk copy (``<cache>/<sha256>.npz``) is keyed by
-the map's content (:func:`map_digest`: segments and mapped area of a vector map, cells,
-resolution, origin and thresholds of a grid), the laser, the build parameters and
-:data:`VERSION`: a changed map, laser or parameter builds a new index, and an index is never
-read for a map it was not built from.
+walls when it turns, so one signature per position cannot stand for all of them. Each entry
+holds the scan's rotation-invariant signature (:mod:`tfloc.relocalize.signature`) and its range
+profile (:mod:`tfloc.relocalize.profile`). A query finds the entries nearest the real scan by the
+signature's Euclidean distance plus the weighted robust profile distance and returns the best
+``count`` distinct places. The search is brute force (one matrix-vector product and one compiled
+pass over the profiles): in 97 dimensions a KD-tree visits most of its leaves anyway, and the
+profile's truncated distance is no metric a tree could use. The disk copy
+(``<cache>/<sha256>.npz``) is keyed by the map's content (:func:`map_digest`: segments and mapped
+area of a vector map, cells, resolution, origin and thresholds of a grid), the laser, the build
+parameters and :data:`VERSION`: a changed map, laser or parameter builds a new index, and an
+index is never read for a map it was not built from.
 """
 
 from __future__ import annotations
@@ -33,10 +35,12 @@ from tfloc.maps.cache import cached
 from tfloc.maps.grid import GridMap
 from tfloc.maps.vector import VectorMap
 
+from .profile import ProfileConfig, index_profiles
+from .profile_kernel import place_distances
 from .signature import SignatureConfig, signatures
 
 #: Bumped when the index's content changes for the same inputs (old files are then not read).
-VERSION = 1
+VERSION = 2
 
 #: Virtual scans ray-cast per batch while building (bounds the memory of a build).
 BATCH = 4096
@@ -51,6 +55,7 @@ class IndexConfig:
         headings: headings per position, evenly spaced from 0.
         clearance: a lattice position lies at least this far from the map's walls.
         signature: how a scan becomes its signature (:class:`SignatureConfig`).
+        profile: the sectors of its range profile (:class:`ProfileConfig`).
     """
 
     RULES: ClassVar[dict] = {"> 0": ("step",), ">= 1": ("headings",), ">= 0": ("clearance",)}
@@ -59,6 +64,7 @@ class IndexConfig:
     headings: int = 16
     clearance: float = 0.2
     signature: SignatureConfig = SignatureConfig()
+    profile: ProfileConfig = ProfileConfig()
 
 
 @dataclass(frozen=True, eq=False)
@@ -69,6 +75,8 @@ class PlaceIndex:
         poses: ``(N, 3)`` the virtual scans' poses (metres, radians).
         signatures: ``(N, D)`` their signatures.
         norms: ``(N,)`` their squared norms (for the distance by one product).
+        profiles: ``(sectors, N)`` their range profiles (float32, fractions of the cap;
+            sector-major for the query's pass over the entries).
         free_area_m2: the map's free area (m², counted on a 0.1 m lattice).
         build_cpu_s: CPU seconds the build took (0 if it was never built here: see ``loaded``).
         loaded: read from the disk cache rather than built.
@@ -78,6 +86,7 @@ class PlaceIndex:
     poses: np.ndarray
     signatures: np.ndarray
     norms: np.ndarray
+    profiles: np.ndarray
     free_area_m2: float
     build_cpu_s: float
     loaded: bool
@@ -85,22 +94,36 @@ class PlaceIndex:
 
     @property
     def nbytes(self) -> int:
-        """Bytes in memory: poses, signatures and their norms."""
-        return int(self.poses.nbytes + self.signatures.nbytes + self.norms.nbytes)
+        """Bytes in memory: poses, signatures, their norms and the profiles."""
+        return int(self.poses.nbytes + self.signatures.nbytes + self.norms.nbytes
+                   + self.profiles.nbytes)
+
+    def distances(self, signature: np.ndarray, profiles: np.ndarray | None = None,
+                  profile_weight: float = 0.0, truncation: float = 1.0) -> np.ndarray:
+        """Distance ``(N,)`` of every entry to a query: the signatures' Euclidean distance, plus
+        ``profile_weight`` times the robust profile distance to the query's shifted profiles
+        ``(K, sectors)`` (:func:`~tfloc.relocalize.profile_kernel.place_distances`)."""
+        sq = self.norms - 2.0 * (self.signatures @ signature) + float(signature @ signature)
+        base = np.sqrt(np.maximum(sq, 0.0))
+        if profiles is None or profile_weight <= 0.0:
+            return base
+        return place_distances(base, self.profiles, np.asarray(profiles, dtype=np.float32),
+                               float(truncation), float(profile_weight))
 
     def query(self, signature: np.ndarray, count: int, separation: float,
-              heading_separation: float, candidates: int = 8) -> tuple[np.ndarray, np.ndarray]:
-        """The ``count`` nearest entries to ``signature`` that are distinct places: an entry is
-        skipped if a better one lies within ``separation`` metres and ``heading_separation``
-        radians of it. Looks at ``candidates × count`` nearest entries. Returns entry indices
-        (best first) and their signature distances."""
+              heading_separation: float, candidates: int = 8, profiles: np.ndarray | None = None,
+              profile_weight: float = 0.0, truncation: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+        """The ``count`` nearest entries to the query (:meth:`distances`) that are distinct
+        places: an entry is skipped if a better one lies within ``separation`` metres and
+        ``heading_separation`` radians of it. Looks at ``candidates × count`` nearest entries.
+        Returns entry indices (best first) and their distances."""
         k = int(min(len(self.poses), max(count, candidates * count)))
         if k == 0:
             return np.zeros(0, dtype=np.int64), np.zeros(0)
-        sq = self.norms - 2.0 * (self.signatures @ signature)
-        idx = np.argpartition(sq, k - 1)[:k] if k < len(sq) else np.arange(len(sq))
-        idx = idx[np.argsort(sq[idx], kind="stable")]
-        dist = np.sqrt(np.maximum(sq[idx] + float(signature @ signature), 0.0))
+        d = self.distances(signature, profiles, profile_weight, truncation)
+        idx = np.argpartition(d, k - 1)[:k] if k < len(d) else np.arange(len(d))
+        idx = idx[np.argsort(d[idx], kind="stable")]
+        dist = d[idx]
         keep: list[int] = []
         for n, i in enumerate(idx):
             p = self.poses[i]
@@ -176,11 +199,13 @@ def build_index(map_: Map, laser: LaserSpec, cfg: IndexConfig, key: str = "") ->
     heads = (heads + np.pi) % (2 * np.pi) - np.pi
     poses = np.column_stack((np.repeat(xy, len(heads), axis=0), np.tile(heads, len(xy))))
     sig = np.empty((len(poses), cfg.signature.size))
+    prof = np.empty((cfg.profile.sectors, len(poses)), dtype=np.float32)
     for lo in range(0, len(poses), BATCH):
         ranges = np.atleast_2d(map_.raycast(poses[lo:lo + BATCH], laser))
         sig[lo:lo + BATCH] = signatures(ranges, laser, cfg.signature)
+        prof[:, lo:lo + BATCH] = index_profiles(ranges, laser, cfg.profile).T
     area = free_area(map_)
-    return PlaceIndex(poses, sig, np.einsum("ij,ij->i", sig, sig), area,
+    return PlaceIndex(poses, sig, np.einsum("ij,ij->i", sig, sig), prof, area,
                       time.process_time() - t0, False, key)
 
 
@@ -189,7 +214,7 @@ def _save(path: Path, index: PlaceIndex) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     with open(tmp, "wb") as f:
-        np.savez(f, poses=index.poses, signatures=index.signatures,
+        np.savez(f, poses=index.poses, signatures=index.signatures, profiles=index.profiles,
                  meta=np.array([index.free_area_m2, index.build_cpu_s]))
     os.replace(tmp, path)
 
@@ -198,14 +223,16 @@ def _load(path: Path, key: str) -> PlaceIndex | None:
     """The index stored at ``path``, or ``None`` if there is none or it cannot be read."""
     try:
         with np.load(path) as z:
-            poses, sig, meta = z["poses"], z["signatures"], z["meta"]
+            poses, sig, prof, meta = z["poses"], z["signatures"], z["profiles"], z["meta"]
     except (OSError, ValueError, KeyError, EOFError):
         return None
-    if poses.ndim != 2 or poses.shape[1] != 3 or len(sig) != len(poses) or len(poses) == 0:
+    if (poses.ndim != 2 or poses.shape[1] != 3 or len(sig) != len(poses) or len(poses) == 0
+            or prof.ndim != 2 or prof.shape[1] != len(poses) or not np.isfinite(prof).all()):
         return None
     sig = np.ascontiguousarray(sig, dtype=float)
-    return PlaceIndex(poses, sig, np.einsum("ij,ij->i", sig, sig), float(meta[0]), float(meta[1]),
-                      True, key)
+    prof = np.ascontiguousarray(prof, dtype=np.float32)
+    return PlaceIndex(poses, sig, np.einsum("ij,ij->i", sig, sig), prof, float(meta[0]),
+                      float(meta[1]), True, key)
 
 
 def load_or_build(map_: Map, laser: LaserSpec, cfg: IndexConfig,

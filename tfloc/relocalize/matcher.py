@@ -5,8 +5,10 @@ index resolved by ``tf-plus``.
    virtual scans from a lattice of free positions × a few headings, cached on disk under the
    map's content hash.
 2. **Query**: the real scan's signature (:mod:`tfloc.relocalize.signature`: heading-invariant,
-   from the turning function's edge directions and turning angles, and the ranges) → the
-   ``places`` nearest distinct index entries.
+   from the turning function's turning angles, the wall lengths and the ranges) and its range
+   profile (:mod:`tfloc.relocalize.profile`: sector medians, a real scan's no-returns unknown,
+   compared with a truncated distance over shifts that cover the gap between two index headings)
+   → the ``places`` nearest distinct index entries.
 3. **Resolve** the places with ``tf-plus``'s stages, configured by ``resolver``: each place's
    pose is the guess of its turning-function heading seeds, heading sweep and coarse grid (over
    ``resolver.search_radius`` around the place); the coarse candidates of all places compete
@@ -36,6 +38,7 @@ from tfloc.core.problem import Estimate, Problem
 from tfloc.tfplus.matcher import TfPlusConfig, TurningFunctionPlusMatcher
 
 from .index import IndexConfig, PlaceIndex, place_index
+from .profile import FAR, UNKNOWN, query_profiles, query_shifts
 from .resolve import resolve_places
 from .signature import scan_signature
 
@@ -55,6 +58,16 @@ class TfGlobalConfig:
         resolve: ``"per-place"`` (tf-plus's ``localize`` from each place) or ``"batched"`` (its
             stages, the coarse candidates of all places competing for one refinement of the
             best ``refined``: :mod:`tfloc.relocalize.resolve`).
+        profile_weight: weight of the robust range-profile distance (a mean of per-sector
+            differences in fractions of the profile's cap) beside the signature's Euclidean
+            distance; 0 ranks by the signature alone.
+        profile_truncation: a sector's difference counts at most this (fraction of the cap):
+            a few sectors that see through glass or a door the map drew closed cost a bounded
+            amount.
+        profile_shifts: the query's profile at this many shifts over ± half the gap between two
+            index headings (the best shift counts).
+        no_return: a real scan's no-return beam is ``"unknown"`` (left out of the profile) or
+            ``"far"`` (the cap, as open space in the map).
         local: a problem with an initial guess: ``"tf-plus"`` (``tf-plus`` with its own defaults
             from the guess: the local matcher) or ``"global"`` (the guess ignored).
         cache_dir: where the index is stored on disk ("" = ``$TFLOC_INDEX_CACHE`` or
@@ -62,21 +75,27 @@ class TfGlobalConfig:
     """
 
     RULES: ClassVar[dict] = {
-        ">= 1": ("places", "hypotheses", "refined"),
+        ">= 1": ("places", "hypotheses", "refined", "profile_shifts"),
         ("per-place", "batched"): ("resolve",),
         ">= 0": ("place_density", "place_separation", "place_heading_separation", "hypothesis_separation",
-                 "hypothesis_heading_separation"),
-        ("tf-plus", "global"): ("local",)}
+                 "hypothesis_heading_separation", "profile_weight"),
+        ("tf-plus", "global"): ("local",),
+        "> 0": ("profile_truncation",),
+        (UNKNOWN, FAR): ("no_return",)}
 
     places: int = 24  #: index places resolved per scan, at least (see place_density)
     place_density: float = 0.08
-    place_separation: float = 0.75  #: index entries within this distance (metres) ...
+    place_separation: float = 0.5  #: index entries within this distance (metres; the resolver reaches 0.5 m) ...
     place_heading_separation: float = math.radians(30.0)  #: ... and heading (rad): one place
     hypotheses: int = 5  #: ranked answers returned (Estimate.hypotheses; scored: 5)
     hypothesis_separation: float = 0.3  #: hypotheses are at least this far apart (metres) ...
     hypothesis_heading_separation: float = math.radians(10.0)  #: ... or this in heading (rad)
     resolve: str = "batched"
     refined: int = 16  #: batched: candidates refined (see resolve)
+    profile_weight: float = 10.0
+    profile_truncation: float = 0.1
+    profile_shifts: int = 9
+    no_return: str = UNKNOWN
     local: str = "tf-plus"
     cache_dir: str = ""
     disk_cache: bool = True  #: store and read the index on disk (else once per process)
@@ -142,8 +161,13 @@ class TurningFunctionGlobalMatcher:
             return Estimate(Pose(math.nan, math.nan, math.nan), False, 0, 0, {
                 "status": "no-answer", "reason": "the map has no free lattice position to index"})
         sig = scan_signature(problem.ranges, problem.laser, cfg.index.signature)
+        prof = (query_profiles(problem.ranges, problem.laser, cfg.index.profile,
+                               query_shifts(cfg.index.headings, cfg.profile_shifts), cfg.no_return)
+                if cfg.profile_weight > 0 else None)
         count = max(cfg.places, int(round(cfg.place_density * idx.free_area_m2)))
-        entries, sig_dist = idx.query(sig, count, cfg.place_separation, cfg.place_heading_separation)
+        entries, sig_dist = idx.query(sig, count, cfg.place_separation, cfg.place_heading_separation,
+                                      profiles=prof, profile_weight=cfg.profile_weight,
+                                      truncation=cfg.profile_truncation)
         if cfg.resolve == "batched":
             ranked, cost, evaluations = resolve_places(problem, idx.poses[entries], cfg.resolver,
                                                        cfg.refined)
