@@ -1,4 +1,4 @@
-"""A fixed stratified sample of scans for the speed scripts: ``per`` scans of each dataset ×
+"""One-off research helper: a fixed stratified sample of scans for the speed scripts: ``per`` scans of each dataset ×
 group (first ``per`` in file order, so "before" and "after" checkouts see the same scans)."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Where tf-plus's CPU time goes, per stage (one process, one thread, warm caches).
+"""One-off research: where tf-plus's CPU time goes, per stage (one process, one thread, warm caches).
 
 Runs each stage of ``TurningFunctionPlusMatcher.localize`` (default configuration) by hand
 with a CPU timer around it, on the speed scripts' sample (:mod:`_sample`), and prints the
