@@ -146,11 +146,11 @@ test-cpu: $(STAMP)
 ## values (make test runs a few hundred per reader); prints how many inputs each reader tried.
 fuzz: $(STAMP)
 	TFLOC_FUZZ_EXAMPLES=$${TFLOC_FUZZ_EXAMPLES:-3000} TFLOC_FUZZ_RANDOM=1 $(BIN)/python -m pytest -q -s \
-		tests/test_fuzz_readers.py tests/test_matcher_params.py
+		tests/io/test_fuzz_readers.py tests/core/test_matcher_params.py
 
 ## The long kill tests: runs of 240 tasks killed with SIGKILL 10 times (local pool and Dask).
 chaos: $(STAMP)
-	$(BIN)/python -m pytest -q -m slow tests/test_chaos.py
+	$(BIN)/python -m pytest -q -m slow tests/toolchain/test_chaos.py
 
 ## Full pytest-benchmark timing (pinned to 2 cores); not part of CI.
 timing: $(STAMP)

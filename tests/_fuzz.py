@@ -1,4 +1,4 @@
-"""Mutation fuzzing of the readers (tests/test_fuzz_readers.py): hypothesis strategies that turn a
+"""Mutation fuzzing of the readers (tests/io/test_fuzz_readers.py): hypothesis strategies that turn a
 valid file into a damaged one, and the oracle every damaged input must satisfy.
 
 The oracle: reading ends in a valid result or in a :class:`~tfloc.errors.TflocError` whose one-line

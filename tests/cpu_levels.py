@@ -3,7 +3,7 @@ so that numpy computes as it does on a CPU without AVX-512 (or without AVX2 and 
 taken from this numpy's own dispatch targets (numpy 2.4 names them ``X86_V3``/``X86_V4``, older
 releases ``AVX2``, ``AVX512F``, ``AVX512_SKX``, …; a name numpy does not know is silently ignored,
 so the list cannot be written down once). ``make test-cpu`` uses it, with the matching
-``OPENBLAS_CORETYPE``; ``tests/test_cpu_level.py`` checks that the pass got what it asked for."""
+``OPENBLAS_CORETYPE``; ``tests/toolchain/test_cpu_level.py`` checks that the pass got what it asked for."""
 
 from __future__ import annotations
 

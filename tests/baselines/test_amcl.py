@@ -5,7 +5,7 @@ brushfire), the KLD sample count against ``pf_resample_limit``'s formula, the mo
 sample moments, the heaviest cluster of a two-mode set, seeded repeatability (random injection and
 global initialisation included), Nav2's update gate, global initialisation on free cells only, and
 bad parameters refused by name. Fidelity against Nav2's own code (the ``amcl`` wheel):
-``tests/test_amcl_fidelity.py``."""
+``tests/baselines/test_amcl_fidelity.py``."""
 
 from __future__ import annotations
 
@@ -31,7 +31,7 @@ from tfloc.core.tracker import as_tracker, has_single_scan_mode, is_tracker
 from tfloc.errors import ParameterError
 from tfloc.maps.grid import GridMap
 
-MAPS = Path(__file__).resolve().parents[1] / "data" / "maps"
+MAPS = Path(__file__).resolve().parents[2] / "data" / "maps"
 LASER = LaserSpec.lms200()
 SPREAD = {"initial_sigma_xy": 0.5, "initial_sigma_theta": math.radians(15.0)}
 

@@ -16,7 +16,7 @@ from tfloc.core.pose import Pose
 from tfloc.io.scenario import Scan, read_scans, read_scenario, write_scenario
 from tfloc.report.belief import Snapshot, motion_noise, summarize
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 QUICK = ROOT / "data" / "scenarios" / "seq-quick"
 
 

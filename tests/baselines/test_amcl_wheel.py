@@ -25,7 +25,7 @@ pytest.importorskip("amcl")
 import amcl._amcl_impl  # noqa: E402
 from tfloc.baselines.amcl_wheel import AmclWheelTracker, _pdf_seed_counter, amcl_grid  # noqa: E402
 
-OFFICE = Path(__file__).resolve().parents[1] / "data" / "maps" / "office-1.geojson"
+OFFICE = Path(__file__).resolve().parents[2] / "data" / "maps" / "office-1.geojson"
 LASER = LaserSpec.lms200()
 SPREAD = {"initial_sigma_xy": 0.5, "initial_sigma_theta": math.radians(15.0)}
 

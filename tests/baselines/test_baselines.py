@@ -1,7 +1,7 @@
 """Every baseline matcher (the registry's matchers whose module is in ``baselines/``): recovers a
 known 0.3 m / 5° offset in the test room within 2 cm / 0.5° from three directions. The contract
 every matcher meets (names, parameters, score, tiny scans) is ``test_matchers.py``;
-matcher-specific tests stay in ``test_baselines_<name>.py``."""
+matcher-specific tests stay in ``tests/baselines/test_<name>.py``."""
 
 from __future__ import annotations
 

@@ -23,7 +23,7 @@ import tfloc
 from tfloc import LaserSpec, Pose, Problem, angdiff
 from tfloc.maps.scanmap import polyline_map_from_scan
 
-SCANS = Path(__file__).resolve().parents[1] / "data/scenarios/real-csail-relations/scans.csv"
+SCANS = Path(__file__).resolve().parents[2] / "data/scenarios/real-csail-relations/scans.csv"
 LASER = LaserSpec.from_degrees(50.0, 180.0, 0.5, -90.0)   # as its scenario.json
 IDS = ("rel0001", "rel0002", "rel0003", "rel0004", "rel0005")
 

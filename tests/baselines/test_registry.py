@@ -19,7 +19,7 @@ from tfloc import Pose
 from tfloc.core.params import resolve_params
 from tfloc.errors import ParameterError
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 _SCRIPT = """
 import json, sys

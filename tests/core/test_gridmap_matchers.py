@@ -19,7 +19,7 @@ from tfloc.core.problem import Problem
 from tfloc.errors import MatcherError
 from tfloc.maps.build import rasterize
 
-ROOM = Path(__file__).resolve().parents[1] / "data" / "maps" / "test-room.geojson"
+ROOM = Path(__file__).resolve().parents[2] / "data" / "maps" / "test-room.geojson"
 
 
 @pytest.mark.parametrize("name", available_matchers())

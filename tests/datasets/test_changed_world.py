@@ -26,7 +26,7 @@ from tfloc.datasets.rearranged import (
 from tfloc.io.scenario import read_scenario
 from tfloc.maps.vector import VectorMap
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SCEN = ROOT / "data" / "scenarios"
 POSES = [Pose(2.0, 7.5, 0.0), Pose(10.0, 3.0, 1.2), Pose(17.0, 12.0, -2.0), Pose(6.5, 10.5, 2.5)]
 

@@ -21,7 +21,7 @@ from tfloc.errors import InvalidProblemError
 from tfloc.io.geojson import read_vector_map
 from tfloc.io.scenario import GLOBAL, map_for, read_scans, read_scenario
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SCEN = ROOT / "data" / "scenarios"
 
 

@@ -114,7 +114,7 @@ def test_scan_rate_does_not_change_the_odometry():
 
     from tfloc.io.scenario import read_scans, read_scenario
 
-    root = Path(__file__).resolve().parents[1] / "data" / "scenarios"
+    root = Path(__file__).resolve().parents[2] / "data" / "scenarios"
     err = {}
     for name in ("seq-rate-1hz-b", "seq-easy-b"):
         s = read_scans(read_scenario(root / name))

@@ -24,7 +24,7 @@ from tfloc.datasets.relations import build_relations, overlap
 from tfloc.io.carmen import read_carmen
 from tfloc.io.scenario import map_for, read_scans, read_scenario
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "data"
 SCEN = DATA / "scenarios"
 

@@ -32,7 +32,7 @@ from tfloc.io.carmen import read_carmen, read_flaser_no_timestamps
 from tfloc.io.relations import Relation, read_relations
 from tfloc.io.scenario import read_scans, read_scenario
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 REAL = ROOT / "data" / "real"
 SCEN = ROOT / "data" / "scenarios"
 #: (key, scans in the dataset, truth-bearing scans, raw scans in the log)

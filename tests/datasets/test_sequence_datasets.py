@@ -18,7 +18,7 @@ from tfloc.datasets.sequences import BUNDLE, CONDITIONS, SequenceSpec, SimSpec, 
 from tfloc.errors import DatasetError
 from tfloc.io.scenario import SEQUENCE, Scan, read_scans, read_scenario, write_scenario
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 MAP = ROOT / "data" / "maps" / "test-room.geojson"
 LASER = LaserSpec.lms200()
 

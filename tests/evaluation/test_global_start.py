@@ -23,7 +23,7 @@ from tfloc.evaluation.global_start import (
 from tfloc.io.estimates import result_row
 from tfloc.io.scenario import read_scans, read_scenario
 
-SCEN = Path(__file__).resolve().parents[1] / "data" / "scenarios"
+SCEN = Path(__file__).resolve().parents[2] / "data" / "scenarios"
 
 
 def drive(n: int, step: float = 0.1, turn: float = 0.02) -> np.ndarray:

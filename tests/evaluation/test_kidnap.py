@@ -24,7 +24,7 @@ from tfloc.harness.track import odom_deltas
 from tfloc.io.estimates import result_row
 from tfloc.io.scenario import SEQUENCE, read_scans, read_scenario
 
-SCEN = Path(__file__).resolve().parents[1] / "data" / "scenarios"
+SCEN = Path(__file__).resolve().parents[2] / "data" / "scenarios"
 
 
 # -- metrics on hand-made trajectories ---------------------------------------------------------

@@ -14,7 +14,7 @@ from tfloc.core.pose import Pose
 from tfloc.datasets.motion import OdometryNoise, sample_increments
 from tfloc.evaluation.motion_fit import fit_motion_noise, fit_sigma_hit, update_intervals
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _walk(n: int, rng: np.random.Generator) -> list[Pose]:

@@ -16,7 +16,7 @@ import pytest
 distributed = pytest.importorskip("distributed")
 
 import dask  # noqa: E402
-from test_harness_runner import make_dataset  # noqa: E402
+from test_runner import make_dataset  # noqa: E402
 
 from tfloc.errors import ConfigError  # noqa: E402
 from tfloc.harness.config import MatcherSpec, RunConfig  # noqa: E402
@@ -24,8 +24,8 @@ from tfloc.harness.dask_executor import execute_dask  # noqa: E402
 from tfloc.harness.runner import run  # noqa: E402
 from tfloc.io.estimates import read_estimates  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[1]
-TESTS = Path(__file__).resolve().parent
+ROOT = Path(__file__).resolve().parents[2]
+TESTS = Path(__file__).resolve().parents[1]
 ENV = {**os.environ, "PYTHONPATH": os.pathsep.join([str(TESTS), str(ROOT)])}
 KEY = ["dataset", "scan_id", "matcher"]
 

@@ -11,7 +11,7 @@ import pytest
 from tfloc.errors import ConfigError
 from tfloc.harness.dask_executor import execute_dask, parse_scheduler
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.mark.parametrize("address, parsed", [("local:3", ("local", 3)),

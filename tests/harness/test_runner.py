@@ -20,9 +20,9 @@ from tfloc.harness.runner import run
 from tfloc.io.estimates import read_estimates
 from tfloc.io.scenario import Scan, write_scenario
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 ROOM = ROOT / "data" / "maps" / "test-room.geojson"
-TESTS = Path(__file__).resolve().parent
+TESTS = Path(__file__).resolve().parents[1]
 
 
 def make_dataset(root: Path, m, laser, n: int = 6, offset=(0.2, -0.1)) -> Path:

@@ -12,7 +12,7 @@ import pandas as pd
 import pytest
 
 from tests._estimates import frame, row
-from tests.test_harness_runner import cfg, make_dataset
+from tests.harness.test_runner import cfg, make_dataset
 from tfloc.cli import build_parser
 from tfloc.cli.bench import QUICK_PER_GROUP, config_from_args
 from tfloc.errors import ConfigError
@@ -21,7 +21,7 @@ from tfloc.harness.config import MatcherSpec
 from tfloc.harness.runner import run
 from tfloc.harness.timing import TIMING_COLUMNS, run_timing, sample_scans
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 ENV = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "tests"), str(ROOT)])}
 
 

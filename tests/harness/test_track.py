@@ -19,7 +19,7 @@ from tfloc.harness.track import dead_reckoning, track
 from tfloc.io.estimates import COLUMNS
 from tfloc.io.scenario import Scan, read_scans, read_scenario, write_scenario
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 QUICK = ROOT / "data" / "scenarios" / "seq-quick"
 
 

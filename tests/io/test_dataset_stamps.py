@@ -13,7 +13,7 @@ from tfloc.core.pose import Pose
 from tfloc.errors import DatasetError
 from tfloc.io.scenario import Scan, read_scans, read_scenario, write_scenario
 
-MAP = Path(__file__).resolve().parents[1] / "data" / "maps" / "test-room.geojson"
+MAP = Path(__file__).resolve().parents[2] / "data" / "maps" / "test-room.geojson"
 LASER = LaserSpec.lms200()
 
 

@@ -14,7 +14,7 @@ from tfloc import InvalidProblemError, MapFormatError, Pose, Problem
 from tfloc.errors import DatasetError
 from tfloc.io.scenario import Scan, read_scans, read_scenario, write_scenario
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 ROOM = ROOT / "data" / "maps" / "test-room.geojson"
 
 

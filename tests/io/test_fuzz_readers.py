@@ -29,8 +29,8 @@ from tfloc.io.rosmap import read_ros_map, write_ros_map
 from tfloc.io.scenario import Scan, read_scans, read_scenario, write_scenario
 from tfloc.maps.grid import GridMap
 
-ROOT = Path(__file__).resolve().parents[1]
-FIX = Path(__file__).parent / "fixtures" / "real"
+ROOT = Path(__file__).resolve().parents[2]
+FIX = Path(__file__).parents[1] / "fixtures" / "real"
 ROOM = ROOT / "data" / "maps" / "test-room.geojson"
 LASER = tfloc.LaserSpec.from_degrees(8.0, 180.0, 2.0)  # 91 beams: small files, quick cases
 

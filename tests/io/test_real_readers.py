@@ -13,8 +13,8 @@ from tfloc.errors import LogFormatError
 from tfloc.io.carmen import read_carmen
 from tfloc.io.relations import join_relations, read_relations
 
-FIX = Path(__file__).parent / "fixtures" / "real"
-REAL = Path(__file__).resolve().parents[1] / "data" / "real"
+FIX = Path(__file__).parents[1] / "fixtures" / "real"
+REAL = Path(__file__).resolve().parents[2] / "data" / "real"
 INTEL_HEAD = FIX / "intel-head.log"          # first 187 lines of intel-corrected.log
 CSAIL_HEAD = FIX / "mit-csail-head.clf"      # first 6 lines of mit-csail.clf (3 comments, 3 FLASER)
 REL_HEAD = FIX / "mit-csail-head.relations"  # first 5 lines of mit-csail.relations

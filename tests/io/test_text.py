@@ -14,7 +14,7 @@ from tfloc.io.geojson import read_vector_map
 from tfloc.io.scenario import read_scans, read_scenario
 from tfloc.io.text import read_text
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_bom_crlf_and_gzip_read_alike(tmp_path: Path) -> None:

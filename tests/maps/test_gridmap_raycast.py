@@ -13,7 +13,7 @@ from tfloc.core.pose import Pose
 from tfloc.maps import GridMap, Map
 from tfloc.maps.build import grid_from_scans, rasterize
 
-ROOM = Path(__file__).resolve().parents[1] / "data" / "maps" / "test-room.geojson"
+ROOM = Path(__file__).resolve().parents[2] / "data" / "maps" / "test-room.geojson"
 
 
 @pytest.fixture(scope="module")

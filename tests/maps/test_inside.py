@@ -15,7 +15,7 @@ from tfloc.maps import inside
 from tfloc.maps.inside import Rings
 from tfloc.maps.vector import VectorMap
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _points(geom, rng: np.random.Generator, n: int) -> np.ndarray:

@@ -44,7 +44,7 @@ def test_report_draws_tf_objective_around_the_truth(tmp_path):
     from tfloc.harness.runner import run
     from tfloc.report.report import write_report
 
-    root = __import__("pathlib").Path(__file__).resolve().parents[1]
+    root = __import__("pathlib").Path(__file__).resolve().parents[2]
     cfg = RunConfig("t", tmp_path / "run", (root / "data" / "scenarios" / "office-pool",),
                     (MatcherSpec.make("tf"),), jobs=1, limit_per_group=1)
     out = run(cfg, progress=False)

@@ -1,7 +1,7 @@
 """End to end: the ``tf`` matcher with the compiled kernels (the fused cost evaluation of
 tfloc/_tf_kernels.py) gives the same answers as with the previous implementations run step by
 step (brute-force raycast, numpy ShortStraw candidates / turning function / matching, kept as
-oracles in tests/test_kernels_*.py)."""
+oracles in tests/*/test_kernels_*.py)."""
 
 from __future__ import annotations
 

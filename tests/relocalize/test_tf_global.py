@@ -97,7 +97,7 @@ def test_the_index_is_kept_in_memory_per_map(test_room, lms200, tmp_path) -> Non
 
 
 def _room_path() -> Path:
-    return Path(__file__).resolve().parents[1] / "data" / "maps" / "test-room.geojson"
+    return Path(__file__).resolve().parents[2] / "data" / "maps" / "test-room.geojson"
 
 
 @pytest.fixture(scope="module")

@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 
 from tests._estimates import frame, row, synthetic_run
-from tests.test_harness_runner import cfg, make_dataset
+from tests.harness.test_runner import cfg, make_dataset
 from tfloc.core.thresholds import Thresholds
 from tfloc.evaluation.metrics import prepare
 from tfloc.evaluation.paired import paired_comparisons

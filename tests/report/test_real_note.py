@@ -12,7 +12,7 @@ from tfloc.evaluation.relations import relation_stats
 from tfloc.io.scenario import read_scans, read_scenario
 from tfloc.report.relations_note import write_note
 
-DATASET = Path(__file__).resolve().parents[1] / "data" / "scenarios" / "real-csail-relations"
+DATASET = Path(__file__).resolve().parents[2] / "data" / "scenarios" / "real-csail-relations"
 
 
 def test_relation_stats() -> None:

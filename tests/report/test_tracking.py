@@ -13,7 +13,7 @@ from tfloc.io.maps import load_map
 from tfloc.io.scenario import read_scans, read_scenario
 from tfloc.report.tracking import sequence_scores, tracking_section
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _rows(name: str, n: int, lost_from: int | None = None) -> list[dict]:
@@ -49,7 +49,7 @@ def test_a_sequence_with_relations_gets_the_relation_errors_and_a_set_of_buildin
     from tfloc.io.scenario import read_scans, read_scenario
     from tfloc.report.tracking import relations_tables, sequence_scores, tracking_tables
 
-    root = Path(__file__).resolve().parents[1] / "data" / "scenarios"
+    root = Path(__file__).resolve().parents[2] / "data" / "scenarios"
     rows, datasets = [], {}
     for name in ("real-csail-native", "real-aces-native"):
         sc = read_scenario(root / name)

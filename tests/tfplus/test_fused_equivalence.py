@@ -18,7 +18,7 @@ from tfloc.core.pose import Pose
 from tfloc.tfplus.refine import RefineConfig, _virtual_geometry, refine
 from tfloc.tfplus.virtual_kernel import virtual_geometry_kernel
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _poses(rng: np.random.Generator, n: int) -> np.ndarray:

@@ -18,7 +18,7 @@ from tfloc.maps.build import rasterize
 from tfloc.tfplus import pipeline
 from tfloc.tfplus.matcher import TurningFunctionPlusMatcher
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _both(matcher: TurningFunctionPlusMatcher, problem: Problem,

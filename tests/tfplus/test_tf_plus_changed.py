@@ -32,7 +32,7 @@ from tfloc.tfplus.cost_kernel import beam_flags_kernel, see_through_kernel
 from tfloc.tfplus.matcher import TurningFunctionPlusMatcher
 from tfloc.tfplus.view import map_view
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 ROOM = VectorMap(outline=box(0, 0, 8, 6), name="room")
 LASER = LaserSpec.lms200()
 

@@ -15,7 +15,7 @@ from tfloc.harness.track import track
 from tfloc.io.scenario import read_scans, read_scenario
 from tfloc.tfplus.tracker import TfPlusTracker
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 class Stub:

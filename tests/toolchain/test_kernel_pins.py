@@ -16,7 +16,7 @@ Two kinds of pin:
   ``OPENBLAS_CORETYPE`` shows it) or through numpy's SIMD ``arctan2`` (the corner pairs'
   directions in :func:`~tfloc.baselines._corner_match.pair_hypotheses`).
 
-``TFLOC_PRINT_PINS=1 pytest -s tests/test_kernel_pins.py`` prints the pins of the code as it is.
+``TFLOC_PRINT_PINS=1 pytest -s tests/toolchain/test_kernel_pins.py`` prints the pins of the code as it is.
 ``make test`` runs this file again with AVX-512 and with AVX2 disabled (``make test-cpu``)."""
 
 from __future__ import annotations

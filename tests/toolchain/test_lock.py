@@ -14,7 +14,7 @@ from tfloc.errors import ConfigError
 from tfloc.io.lock import LOCK_NAME, find_lock, lock_differences, read_lock
 from tfloc.report.report import lock_note
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_the_checkout_has_its_lock() -> None:

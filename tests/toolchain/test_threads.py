@@ -13,7 +13,7 @@ from _registry import NAMES
 
 from tfloc.harness.runner import _init_worker
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 MATCHERS = tuple(NAMES)  # every registered matcher
 
 
