@@ -9,7 +9,7 @@ sigma_hit, lambda_short, chi_outlier, max_beams), robot_model_type)``, ``set_map
 ``set_laser_pose``, ``set_initial_pose(pose, cov)``, ``update(scan, odom_pose)`` and
 ``get_pose_mean``/``get_pose_covariance``. Nothing of AMCL is rewritten here; this module does what
 Nav2's ``amcl_node`` does around the filter. What the wheel does and does not do (read from its
-signatures and its compiled code; measured in ``tests/test_baselines_amcl_wheel.py``), and each
+signatures and its compiled code; measured in ``tests/baselines/test_amcl_wheel.py``), and each
 departure from Nav2's defaults, is in ``docs/baselines/amcl-wheel.md``. In short:
 
 * **The sensor model is the beam model**: the wheel builds ``BeamModel`` in ``set_map`` whatever

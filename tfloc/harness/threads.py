@@ -18,7 +18,7 @@ Every library with a thread pool is therefore limited to ``n`` threads (1 in the
 * kiss-icp: its TBB pool is sized per ``Registration`` (``max_num_threads``; the ``kiss-icp``
   matcher passes 1).
 
-:func:`thread_settings` reads every limit back; ``tests/test_threads.py`` checks them in a
+:func:`thread_settings` reads every limit back; ``tests/toolchain/test_threads.py`` checks them in a
 worker and that a busy matcher's CPU time does not exceed its wall time.
 """
 

@@ -5,7 +5,7 @@ The segment ray-caster (:mod:`tfloc.maps._raycast`) starts each cast by collecti
 closer than the scanner's range. Tested one by one that is O(M) per pose, so a scan's cost grew
 with the map (measured in ``docs/scaling.md``). With the buckets a cast looks only at the cells
 within range; the set of segments found, and so every range, is the same
-(``tests/test_kernels_raycast.py``).
+(``tests/maps/test_kernels_raycast.py``).
 
 An index is the tuple ``(x0, y0, inv_cell, nx, ny, start, items)``: cell ``(i, j)`` (column,
 row; ``cell = 1 / inv_cell`` metres from ``(x0, y0)``) holds the segments ``items[start[c]:

@@ -6,7 +6,7 @@ ShortStraw corners (Algs. 1–3) → closed scan polygon → turning function (A
 against the real scan's turning function (Sec. 4.3 / Eq. 13). It runs exactly the compiled
 kernels that the step-by-step path (:func:`tfloc.paper.shape.scan_turning_function`, :func:`tfloc.paper.turning.match`)
 calls one by one from Python, in the same order with the same arithmetic, so both give identical
-results (tests/test_perf_tf_equivalence.py); only the Python overhead per pose is gone.
+results (tests/paper/test_perf_tf_equivalence.py); only the Python overhead per pose is gone.
 """
 
 from __future__ import annotations

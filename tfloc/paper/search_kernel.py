@@ -11,7 +11,7 @@ nothing: the initial simplices' random directions come from the caller's generat
 outer iteration in order. It gives up (status -1) where it could not follow Python exactly — a
 position too near the free space's boundary for the compiled free test, or a NaN Err, whose
 comparisons Python's sort would order its own way — and the caller then runs the Python search
-from the start. ``tests/test_fused_equivalence.py`` compares both on scans of the office maps.
+from the start. ``tests/tfplus/test_fused_equivalence.py`` compares both on scans of the office maps.
 """
 
 from __future__ import annotations

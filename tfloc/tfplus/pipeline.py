@@ -8,7 +8,7 @@ kernels run in one compiled call, fed by a :class:`Plan` of everything that depe
 the laser and the configuration alone (built once per map): per scan, one dispatch from Python.
 
 Same arithmetic, same order, same kernels: the poses and costs are those of the staged path bit
-for bit (``tests/test_tfplus_pipeline.py`` runs both). The plan covers the default stage
+for bit (``tests/tfplus/test_pipeline.py`` runs both). The plan covers the default stage
 switches only (turning-function seeds and the heading sweep, the coarse grid, the refinement,
 ``select="residual"``; on a vector map against virtual scans or the map itself, on a grid map
 against the map itself); every other configuration, another kind of map, or a vector map whose

@@ -6,7 +6,7 @@ casts and pruning included, in one call. From Python an iteration was some 20 nu
 temporaries, more than its arithmetic. The same arithmetic in the same order (the ray cast is
 :func:`tfloc.maps._raycast.raycast_segments` itself; the beams' cos/sin come from numpy, computed
 once by the caller), so the poses are those of the step-by-step loop bit for bit
-(``tests/test_fused_equivalence.py``).
+(``tests/tfplus/test_fused_equivalence.py``).
 """
 
 from __future__ import annotations
