@@ -9,7 +9,7 @@ JOBS   ?= 2
 LOCK   := requirements.lock
 UV_VERSION := 0.13.9
 
-.PHONY: install lock quick bench global-full global-offices robustness robustness-full scaling scaling-quick ablation-real test test-cpu test-unit timing lint clean-venv real-data fuzz chaos
+.PHONY: install lock quick bench native global-full global-offices robustness robustness-full scaling scaling-quick ablation-real test test-cpu test-unit timing lint clean-venv real-data fuzz chaos
 
 $(STAMP): pyproject.toml $(LOCK)
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -73,6 +73,15 @@ bench: $(STAMP)
 		$(BIN)/tfloc index --dataset data/scenarios/$$d || exit 1; done
 	$(BIN)/tfloc bench benchmarks/global.toml --jobs $(JOBS) --regenerate
 	$(BIN)/tfloc report results/global
+	$(BIN)/tfloc bench benchmarks/native.toml --datasets real-csail-native --out results/native-csail --jobs $(JOBS) --regenerate
+	$(BIN)/tfloc report results/native-csail
+
+## Tracking the robots' own recordings at their native rate, every matcher, all three logs
+## (22 627 scans) → results/native/ (benchmarks/native.toml; 20-40 min on 2 cores). make bench
+## runs its fixed subsample, MIT CSAIL only (1927 scans, with the relations), → results/native-csail/.
+native: $(STAMP)
+	$(BIN)/tfloc bench benchmarks/native.toml --jobs $(JOBS) --regenerate
+	$(BIN)/tfloc report results/native
 
 ## Global localization on every scan of the global sets (issue 24) → results/global-full/.
 global-full: $(STAMP)

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 from tfloc.core.matcher import available_matchers
@@ -49,6 +50,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="a run configuration, or one or more scenario dataset directories")
     p.add_argument("--matchers", help="comma-separated matcher names (default with datasets: all "
                    f"registered: {','.join(available_matchers())})")
+    p.add_argument("--datasets", metavar="NAMES",
+                   help="with a run configuration: only its datasets of these directory names "
+                        "(comma-separated; a fixed subsample, e.g. make bench's native run)")
     p.add_argument("--out", type=Path, help="run directory (default: results/<name>)")
     p.add_argument("--name", help="run name (default: the config's, or 'run')")
     p.add_argument("--jobs", type=int, help="worker processes (default 2)")
@@ -83,6 +87,18 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_progress(p)
 
 
+def only_datasets(cfg: RunConfig, names: list[str]) -> RunConfig:
+    """``cfg`` with only its datasets whose directory name is one of ``names`` (in its order)."""
+    names = [n.strip() for n in names if n.strip()]
+    unknown = sorted(set(names) - {d.name for d in cfg.datasets})
+    if unknown:
+        raise ConfigError(f"--datasets: {', '.join(unknown)} not in run {cfg.name!r} "
+                          f"(its datasets: {', '.join(d.name for d in cfg.datasets)})")
+    keep = tuple(d for d in cfg.datasets if d.name in names)
+    return replace(cfg, datasets=keep,
+                   skip_per_group=tuple((k, n) for k, n in cfg.skip_per_group if Path(k) in keep))
+
+
 def config_from_args(args: argparse.Namespace) -> RunConfig:
     tomls = [i for i in args.inputs if i.endswith(".toml")]
     if tomls and len(args.inputs) > 1:
@@ -91,6 +107,10 @@ def config_from_args(args: argparse.Namespace) -> RunConfig:
         cfg = load_config(tomls[0])
         if args.matchers:
             cfg = cfg.with_overrides(matchers=parse_matchers(args.matchers.split(","), {}, "--matchers"))
+        if args.datasets:
+            cfg = only_datasets(cfg, args.datasets.split(","))
+    elif args.datasets:
+        raise ConfigError("--datasets selects datasets of a run configuration; give dataset directories directly")
     else:
         names = args.matchers.split(",") if args.matchers else available_matchers()
         name = args.name or "run"
