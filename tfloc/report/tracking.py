@@ -10,7 +10,8 @@ sequences (where the set has several), losses, recoveries and unrecovered losses
 sequences, the longest lost stretch, APE translation RMSE pooled over scans (cm), RPE per metre
 (mean over sequences, cm/m) and the median CPU ms per scan. Definitions:
 :mod:`tfloc.evaluation.trajectory`. Figures: each sequence's trajectories drawn on the map per
-matcher, and the distance error over distance travelled. Sets whose sequences have kidnap events
+matcher, the distance error over distance travelled, and each tracker's first jumps
+(:mod:`tfloc.report.jumps`). Sets whose sequences have kidnap events
 (``scenario.json`` ``"kidnaps"``) get a kidnap table too (:func:`kidnap_tables`;
 :mod:`tfloc.evaluation.kidnap`), their events one row each in ``kidnap.csv``. Sets where a
 tracker starts without a pose (its first row's ``info`` says so) get a start table
@@ -42,6 +43,7 @@ from tfloc.evaluation.trajectory import (
 )
 from tfloc.io.scenario import Scenario
 
+from .jumps import fig_jumps
 from .mdtable import num, table
 
 DEAD_RECKONING = DeadReckoning.name  # the floor, shown last
@@ -395,6 +397,9 @@ def tracking_section(df: pd.DataFrame, datasets: dict[str, Scenario], maps: dict
                 continue
             a = fig_trajectories(sc, maps[ds], g, fig_dir / f"{_safe(ds)}-trajectories.png")
             b = fig_error_distance(sc, g, fig_dir / f"{_safe(ds)}-error.png")
+            j = fig_jumps(ds, maps[ds], g, fig_dir / f"{_safe(ds)}-jumps.png")
             rel = lambda p: p.relative_to(out_dir).as_posix()  # noqa: E731
             text.append(f"\n![{ds} trajectories]({rel(a)})\n\n![{ds} error over distance]({rel(b)})\n")
+            if j is not None:
+                text.append(f"\n![{ds}: the first jumps of each tracker]({rel(j)})\n")
     return "\n".join(text)
