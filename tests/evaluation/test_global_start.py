@@ -82,6 +82,20 @@ def test_a_window_without_truth_does_not_settle() -> None:
     assert first_settled(true, true, scans=5) == 0
 
 
+def test_a_recording_with_sparse_truth_is_scored_on_its_truth_bearing_scans() -> None:
+    """A native-rate log: truth on every 4th scan only; the counts are of those scans, the scan
+    numbers the recording's."""
+    true = drive(240)
+    est = true.copy()
+    est[:100] = elsewhere(true[:100], Pose(4.0, 1.0, 0.0))    # a wrong place, held
+    est[100:] += [0.02, -0.01, 0.005]                         # then the truth
+    sparse = np.full_like(true, np.nan)
+    sparse[::4] = true[::4]
+    s = score_start(est, sparse)
+    assert s.window == 240 and s.settled == 0 and s.wrong and s.scans_to_converge == 100
+    assert score_start(est, np.full_like(true, np.nan)) == type(s)(240, None, None, False)
+
+
 def test_starts_without_pose_is_what_the_first_row_says() -> None:
     assert starts_without_pose({"start": "global", "particles": 2000})
     assert not starts_without_pose({}) and not starts_without_pose({"start": "pose"})

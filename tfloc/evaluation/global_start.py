@@ -13,7 +13,10 @@ first kidnap scan, else the end): a later event is another problem (:mod:`.kidna
   place for :data:`SETTLE_SCANS` scans, the place carried along by the robot's true motion
   (``est(s) ⊕ true(s)⁻¹ · true(k)``: for a robot standing still, one point of the map). It settled
   on a **wrong** place when its error at ``s`` is a loss's (above 0.5 m or 10°,
-  :mod:`.trajectory`). A window without truth on every scan does not count.
+  :mod:`.trajectory`).
+* A recording whose truth is known at some scans only (a native-rate log: the corrected scans)
+  is scored on those scans: ``HOLD`` and ``SETTLE_SCANS`` count truth-bearing scans, and the
+  scan numbers reported are the recording's own.
 * **starts without a pose**: what the tracker itself says in its first row's ``info``
   (``"start": "global"``: it ignored the pose the harness passed), never the label's name.
 """
@@ -93,10 +96,14 @@ def score_start(est: np.ndarray, true: np.ndarray, end: int | None = None,
     """Every start score of one sequence, its window ending before scan ``end`` (module notes)."""
     est, true = np.asarray(est, float).reshape(-1, 3), np.asarray(true, float).reshape(-1, 3)
     window = len(est) if end is None else min(int(end), len(est))
-    ok = correct(est[:window], true[:window], thresholds)
-    s = first_settled(est, true, window)
+    scored = np.flatnonzero(np.isfinite(true[:window]).all(axis=1))  # the truth-bearing scans
+    e, t = est[scored], true[scored]
+    ok = correct(e, t, thresholds)
+    s = first_settled(e, t)
     wrong = False
     if s is not None:
-        d, o = errors(est[s:s + 1], true[s:s + 1])
+        d, o = errors(e[s:s + 1], t[s:s + 1])
         wrong = bool(d[0] > LOST_DIST_M or np.degrees(o[0]) > LOST_ORIENT_DEG)
-    return StartScore(window, scans_to_converge(ok, window), s, wrong)
+    k = scans_to_converge(ok)
+    return StartScore(window, None if k is None else int(scored[k]),
+                      None if s is None else int(scored[s]), wrong)
