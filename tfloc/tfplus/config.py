@@ -123,7 +123,7 @@ class TfPlusConfig:
 #: :class:`TfPlusConfig` for a world that has changed since it was mapped (people, carts, doors,
 #: furniture moved or gone). Chosen on the development split of the ``changed-clutter-*`` and
 #: ``changed-furniture-gone`` scans (``benchmarks/dev/changed-world.toml``); not the default: on
-#: the paper protocol and the real logs it gives other (not worse) answers at more CPU per scan.
+#: the paper protocol it gives the same success, on the real recordings it can lose (ACES) and it costs more CPU.
 #: ``TurningFunctionPlusMatcher(**CHANGED_WORLD)``; in a run configuration, the same as ``params``.
 CHANGED_WORLD = {"refine_to": "field", "free_distance": 0.05, "short_margin": 0.3,
                  "short_residual": 0.05, "object_extent": 1.0, "short_refine": True,
