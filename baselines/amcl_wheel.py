@@ -7,10 +7,8 @@ The ``amcl`` 0.1.2 wheel on PyPI ("AMCL Python Bindings", GPL-3.0, nanobind) com
 alpha_slow, alpha_fast, MotionParameters(α1…α5), LaserParameters(z_hit, z_short, z_max, z_rand,
 sigma_hit, lambda_short, chi_outlier, max_beams), robot_model_type)``, ``set_map``,
 ``set_laser_pose``, ``set_initial_pose(pose, cov)``, ``update(scan, odom_pose)`` and
-``get_pose_mean``/``get_pose_covariance``. Nothing of AMCL is rewritten here; this module does what
-Nav2's ``amcl_node`` does around the filter. What the wheel does and does not do (read from its
-signatures and its compiled code; measured in ``tests/baselines/test_amcl_wheel.py``), and each
-departure from Nav2's defaults, is in ``docs/baselines/amcl-wheel.md``. In short:
+``get_pose_mean``/``get_pose_covariance``. This module does what Nav2's ``amcl_node`` does around
+the filter; the wheel's departures from Nav2 (``docs/baselines/amcl-wheel.md``), in short:
 
 * **The sensor model is the beam model**: the wheel builds ``BeamModel`` in ``set_map`` whatever
   the parameters; it has no likelihood field (no ``laser_likelihood_max_dist``, no distance map).
@@ -22,12 +20,10 @@ departure from Nav2's defaults, is in ``docs/baselines/amcl-wheel.md``. In short
   does not expose them. It reports the whole particle set's mean, not the heaviest cluster's.
 * Random numbers: the filter draws from the C library's ``drand48``; ``pf_alloc`` seeds it with
   the clock and ``set_initial_pose`` with a process-wide counter. Here the counter is set to
-  ``seed`` before the initial draw (for the one build whose machine code we read; elsewhere only
-  the default zero-covariance start is reproducible) and ``srand48(seed)`` is called after it.
-* No global localization (Nav2's ``reinitialize_global_localization``): the wheel has
-  ``pf_init_model`` but nothing calls it. Random particle injection (``recovery_alpha_slow`` /
-  ``_fast`` > 0) draws free cells from a ``std::mt19937`` seeded by ``std::random_device``: such
-  runs do not repeat.
+  ``seed`` before the initial draw (for the one build whose machine code we read) and
+  ``srand48(seed)`` after it.
+* No global localization; random particle injection draws from an unseeded ``std::mt19937``:
+  such runs do not repeat.
 
 A vector map is rasterised at 5 cm (as a user exports it for Nav2), a grid map is used as it is;
 both are handed over in map_server's trinary form (occupied 100, free 0, unknown -1).

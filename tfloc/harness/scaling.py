@@ -12,31 +12,21 @@ Axes (each level one problem set, every matcher on the same scans):
 * ``offset``: initial distance offsets in the protocol's bins 0–1, 1–2, 2–3 m (angle offsets in
   its three bins in turn), one-tile vector map, 181 beams.
 
-Scans: :func:`tfloc.datasets.tiling.tile_scans` (the protocol's sampler; scan k in offset cell
-k mod 9), ranges ray-cast on the tile plus the default noise (1 cm); seeded (:data:`SEED`), so two
-runs pose the same problems.
+Scans: :func:`tfloc.datasets.tiling.tile_scans`, ray-cast on the tile plus 1 cm noise, seeded
+(:data:`SEED`). Measurement under the timing pass's rules (:mod:`tfloc.harness.timing`): one
+pinned process, one thread per library, matchers interleaved scan by scan in rotated order, each
+with its own copy of each map. ``prepare`` is timed (CPU, wall, resident and peak memory:
+:class:`MemoryProbe`), then an untimed warm-up, then every ``localize``
+(:func:`~tfloc.harness.workspace.timed_localize`, its system time apart). Success:
+:class:`~tfloc.core.thresholds.Thresholds`.
 
-Measurement, under the timing pass's rules (:mod:`tfloc.harness.timing`): one process pinned to
-one core, every library on one thread (:func:`~tfloc.harness.timing.pinned`), matchers
-interleaved scan by scan with the order rotated by one per scan
-(:func:`~tfloc.harness.timing.rotated`). Each matcher gets its own copy of each map (no matcher's
-preparation is paid by another's cache). Its ``prepare(problem)`` is timed by the harness's timer
-(:func:`tfloc.harness.workspace.timed`: CPU and wall time), with the resident memory it leaves
-behind and its peak (:class:`MemoryProbe`); then the untimed warm-up
-(:func:`~tfloc.harness.workspace.warm` and ``warmup`` ``localize`` calls); then every scan's
-``localize`` through :func:`~tfloc.harness.workspace.timed_localize`, its system-time part apart
-(``getrusage`` around the call: mostly the kernel handing out fresh pages for large temporaries).
-Success: :class:`~tfloc.core.thresholds.Thresholds` (≤ 10 cm and ≤ 2°).
+Budgets: a matcher over ``budget_ms`` (median CPU) or ``prep_budget_s`` at a level is not run at
+the larger levels of that axis and map kind (:func:`tfloc.evaluation.scaling.over_budget`).
 
-Budgets: a matcher whose median CPU at a level exceeds ``budget_ms``, or whose preparation
-exceeded ``prep_budget_s``, is not run at the larger levels of that axis and map kind
-(:func:`tfloc.evaluation.scaling.over_budget`; ``skips.csv``).
-
-The output directory (:func:`run_study`) holds ``study.json`` (the configuration and its
-fingerprint, package versions, git commit and dirty flag, machine, one session per start with its
-start and end times, the levels done) and the raw rows ``scaling.csv``, ``prep.csv`` and
-``skips.csv``, rewritten atomically after every level: an interrupted study resumes at its first
-level not done, and a directory of another configuration is refused.
+The output directory (:func:`run_study`) holds ``study.json`` (configuration, fingerprint,
+versions, commit, machine, sessions, levels done) and the raw rows ``scaling.csv``, ``prep.csv``
+and ``skips.csv``, rewritten atomically after every level: an interrupted study resumes, a
+directory of another configuration is refused.
 :func:`tfloc.report.scaling.render` derives the tables, the figure and the README from them.
 """
 

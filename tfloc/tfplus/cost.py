@@ -23,13 +23,9 @@ Per beam of the real scan, at a candidate pose (metres², truncated at ``c`` = `
   returns says the pose is wrong), without it each return on its own. Without
   ``short_residual`` such a return costs its residual like any other, up to ``c²``.
 
-The cost is the mean over all beams. Without the beam check two poses that see the same walls
-(a bare corner, a corridor) tie even when one of them would see through a wall; the check is
-the beam model's free-space evidence, which point-to-line matching ignores.
-
-Why the far side on grids: a return lies inside the thick wall it hit, and the rule "beyond the
-first occupied cell" counted about a quarter of all beams at the true poses as seen through a
-wall, penalising the truth as much as a wrong pose (measured: ``docs/tf-plus.md``, "Real logs").
+The cost is the mean over all beams. The beam check is the beam model's free-space evidence,
+which point-to-line matching ignores (two poses that see the same walls otherwise tie). The far
+side on grids: a return lies inside the thick wall it hit (``docs/tf-plus.md``, "Real logs").
 """
 
 from __future__ import annotations
