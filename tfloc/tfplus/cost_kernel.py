@@ -41,7 +41,9 @@ def see_through_kernel(occ: np.ndarray, origin_x: float, origin_y: float, resolu
     more than ``margin`` beyond the far side of the first wall the beam meets (where the first
     run of occupied cells ends: a wall drawn several cells thick holds returns anywhere inside it),
     or no return (NaN, inf, ≥ ``max_range``) where the beam meets a wall within ``max_range``.
-    Each beam is followed only as far as it needs to be."""
+    Each beam is followed only as far as it needs to be. :func:`beam_flags_kernel` gives the same
+    beams in its more general march; this one stays apart because it is the default selection's
+    hot path, where the general march is about 6 % slower."""
     H, W = occ.shape
     k_n, n = poses.shape[0], angles.shape[0]
     out = np.zeros((k_n, n), dtype=np.bool_)
