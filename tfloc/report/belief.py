@@ -33,7 +33,6 @@ from tfloc.evaluation.trajectory import LOST_DIST_M, LOST_ORIENT_DEG
 #: the probes half a metre or 10° off the truth (robot frame: ahead, behind, left, right; turned)
 OFFSET_M, TURN_DEG = 0.5, 10.0
 NEAR_M, NEAR_DEG = 0.5, 10.0  # "near the truth" for the share of weight
-MAP_SPACING_M = 0.05
 
 
 @dataclass(frozen=True)
@@ -258,6 +257,8 @@ def fig_belief(snap: Snapshot, the_map, path: Path, title: str, max_range: float
     fig = Figure(figsize=(12.5 if two else 7.0, 6.0), layout="constrained")
     axes = np.atleast_1d(fig.subplots(1, 2 if two else 1, width_ratios=[1.25, 1] if two else None))
     ax = axes[0]
+    from .figures import MAP_SPACING_M
+
     mp, _ = the_map.sample_points(MAP_SPACING_M)
     near = (np.abs(mp[:, 0] - centre.x) <= radius_m) & (np.abs(mp[:, 1] - centre.y) <= radius_m)
     ax.scatter(mp[near, 0], mp[near, 1], s=3, c="black", marker="s", linewidths=0, label="map")

@@ -28,6 +28,14 @@ DPI = 120
 #: label with the first only and draws the first label's failures only; its line figures show a
 #: few labels, its bar and box figures turn horizontal (one row per label).
 MANY_MATCHERS = 12
+#: Metres between the map points drawn under a trajectory or a belief (the tracking figures).
+MAP_SPACING_M = 0.05
+
+
+def pose_columns(g: pd.DataFrame, prefix: str) -> np.ndarray:
+    """The ``(N, 3)`` poses ``<prefix>_x/_y/_theta`` of estimate rows (metres, radians; NaN where
+    empty)."""
+    return g[[f"{prefix}_x", f"{prefix}_y", f"{prefix}_theta"]].apply(pd.to_numeric, errors="coerce").to_numpy(float)
 
 
 def colours(matchers: list[str]) -> dict[str, tuple]:

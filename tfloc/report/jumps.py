@@ -19,15 +19,16 @@ from matplotlib.figure import Figure
 
 from tfloc.evaluation.trajectory import JUMP_M
 
+from .figures import MAP_SPACING_M, pose_columns
+
 PER_MATCHER = 3  #: jumps drawn per matcher
 CONTEXT = 30  #: scans drawn before and after a jump
 HALF_M = 4.0  #: half the side of a panel (metres)
 EVENT_GAP = 10  #: a jump within this many scans of a drawn one is the same event, not drawn
-MAP_SPACING_M = 0.05
 
 
 def _xy(g: pd.DataFrame, prefix: str) -> np.ndarray:
-    return g[[f"{prefix}_x", f"{prefix}_y"]].apply(pd.to_numeric, errors="coerce").to_numpy(float)
+    return pose_columns(g, prefix)[:, :2]
 
 
 def first_jumps(rows: pd.DataFrame, per_matcher: int = PER_MATCHER) -> list[tuple[str, int]]:

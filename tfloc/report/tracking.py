@@ -43,11 +43,11 @@ from tfloc.evaluation.trajectory import (
 )
 from tfloc.io.scenario import Scenario
 
+from .figures import MAP_SPACING_M, pose_columns
 from .jumps import fig_jumps
 from .mdtable import num, table
 
 DEAD_RECKONING = DeadReckoning.name  # the floor, shown last
-MAP_SPACING_M = 0.05
 DEFAULT = Thresholds()
 
 
@@ -131,7 +131,7 @@ def kidnap_events(df: pd.DataFrame, datasets: dict[str, Scenario],
             continue
         pos = {str(sid): i for i, sid in enumerate(g["scan_id"].astype(str))}
         events = [pos[k] for k in map(str, kid) if k in pos]
-        ks = score_kidnaps(_poses(g, "est"), _poses(g, "true"), _poses(g, "init"), events, thresholds)
+        ks = score_kidnaps(pose_columns(g, "est"), pose_columns(g, "true"), pose_columns(g, "init"), events, thresholds)
         tracked = score_rows(g, thresholds).tracked
         for i, (e, n) in enumerate(zip(ks.events, ks.scans_to_relocalize, strict=True)):
             out.append({"dataset": ds, "matcher": m, "set": condition_of(sc, g),
@@ -177,7 +177,7 @@ def start_scores(df: pd.DataFrame, datasets: dict[str, Scenario],
         sc = datasets.get(ds)
         pos = {str(sid): i for i, sid in enumerate(g["scan_id"].astype(str))}
         kid = [pos[k] for k in map(str, (sc.extra.get("kidnaps") or []) if sc is not None else []) if k in pos]
-        st = score_start(_poses(g, "est"), _poses(g, "true"), min(kid, default=len(g)), thresholds)
+        st = score_start(pose_columns(g, "est"), pose_columns(g, "true"), min(kid, default=len(g)), thresholds)
         first = g["info"].iloc[0] if "info" in g else ""
         out.append({"dataset": ds, "matcher": m, "set": condition_of(sc, g),
                     "no_pose": starts_without_pose(json.loads(first) if isinstance(first, str) and first else {}),
@@ -224,10 +224,6 @@ def _safe(name: str) -> str:
     return re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("_") or "x"
 
 
-def _poses(g: pd.DataFrame, prefix: str) -> np.ndarray:
-    return g[[f"{prefix}_x", f"{prefix}_y", f"{prefix}_theta"]].apply(pd.to_numeric, errors="coerce").to_numpy(float)
-
-
 def fig_trajectories(scenario: Scenario, the_map, rows: pd.DataFrame, path: Path) -> Path:
     """One panel per matcher: the map, the true trajectory and the matcher's estimates (scans
     lost, > 0.5 m off, in red)."""
@@ -239,7 +235,7 @@ def fig_trajectories(scenario: Scenario, the_map, rows: pd.DataFrame, path: Path
     axes = np.atleast_1d(fig.subplots(nrow, ncol)).ravel()
     for ax, m in zip(axes, ms, strict=False):
         g = rows[rows["matcher"] == m]
-        t, e = _poses(g, "true"), _poses(g, "est")
+        t, e = pose_columns(g, "true"), pose_columns(g, "est")
         ax.scatter(mp[:, 0], mp[:, 1], s=0.2, c="black", rasterized=True)
         ax.plot(t[:, 0], t[:, 1], "-", color="#2ca02c", lw=1.2, label="truth")
         ax.plot(e[:, 0], e[:, 1], "-", color="#1f77b4", lw=0.8, label="estimate")
@@ -270,7 +266,7 @@ def fig_error_distance(scenario: Scenario, rows: pd.DataFrame, path: Path) -> Pa
     ax = fig.subplots()
     for m in ms:
         g = rows[rows["matcher"] == m]
-        t, e = _poses(g, "true"), _poses(g, "est")
+        t, e = pose_columns(g, "true"), pose_columns(g, "est")
         ok = np.isfinite(t).all(axis=1)
         if ok.sum() < 2:
             continue
