@@ -15,6 +15,7 @@ from shapely.geometry import Point, box
 
 from tfloc import Pose, VectorMap
 from tfloc.core.laser import LaserSpec
+from tfloc.core.presets import resolve
 from tfloc.harness.config import load_config
 from tfloc.harness.task import load_dataset, problem_of
 from tfloc.maps.build import rasterize
@@ -55,7 +56,8 @@ def test_the_default_configuration_has_every_changed_world_term_off() -> None:
                                  "dev/changed-world-heldout.toml", "dev/changed-world-guard.toml"])
 def test_run_configurations_name_the_configuration_as_it_is(run: str) -> None:
     spec = next(m for m in load_config(ROOT / "benchmarks" / run).matchers if m.label == "tf-plus-changed")
-    assert spec.name == "tf-plus" and dict(spec.params) == CHANGED_WORLD
+    assert spec.name == "tf-plus-changed" and not spec.params  # the preset, by its name
+    assert resolve(spec.name, {}) == ("tf-plus", CHANGED_WORLD)
 
 
 def test_free_space_caps_the_coarse_field_there_only() -> None:

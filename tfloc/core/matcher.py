@@ -26,6 +26,7 @@ from typing import Any, Protocol, runtime_checkable
 from tfloc.errors import InvalidProblemError, LibraryMissingError, MatcherError, ParameterError
 
 from .pose import Pose
+from .presets import presets, resolve
 from .problem import Estimate, Problem
 
 GROUP = "tfloc.matchers"
@@ -90,24 +91,93 @@ def _factory(name: str, target: str, registered: bool) -> Any:
         raise MatcherError(f"matcher {name!r}: cannot import it ({exc})") from None
 
 
+def close_names(name: str, names: list[str], n: int = 3) -> list[str]:
+    """The names of ``names`` closest to ``name`` (a misspelling's "did you mean")."""
+    import difflib
+
+    return difflib.get_close_matches(name, names, n=n, cutoff=0.6)
+
+
+def unknown_matcher(name: str) -> str:
+    """One line for an unknown matcher name: the closest registered names or presets."""
+    known = sorted({*_registry(), *presets()})
+    close = close_names(name, known)
+    hint = f"did you mean {' or '.join(repr(c) for c in close)}? " if close else ""
+    return f"unknown matcher {name!r}; {hint}(tfloc matchers lists them: {', '.join(known)})"
+
+
 def get_matcher(name: str, **params: Any) -> Matcher:
-    """Instantiate the registered matcher ``name`` (or the class ``module:Class``: its module is
-    imported, so its code runs; the command line allows that only with ``--allow-import``) with
-    configuration overrides ``params``.
+    """Instantiate the registered matcher ``name`` (a preset or a label ``base[key=value,...]``
+    stands for its matcher and parameters, :mod:`tfloc.core.presets`; ``module:Class`` imports
+    that module, so its code runs; the command line allows that only with ``--allow-import``)
+    with configuration overrides ``params``.
 
     Raises :class:`MatcherError` for an unknown name or a missing optional library, and its
     subclass :class:`ParameterError` for an unknown parameter or a bad value.
     """
+    given = name
+    name, params = resolve(name, params)
     if ":" in name:
         factory = _factory(name, name, registered=False)
     else:
         reg = _registry()
         if name not in reg:
-            raise MatcherError(f"unknown matcher {name!r}; registered: {', '.join(sorted(reg))}")
+            raise MatcherError(unknown_matcher(given if name == given else name))
         factory = _factory(name, reg[name], registered=True)
+    name = given
     try:
         return factory(**params)
     except ParameterError as exc:
         raise ParameterError(f"matcher {name!r}: {exc}", exc.names) from None
-    except TypeError as exc:  # a third-party factory that rejects a keyword the Python way
-        raise ParameterError(f"matcher {name!r}: bad parameters {params}: {exc}") from None
+    except (TypeError, ValueError) as exc:  # a third-party factory that rejects a value the Python way
+        raise ParameterError(f"matcher {name!r}: bad parameters {params}: {type(exc).__name__}: {exc}") from None
+
+
+#: what a matcher solves: one scan from a guess, a sequence (a tracker: start/step, no single-scan
+#: mode), or one scan without a guess (a global matcher also answers a scan with a guess)
+SINGLE_SCAN, TRACKER, GLOBAL = "single-scan", "tracker", "global"
+
+
+def kind_of(obj: object) -> str:
+    """:data:`SINGLE_SCAN`, :data:`TRACKER` or :data:`GLOBAL` for a matcher, or for its class
+    (a class may declare its ``kind``: ``odometry`` answers a single scan with its guess, but is
+    meant for sequences)."""
+    declared = getattr(obj, "kind", None)
+    if declared in (SINGLE_SCAN, TRACKER, GLOBAL):
+        return declared
+    if solves_global(obj):
+        return GLOBAL
+    if callable(getattr(obj, "start", None)) and callable(getattr(obj, "step", None)):
+        return TRACKER
+    return SINGLE_SCAN
+
+
+def factory_of(name: str) -> Any:
+    """The class (or factory) behind a registered name or preset, imported but not built (raises
+    :class:`MatcherError` for an unknown name, :class:`LibraryMissingError` for a missing library)."""
+    base, _ = resolve(name, {})
+    if ":" in base:
+        return _factory(base, base, registered=False)
+    reg = _registry()
+    if base not in reg:
+        raise MatcherError(unknown_matcher(name))
+    return _factory(base, reg[base], registered=True)
+
+
+def default_matchers(modes: set[str]) -> list[str]:
+    """The registered matchers that solve datasets of ``modes`` (:data:`tfloc.io.scenario.MODES`:
+    ``single`` and ``scan-to-scan`` take single-scan matchers, ``sequence`` trackers and
+    single-scan matchers, ``global`` global matchers); a matcher whose library is missing is
+    listed (the run leaves it out with one line)."""
+    want: set[str] = set()
+    for mode in modes:
+        want |= {"global": {GLOBAL}, "sequence": {TRACKER, SINGLE_SCAN}}.get(mode, {SINGLE_SCAN})
+    out = []
+    for name in available_matchers():
+        try:
+            kind = kind_of(factory_of(name))
+        except LibraryMissingError:
+            kind = SINGLE_SCAN
+        if kind in want:
+            out.append(name)
+    return out

@@ -155,6 +155,7 @@ class DeadReckoning(Configured):
 
     CONFIG = NoParameters
     name = "odometry"
+    kind = "tracker"  # (core.matcher.TRACKER: meant for sequences)
 
     def localize(self, problem: Problem) -> Estimate:
         return Estimate(problem.initial, True)

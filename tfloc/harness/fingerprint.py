@@ -6,9 +6,10 @@ line naming the configuration key (``x.toml: [params.csm-corr] search_radiuss: �
 
 :func:`fingerprint` is everything that decides a run's rows: a content hash (SHA-256) of each
 dataset's ``scans.csv``, ``scenario.json`` and map file(s), each matcher label with its *resolved*
-parameters (defaults included, so a changed default shows), the success thresholds and the tfloc
-version. ``run.json`` records it; a run directory is resumed only by a run with the same
-fingerprint (:func:`differences` says what changed). ``jobs``, ``timeout_s`` and
+parameters (defaults included, so a changed default shows), the success thresholds and the code
+that answers (:mod:`tfloc.harness.identity`: tfloc's answering source, and each plugin matcher's
+distribution, version and source). ``run.json`` records it; a run directory is resumed only by a
+run with the same fingerprint (:func:`differences` says what changed). ``jobs``, ``timeout_s`` and
 ``limit_per_group`` are not in it: they decide how many tasks run and how fast, not what a
 finished row holds (timed-out rows can be run again with ``--retry-errors``).
 """
@@ -18,15 +19,17 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
-from importlib import metadata
 from pathlib import Path
 from typing import Any
 
+from tfloc.core.matcher import factory_of
+from tfloc.core.presets import resolve
 from tfloc.errors import ConfigError, LibraryMissingError, MatcherError, ParameterError
 from tfloc.io.maps import map_files
 from tfloc.io.scenario import read_scenario
 
 from .config import MatcherSpec, RunConfig
+from .identity import matcher_code, tfloc_code
 from .workspace import load_matcher
 
 
@@ -51,8 +54,14 @@ def build_matcher(spec: MatcherSpec) -> dict[str, Any]:
 
 
 def build_matchers(config: RunConfig) -> dict[str, dict[str, Any]]:
-    """Every matcher of the run built once: label → resolved parameters."""
-    return {m.label: {"name": m.name, "params": build_matcher(m)} for m in config.matchers}
+    """Every matcher of the run built once: label → name, the registered matcher it stands for
+    (a preset's or a label's), resolved parameters and the code that answers."""
+    out = {}
+    for m in config.matchers:
+        params = build_matcher(m)
+        out[m.label] = {"name": m.name, "matcher": resolve(m.name, {})[0], "params": params,
+                        **matcher_code(factory_of(m.name))}
+    return out
 
 
 def available(config: RunConfig, log=None) -> RunConfig:
@@ -95,18 +104,29 @@ def dataset_hashes(path: Path) -> dict[str, Any]:
     return out
 
 
-def tfloc_version() -> str | None:
-    try:
-        return metadata.version("tfloc")
-    except metadata.PackageNotFoundError:
-        return None
-
-
 def fingerprint(config: RunConfig, matchers: dict[str, dict[str, Any]]) -> dict[str, Any]:
     """What decides the rows of a run (see the module notes); JSON-serialisable."""
-    return {"tfloc": tfloc_version(),
+    return {"tfloc": tfloc_code(),
             "datasets": {read_scenario(d).name: dataset_hashes(d) for d in config.datasets},
             "matchers": matchers, "success": config.success.to_dict()}
+
+
+_CODE = ("code", "module", "distribution", "version", "source")
+
+
+def _code_changes(label: str, a: dict, b: dict) -> list[str]:
+    """What changed in the code behind one matcher label (its plugin's version or source)."""
+    if a.get("code") == b.get("code") == "tfloc" or all(a.get(f) == b.get(f) for f in _CODE):
+        return []
+    if a.get("code") != b.get("code") or a.get("module") != b.get("module"):
+        return [f"{label}: now answered by {b.get('module') or 'tfloc'} (was {a.get('module') or a.get('code') or 'unknown code'})"]
+    out = []
+    if a.get("version") != b.get("version") or a.get("distribution") != b.get("distribution"):
+        out.append(f"{label}: {a.get('distribution') or '(no distribution)'} {_show(a.get('version'))} → "
+                   f"{b.get('distribution') or '(no distribution)'} {_show(b.get('version'))}")
+    if a.get("source") != b.get("source"):
+        out.append(f"{label}: source changed")
+    return out
 
 
 def _flat(d: Any, prefix: str = "") -> dict[str, Any]:
@@ -128,14 +148,24 @@ def differences(old: dict | None, new: dict) -> list[str]:
     if not isinstance(old, dict):
         return ["the run records no fingerprint (made by an older tfloc, or run.json is missing)"]
     out = []
-    if old.get("tfloc") != new["tfloc"]:
-        out.append(f"tfloc {_show(old.get('tfloc'))} → {_show(new['tfloc'])}")
+    was, now = old.get("tfloc"), new["tfloc"]
+    if not isinstance(was, dict):
+        out.append(f"the run was made by tfloc {_show(was)}, which recorded no code identity")
+    elif was.get("source") != now["source"]:
+        out.append(f"tfloc's code changed (source {str(was.get('source'))[:12]} → {now['source'][:12]})")
+    elif was.get("version") != now["version"]:
+        out.append(f"tfloc {_show(was.get('version'))} → {_show(now['version'])}")
     for what, key in (("dataset", "datasets"), ("matcher", "matchers")):
         a, b = old.get(key) or {}, new[key]
         out += [f"{what} {k} added" for k in b if k not in a]
         out += [f"{what} {k} removed" for k in a if k not in b]
         for k in (k for k in b if k in a and a[k] != b[k]):
-            fa, fb = _flat(a[k]), _flat(b[k])
+            if what == "matcher":
+                out += _code_changes(k, a[k], b[k])
+                a_k, b_k = ({f: v for f, v in x.items() if f not in _CODE} for x in (a[k], b[k]))
+                if a_k == b_k:
+                    continue
+            fa, fb = (_flat(a[k]), _flat(b[k])) if what == "dataset" else (_flat(a_k), _flat(b_k))
             changed = [f for f in dict.fromkeys([*fb, *fa]) if fa.get(f) != fb.get(f)]
             if what == "dataset":
                 out.append(f"dataset {k}: {', '.join(c.removeprefix('map:') for c in changed)} changed")

@@ -17,7 +17,6 @@ from __future__ import annotations
 import multiprocessing
 import os
 import platform
-import subprocess
 import sys
 from collections.abc import Callable
 from concurrent.futures import TimeoutError as FutureTimeout
@@ -36,6 +35,7 @@ from tfloc.io.scenario import SEQUENCE, iter_scans, read_scans, read_scenario
 
 from .config import RunConfig
 from .fingerprint import available, build_matchers, differences, fingerprint
+from .identity import git_state
 from .task import Task, failure_row, run_task, warm_up
 from .threads import limit_threads
 from .workspace import load_matcher
@@ -94,18 +94,6 @@ def load_average() -> list[float] | None:
         return [round(x, 2) for x in os.getloadavg()]
     except (AttributeError, OSError):
         return None
-
-
-def git_state() -> dict:
-    """``{"commit", "dirty"}`` of the working tree (``None`` each where git cannot say)."""
-    try:
-        commit = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
-                                timeout=10).stdout.strip() or None
-        dirty = bool(subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
-                                    capture_output=True, text=True, timeout=10).stdout.strip())
-    except (OSError, subprocess.SubprocessError):
-        commit, dirty = None, None
-    return {"commit": commit, "dirty": dirty}
 
 
 def environment() -> dict:
@@ -236,7 +224,11 @@ def run(config: RunConfig, progress: bool | None = None, executor: Executor = ex
     rd.make()
     rd.start_session(session_doc(config, fp), len(tasks), len(tasks) - len(todo), load_average())
     if not todo:
+        log(f"{rd.path}: already complete: 0 tasks run (--regenerate runs it again)")
         return rd.path
+    if done:
+        log(f"{rd.path}: resuming: {len(tasks) - len(todo)} of {len(tasks)} tasks done by the same code "
+            "and configuration")
     bar = tqdm(total=len(tasks), initial=len(tasks) - len(todo), unit="task", desc=config.name,
                disable=None if progress is None else not progress, smoothing=0.05, mininterval=1.0)
     failures = 0

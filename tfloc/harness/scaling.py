@@ -70,7 +70,8 @@ from tfloc.maps.grid import GridMap
 from tfloc.maps.vector import VectorMap
 
 from .config import MatcherSpec
-from .fingerprint import build_matcher, differences, tfloc_version
+from .fingerprint import build_matcher, differences
+from .identity import tfloc_code
 from .runner import environment, load_average
 from .timing import pinned, rotated
 from .workspace import status_of, timed, timed_localize, warm
@@ -364,7 +365,7 @@ def study_fingerprint(cfg: StudyConfig, matchers: Sequence[str]) -> dict[str, An
     matcher with its resolved parameters (:func:`tfloc.harness.fingerprint.build_matcher`), the
     success thresholds and the configuration; JSON-normalised."""
     path = Path(cfg.map_path)
-    fp = {"tfloc": tfloc_version(), "datasets": {"map": {path.name: _sha256(path)}},
+    fp = {"tfloc": tfloc_code(), "datasets": {"map": {path.name: _sha256(path)}},
           "matchers": {n: {"name": n, "params": build_matcher(MatcherSpec.make(n))} for n in matchers},
           "success": THRESHOLDS.to_dict(), "study": asdict(cfg)}
     return json.loads(json.dumps(fp, default=str))

@@ -40,7 +40,8 @@ import pandas as pd
 from tfloc.errors import ConfigError
 from tfloc.io.rundir import RunDir, RunInfo
 
-from .runner import git_state, load_average
+from .identity import git_state
+from .runner import load_average
 from .threads import limit_threads
 from .workspace import load_dataset, load_matcher, problem_of, timed_localize, warm
 

@@ -12,6 +12,7 @@ from typing import ClassVar
 import numpy as np
 
 from tfloc.core.map import Map
+from tfloc.core.presets import preset_params
 from tfloc.paper.shape import ShapeConfig
 
 from .refine import RefineConfig
@@ -119,15 +120,11 @@ class TfPlusConfig:
     shape: ShapeConfig = ShapeConfig(spacing=0.05)
 
 
-#: ``tf-plus``'s changed-world configuration (``docs/robustness.md``): overrides of
-#: :class:`TfPlusConfig` for a world that has changed since it was mapped (people, carts, doors,
-#: furniture moved or gone). Chosen on the development split of the ``changed-clutter-*`` and
-#: ``changed-furniture-gone`` scans (``benchmarks/dev/changed-world.toml``); not the default: on
-#: the paper protocol it gives the same success, on the real recordings it can lose (ACES) and it costs more CPU.
-#: ``TurningFunctionPlusMatcher(**CHANGED_WORLD)``; in a run configuration, the same as ``params``.
-CHANGED_WORLD = {"refine_to": "field", "free_distance": 0.05, "short_margin": 0.3,
-                 "short_residual": 0.05, "object_extent": 1.0, "short_refine": True,
-                 "see_through_share": 0.05, "shortlist": 128, "candidates": 6}
+#: ``tf-plus``'s changed-world configuration, the preset ``tf-plus-changed`` (``tfloc/presets.toml``,
+#: ``docs/robustness.md``): overrides of :class:`TfPlusConfig` for a world that has changed since it
+#: was mapped (people, carts, doors, furniture moved or gone). Not the default: on the paper
+#: protocol it gives the same success, on the real recordings it can lose (ACES) and it costs more CPU.
+CHANGED_WORLD = preset_params("tf-plus-changed")
 
 
 def field_view(map_: Map, cfg: TfPlusConfig) -> MapView:
