@@ -6,8 +6,9 @@ callee as it was when it was compiled: after an edit of ``maps/_raycast.py`` the
 of ``tfplus/`` and ``paper/`` went on casting rays the old way (so measurements compared old
 code with old code), and a cached caller of a changed callee can crash. So, unless the user
 chose a directory (``NUMBA_CACHE_DIR``), the cache lives in
-``$XDG_CACHE_HOME/tfloc/numba/<hash of every tfloc module's source>`` (``~/.cache`` when unset): any change of the source
-starts a fresh cache, and each version's cache stays valid. The last few versions are kept.
+``$XDG_CACHE_HOME/tfloc/numba/<hash of tfloc's source>`` (``~/.cache`` when unset): any change of
+the source starts a fresh cache, and each version's cache stays valid (the presentation layers,
+:data:`PRESENTATION`, hold no kernel and feed none: they are left out). The last few are kept.
 
 The directory is also put in the environment (``NUMBA_CACHE_DIR``). numba reads its settings from
 the environment again whenever the environment has changed (``numba.core.config.reload_config``,
@@ -28,14 +29,20 @@ import shutil
 from pathlib import Path
 
 KEEP = 4  # cache directories of other source versions kept (most recently used)
+#: top-level folders of the package that draw results and parse commands: no kernel, no constant
+#: a kernel reads (also left out of a run's code identity, :mod:`tfloc.harness.identity`)
+PRESENTATION = ("report", "cli", "site")
 _MARK = "TFLOC_NUMBA_CACHE_DIR"  # NUMBA_CACHE_DIR as tfloc set it (not the user's choice)
 
 
-def source_hash(roots: list[Path]) -> str:
-    """A hash of every ``.py`` file under the ``roots``: names and contents."""
+def source_hash(roots: list[Path], leave_out: tuple[str, ...] = ()) -> str:
+    """A hash of every ``.py`` file under the ``roots`` (but those in a top-level folder named in
+    ``leave_out``): names and contents."""
     h = hashlib.sha1()
     for root in roots:
         for path in sorted(root.rglob("*.py")):
+            if path.relative_to(root).parts[0] in leave_out:
+                continue
             h.update(path.relative_to(root).as_posix().encode())
             h.update(b"\0")
             h.update(path.read_bytes())
@@ -68,7 +75,7 @@ def configure() -> str | None:
     if (chosen and not ours) or (not chosen and numba.config.CACHE_DIR):
         return None
     base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "tfloc" / "numba"
-    here = base / source_hash(_roots())
+    here = base / source_hash(_roots(), PRESENTATION)
     try:
         here.mkdir(parents=True, exist_ok=True)
         os.utime(here)

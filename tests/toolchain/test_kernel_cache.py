@@ -21,13 +21,17 @@ def test_the_source_hash_follows_every_file(tmp_path: Path) -> None:
     assert _kernel_cache.source_hash([tmp_path]) == first
     (tmp_path / "sub" / "b.py").write_text("y = 3\n")           # a callee's module changes
     assert _kernel_cache.source_hash([tmp_path]) != first
+    kept = _kernel_cache.source_hash([tmp_path], ("report",))
+    (tmp_path / "report").mkdir()
+    (tmp_path / "report" / "c.py").write_text("z = 1\n")       # a presentation layer: no kernel
+    assert _kernel_cache.source_hash([tmp_path], ("report",)) == kept
 
 
 def test_this_process_caches_under_its_source_version() -> None:
     here = Path(numba.config.CACHE_DIR)
     if os.environ.get("NUMBA_CACHE_DIR") != os.environ.get("TFLOC_NUMBA_CACHE_DIR"):
         pytest.skip("the user chose numba's cache directory")
-    assert here.name == _kernel_cache.source_hash(_kernel_cache._roots())
+    assert here.name == _kernel_cache.source_hash(_kernel_cache._roots(), _kernel_cache.PRESENTATION)
     assert here.parent.name == "numba" and here.parent.parent.name == "tfloc"
 
 
@@ -68,7 +72,7 @@ def test_kernels_imported_after_a_thread_limit_still_cache_under_the_source_vers
             "print(k.function1_kernel._cache._cache_path)\n")
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
                          check=True).stdout.split()
-    here = tmp_path / "tfloc" / "numba" / _kernel_cache.source_hash(_kernel_cache._roots())
+    here = tmp_path / "tfloc" / "numba" / _kernel_cache.source_hash(_kernel_cache._roots(), _kernel_cache.PRESENTATION)
     assert Path(out[0]) == here
     assert Path(out[1]).parent == here
 

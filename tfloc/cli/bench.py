@@ -20,11 +20,11 @@ Run only configurations you trust; such matchers are refused without --allow-imp
 
 Examples:
   tfloc bench benchmarks/paper-protocol.toml
-  tfloc bench benchmarks/paper-protocol.toml --quick        # → results/paper-protocol-quick
-  tfloc bench data/scenarios/detail-1 --matchers tf,csm-corr --out results/try --jobs 2
-  tfloc bench benchmarks/paper-protocol.toml --scheduler local:2           # a local Dask cluster
-  tfloc bench benchmarks/paper-protocol.toml --scheduler tls://HOST:8786 \
-      --tls-ca-file ca.pem --tls-cert client.pem --tls-key client.key      # a Dask cluster over TLS
+  tfloc bench benchmarks/paper-protocol.toml --quick   # → results/paper-protocol-quick
+  tfloc bench data/scenarios/detail-1 --matchers tf,csm-corr --out results/try
+  tfloc bench benchmarks/paper-protocol.toml --scheduler local:2   # a local Dask cluster
+  tfloc bench benchmarks/paper-protocol.toml --scheduler tls://HOST:8786 \\
+      --tls-ca-file ca.pem --tls-cert client.pem --tls-key client.key   # a Dask cluster over TLS
 """
 
 from __future__ import annotations
@@ -34,10 +34,11 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from tfloc.core.matcher import available_matchers
+from tfloc.core.matcher import default_matchers
 from tfloc.core.thresholds import Thresholds
 from tfloc.errors import ConfigError
 from tfloc.harness.config import RunConfig, check_imports, load_config, parse_matchers
+from tfloc.io.scenario import read_scenario
 
 from ._options import add_progress
 
@@ -48,8 +49,10 @@ QUICK_PER_GROUP = 3
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("inputs", nargs="+", metavar="CONFIG.toml | DATASET_DIR",
                    help="a run configuration, or one or more scenario dataset directories")
-    p.add_argument("--matchers", help="comma-separated matcher names (default with datasets: all "
-                   f"registered: {','.join(available_matchers())})")
+    p.add_argument("--matchers", help="comma-separated matcher names or presets (default with datasets: "
+                   "every registered matcher that solves their mode: the single-scan matchers on a "
+                   "single-scan dataset, trackers and single-scan matchers on a sequence, the global "
+                   "matchers on a global set; 'tfloc matchers' lists them)")
     p.add_argument("--datasets", metavar="NAMES",
                    help="with a run configuration: only its datasets of these directory names "
                         "(comma-separated; a fixed subsample, e.g. make bench's native run)")
@@ -112,7 +115,8 @@ def config_from_args(args: argparse.Namespace) -> RunConfig:
     elif args.datasets:
         raise ConfigError("--datasets selects datasets of a run configuration; give dataset directories directly")
     else:
-        names = args.matchers.split(",") if args.matchers else available_matchers()
+        names = args.matchers.split(",") if args.matchers else default_matchers(
+            {read_scenario(d).mode for d in args.inputs})
         name = args.name or "run"
         cfg = RunConfig(name=name, out=args.out or Path("results") / name,
                         datasets=tuple(Path(d) for d in args.inputs),

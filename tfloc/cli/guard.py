@@ -6,8 +6,8 @@ Exits 1 and prints a table of every metric that got worse than its tolerance all
 reference deliberately and prints what changed.
 
 Examples:
-  tfloc guard              # check
-  tfloc guard --update     # accept the current results as the new reference
+  tfloc guard   # check
+  tfloc guard --update   # accept the current results as the new reference
 """
 
 from __future__ import annotations

@@ -13,7 +13,7 @@ robot starting at the reference pose of the first scan.
 Example:
   tfloc import-bag run1.bag --scan-topic /scan --pose-topic /ground_truth \\
       --map map.yaml --out data/scenarios/run1
-  tfloc import-bag run1.bag --scan-topic /scan --pose-topic /ground_truth --odom-topic /odom \
+  tfloc import-bag run1.bag --scan-topic /scan --pose-topic /ground_truth --odom-topic /odom \\
       --map map.yaml --out data/scenarios/run1-sequence
 """
 

@@ -22,8 +22,8 @@ complete study it only redraws the tables, figure and README. A directory holdin
 another configuration is refused (exit 2): give --regenerate to start it over, or another --out.
 
 Examples:
-  tfloc scaling --out results/scaling                    # the full study (make scaling)
-  tfloc scaling --quick --out results/scaling-quick      # 9 scans per level (make scaling-quick)
+  tfloc scaling --out results/scaling   # the full study (make scaling)
+  tfloc scaling --quick --out results/scaling-quick   # 9 scans per level (make scaling-quick)
   tfloc scaling --quick --out /tmp/s --matchers tf-plus,o3d-icp --axes area --areas 300,5000
 """
 

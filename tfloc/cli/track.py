@@ -9,6 +9,8 @@ each step (this process, every library on one thread). With --matcher odometry t
 the prediction alone (dead reckoning).
 
 Output (--out): scan_id, est_x, est_y, est_theta, status, cpu_s; one row per scan, in order.
+Where the dataset has truth, a last line scores the track: the tracked share of the scans with
+truth (within 10 cm and 2 deg), APE, losses, jumps > 1 m and the median CPU per step.
 
 --draw-at SCAN_ID (or first-loss: the first scan with truth whose estimate is more than 0.5 m or
 10 deg off) looks at the tracker right after that scan's step: --figure PATH draws the map around
@@ -19,7 +21,7 @@ metre off, the spread the motion model added). Drawing and summary: tfloc/report
 
 Example:
   tfloc track --dataset data/scenarios/seq-quick --matcher tf-plus --out est.csv
-  tfloc track --dataset data/scenarios/real-csail-native --matcher amcl --draw-at first-loss \
+  tfloc track --dataset data/scenarios/real-csail-native --matcher amcl --draw-at first-loss \\
       --figure loss.png --explain
 """
 
@@ -32,10 +34,12 @@ from pathlib import Path
 
 from tqdm import tqdm
 
+from tfloc.core.thresholds import Thresholds
 from tfloc.errors import ConfigError, ResultsError
 
 HELP = "track a sequence dataset with one matcher (guess = last estimate ⊕ odometry)"
 COLUMNS = ["scan_id", "est_x", "est_y", "est_theta", "status", "cpu_s"]
+DEFAULT_THRESHOLDS = Thresholds()
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -86,7 +90,24 @@ def run(args: argparse.Namespace) -> int:
         counts[kind] = counts.get(kind, 0) + 1
     print(f"wrote {args.out}: {len(rows)} scans; " + ", ".join(f"{k} {v}" for k, v in counts.items()),
           file=sys.stderr)
+    line = score_line(rows)
+    if line:
+        print(line, file=sys.stderr)
     return 3 if counts.get("error") else 0
+
+
+def score_line(rows: list[dict]) -> str:
+    """One line scoring the track where the dataset has truth: tracked share of the truth-bearing
+    scans, APE, losses and jumps > 1 m, median CPU per step (empty without truth)."""
+    from tfloc.evaluation.trajectory import JUMP_M, score_rows
+
+    s = score_rows(rows)
+    if s.n_truth == 0:
+        return ""
+    return (f"score: tracked {100 * s.tracked:.1f} % of {s.n_truth} scans with truth "
+            f"({s.n_tracked} within {100 * DEFAULT_THRESHOLDS.dist_m:g} cm and {DEFAULT_THRESHOLDS.orient_deg:g}°); "
+            f"APE RMSE {100 * s.ape_rmse_m:.1f} cm; losses {s.losses} ({s.unrecovered} unrecovered); "
+            f"jumps > {JUMP_M:g} m {s.jumps}; CPU {s.cpu_ms_median:.2f} ms per step (median)")
 
 
 def check_draw_options(args: argparse.Namespace) -> None:

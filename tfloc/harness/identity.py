@@ -23,8 +23,7 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
-#: the parts of the package that draw rows instead of making them (their changes keep a run)
-PRESENTATION = ("report", "cli", "site")
+from tfloc._kernel_cache import PRESENTATION  # the parts that draw rows, not make them
 
 
 def _hash_files(files: dict[str, Path]) -> str:

@@ -101,12 +101,29 @@ def paper_scenarios_of(extra: dict, where: str = "scenario.json") -> tuple[str, 
     return tuple(got)
 
 
+def missing_dataset(root: Path) -> str:
+    """One line for a dataset directory that is not one: no such directory (with the closest
+    names beside it), or a directory without ``scenario.json``."""
+    import difflib
+
+    if root.is_dir():
+        return f"{root}: not a scenario dataset (no scenario.json)"
+    parent = root.parent if str(root.parent) else Path(".")
+    try:
+        names = [p.name for p in parent.iterdir() if (p / "scenario.json").is_file()] if parent.is_dir() else []
+    except OSError:
+        names = []
+    close = difflib.get_close_matches(root.name, names, n=3, cutoff=0.6)
+    hint = f"; did you mean {' or '.join(str(parent / c) for c in close)}?" if close else ""
+    return f"{root}: no such directory{hint}"
+
+
 def read_scenario(root: str | Path) -> Scenario:
     """Read and validate ``root/scenario.json``."""
     root = Path(root)
     path = root / "scenario.json"
     if not path.is_file():
-        raise DatasetError(f"{root}: not a scenario dataset (no scenario.json)")
+        raise DatasetError(missing_dataset(root))
     doc = parse_text(path, DatasetError, "scenario.json", json.loads, json.JSONDecodeError, "JSON")
     if not isinstance(doc, dict):
         raise DatasetError(f"{path}: expected a JSON object of scenario fields")
