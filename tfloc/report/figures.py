@@ -184,13 +184,15 @@ def fig_cdf(p: pd.DataFrame, path: Path, thr: Thresholds) -> Path | None:
 
 
 def fig_runtime(p: pd.DataFrame, path: Path) -> Path | None:
-    """CPU time per scan (ms, log scale), one box per matcher (wall time for runs without CPU time)."""
+    """CPU time per scan (ms, log scale), one box per matcher, fastest first (wall time for runs
+    without CPU time)."""
     metric = "cpu_ms" if "cpu_ms" in p and p["cpu_ms"].notna().any() else "runtime_ms"
     kind = "CPU time" if metric == "cpu_ms" else "wall time (this run has no CPU times)"
     t = p[p[metric].notna()]
     if t.empty:
         return None
-    matchers = sorted(t["matcher"].unique())
+    medians = t.groupby("matcher")[metric].median()
+    matchers = sorted(medians.index, key=lambda m: (medians[m], m))  # fastest first
     col = colours(list(p["matcher"].unique()))
     wide = len(matchers) > MANY_MATCHERS  # a sweep: one row per label, names on the y axis
     size = (9.0, 0.25 * len(matchers) + 1.5) if wide else (max(5.0, 1.3 * len(matchers) + 2), 4.4)
@@ -221,7 +223,8 @@ def fig_runtime(p: pd.DataFrame, path: Path) -> Path | None:
 
 
 def fig_outcomes(p: pd.DataFrame, path: Path, scan_to_scan: set[str] = frozenset()) -> Path | None:
-    """Outcome shares per matcher: overall, and per initial distance bin (scan-to-map datasets)."""
+    """Outcome shares per matcher, most successful first: overall, and per initial distance bin
+    (scan-to-map datasets)."""
     t = p[p["truth"]]
     if t.empty:
         return None
@@ -231,7 +234,8 @@ def fig_outcomes(p: pd.DataFrame, path: Path, scan_to_scan: set[str] = frozenset
         g = s2m[s2m["dist_bin"] == b]
         if len(g):
             panels.append((f"initial offset {b} cm", g))
-    matchers = sorted(t["matcher"].unique())
+    share = (t["outcome_eval"] == "success").groupby(t["matcher"]).mean()
+    matchers = sorted(share.index, key=lambda m: (-share[m], m))  # most successful first
     wide = len(matchers) > MANY_MATCHERS  # a sweep: horizontal bars, one row per label
     size = ((3.0 * len(panels) + 5.0, 0.22 * len(matchers) + 2.0) if wide
             else (max(8.0, 0.55 * len(matchers) * len(panels) + 2), 4.6))

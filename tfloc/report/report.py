@@ -36,6 +36,7 @@ from . import figures as F
 from . import sections as S
 from .failures import draw_failures, failures_section
 from .figures import MANY_MATCHERS
+from .headline import headline_section
 from .landscape import draw_landscapes, landscape_section
 from .mdtable import num
 
@@ -75,6 +76,7 @@ def header(run_dir: Path, run: dict, df: pd.DataFrame, thr: Thresholds, s2s: set
              f"- Run started: {sessions[0].get('started', 'unknown') if sessions else 'unknown'}"
              + (f" ({len(sessions)} sessions, resumed)" if len(sessions) > 1 else ""),
              f"- Commit: `{commit}`",
+             code_note(run),
              f"- Machine: {mach.get('platform', '?')}, {mach.get('cpu_count', '?')} CPUs, Python "
              f"{mach.get('python', '?')}; {cfg.get('jobs', '?')} worker(s) of one thread each; "
              f"time limit {cfg.get('timeout_s', '?')} s per scan",
@@ -104,6 +106,19 @@ def header(run_dir: Path, run: dict, df: pd.DataFrame, thr: Thresholds, s2s: set
                      + (f"; at the end: {end[0]:.2f}" if end else "") + f" ({mach.get('cpu_count', '?')} CPUs)")
     lines += contention(df)
     return "\n".join(lines) + "\n"
+
+
+def code_note(run: dict) -> str:
+    """The code that made the rows (its source hash, :mod:`tfloc.harness.identity`) and whether it
+    is this checkout's."""
+    from tfloc.harness.identity import tfloc_code
+
+    made = ((run.get("fingerprint") or {}).get("tfloc") or {})
+    if not isinstance(made, dict) or not made.get("source"):
+        return "- Code: not recorded (a run made before code identity was recorded)"
+    same = made["source"] == tfloc_code()["source"]
+    return (f"- Code: tfloc's answering source `{made['source'][:12]}`, "
+            + ("the same as this checkout's" if same else "**not this checkout's** (made by other code)"))
 
 
 def lock_note(run: dict) -> list[str]:
@@ -230,12 +245,13 @@ def _paired_section(pt: pd.DataFrame, sweep: bool) -> list[str]:
 
 def render(run_dir: Path, run: dict, p: pd.DataFrame, thr: Thresholds, s2s: set[str],
            figs: list[Path], pt: pd.DataFrame | None = None, failures: str = "", landscape: str = "",
-           line_labels: list[str] | None = None, sweep: bool = False, paper: dict | None = None) -> str:
+           line_labels: list[str] | None = None, sweep: bool = False, paper: dict | None = None,
+           headline: str = "") -> str:
     """The whole report.md text (``sweep``: a parameter sweep, see :data:`MANY_MATCHERS`;
     ``line_labels``: the labels its line figures show; ``paper``: dataset → the paper scenarios
-    it declares)."""
+    it declares; ``headline``: the opening section, :mod:`tfloc.report.headline`)."""
     paper = paper or {}
-    parts = [header(run_dir, run, p, thr, s2s), definitions(thr, paper)]
+    parts = [header(run_dir, run, p, thr, s2s), headline, definitions(thr, paper)]
     truth = p[p["truth"]]
     sc = scenario_summary(truth, paper)
     if not truth.empty and len(sc):
@@ -342,13 +358,14 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
     thr = thresholds or info.thresholds
     names = list(df["dataset"].unique())
     seq, glob = info.datasets_in(names, SEQUENCE), info.datasets_in(names, GLOBAL)
+    top = headline_section(prepare(df, thr), {n: info.mode(n) for n in names}, thr, run_dir)
     tracking = _tracking(run_dir, df[df["dataset"].isin(seq)], info, thr, with_figures) if seq else ""
     if glob:
         tracking = _relocalization(run_dir, df[df["dataset"].isin(glob)], info, thr) + "\n" + tracking
     if df["dataset"].isin(seq | glob).all():
         p = prepare(df, thr)
         report = run_dir / "report.md"
-        report.write_text("\n".join([header(run_dir, run, p, thr, set()), tracking]))
+        report.write_text("\n".join([header(run_dir, run, p, thr, set()), top, tracking]))
         return ReportFiles(report, run_dir / ("tracking.csv" if seq else "relocalization.csv"), ())
     p = prepare(df[~df["dataset"].isin(seq | glob)], thr)
     s2s = info.datasets_in(list(p["dataset"].unique()), SCAN_TO_SCAN)
@@ -374,6 +391,6 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
         binned = sorted(set(declaring(paper, "II")) | set(declaring(paper, "III")))
         landscape = landscape_section(*draw_landscapes(run_dir, p, info.datasets, binned))
     report = run_dir / "report.md"
-    text = render(run_dir, run, p, thr, s2s, figs, pt, failures, landscape, line_labels, sweep, paper)
+    text = render(run_dir, run, p, thr, s2s, figs, pt, failures, landscape, line_labels, sweep, paper, top)
     report.write_text(text + ("\n" + tracking if tracking else ""))
     return ReportFiles(report, summary, tuple(figs))

@@ -27,27 +27,23 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from matplotlib.figure import Figure
 
 from tfloc.core.thresholds import Thresholds
-from tfloc.core.tracker import DeadReckoning
 from tfloc.evaluation.global_start import SETTLE_M, SETTLE_SCANS, score_start, starts_without_pose
 from tfloc.evaluation.kidnap import HOLD, WITHIN, median_scans, score_kidnaps
 from tfloc.evaluation.trajectory import (
     LOST_DIST_M,
     LOST_ORIENT_DEG,
-    errors,
-    path_length,
     pooled_share,
     score_rows,
 )
 from tfloc.io.scenario import Scenario
 
-from .figures import MAP_SPACING_M, pose_columns
+from .figures import pose_columns
 from .jumps import fig_jumps
 from .mdtable import num, table
+from .tracking_figures import DEAD_RECKONING, fig_error_distance, fig_trajectories, order
 
-DEAD_RECKONING = DeadReckoning.name  # the floor, shown last
 DEFAULT = Thresholds()
 
 
@@ -70,15 +66,10 @@ def sequence_scores(df: pd.DataFrame, datasets: dict[str, Scenario],
     return pd.DataFrame(out)
 
 
-def _order(matchers) -> list[str]:
-    ms = sorted(set(matchers) - {DEAD_RECKONING})
-    return ms + ([DEAD_RECKONING] if DEAD_RECKONING in set(matchers) else [])
-
-
 def condition_table(s: pd.DataFrame) -> str:
     """The markdown table of one sequence set (rows of :func:`sequence_scores`)."""
     rows = []
-    for m in _order(s["matcher"]):
+    for m in order(s["matcher"]):
         g = s[s["matcher"] == m]
         share, lo, hi = pooled_share(g["n_tracked"], g["n_truth"])
         ci = "" if math.isnan(lo) else f" [{100 * lo:.1f}, {100 * hi:.1f}]"
@@ -149,7 +140,7 @@ def kidnap_tables(ev: pd.DataFrame) -> str:
     parts = []
     for cond, g in ev.groupby("set", sort=True):
         rows = []
-        for m in _order(g["matcher"]):
+        for m in order(g["matcher"]):
             h = g[g["matcher"] == m]
             n = [None if math.isnan(v) else int(v) for v in h["scans_to_relocalize"]]
             ok = sum(v is not None and v <= WITHIN for v in n)
@@ -200,7 +191,7 @@ def start_tables(st: pd.DataFrame) -> str:
     for cond, g in st.groupby("set", sort=True):
         seqs = sorted(g["dataset"].unique())
         rows = []
-        for m in _order(g["matcher"]):
+        for m in order(g["matcher"]):
             h = g[g["matcher"] == m].set_index("dataset").reindex(seqs)
             n = [None if not np.isfinite(v) else int(v) for v in h["scans_to_converge"].to_numpy(float)]
             med = median_scans(n)
@@ -222,65 +213,6 @@ def start_tables(st: pd.DataFrame) -> str:
 
 def _safe(name: str) -> str:
     return re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("_") or "x"
-
-
-def fig_trajectories(scenario: Scenario, the_map, rows: pd.DataFrame, path: Path) -> Path:
-    """One panel per matcher: the map, the true trajectory and the matcher's estimates (scans
-    lost, > 0.5 m off, in red)."""
-    ms = _order(rows["matcher"].unique())
-    mp, _ = the_map.sample_points(MAP_SPACING_M)
-    ncol = min(3, len(ms))
-    nrow = math.ceil(len(ms) / ncol)
-    fig = Figure(figsize=(5.2 * ncol, 4.2 * nrow), layout="constrained")
-    axes = np.atleast_1d(fig.subplots(nrow, ncol)).ravel()
-    for ax, m in zip(axes, ms, strict=False):
-        g = rows[rows["matcher"] == m]
-        t, e = pose_columns(g, "true"), pose_columns(g, "est")
-        ax.scatter(mp[:, 0], mp[:, 1], s=0.2, c="black", rasterized=True)
-        ax.plot(t[:, 0], t[:, 1], "-", color="#2ca02c", lw=1.2, label="truth")
-        ax.plot(e[:, 0], e[:, 1], "-", color="#1f77b4", lw=0.8, label="estimate")
-        ok = np.isfinite(t).all(axis=1)
-        d = np.full(len(t), np.nan)
-        d[ok] = errors(e[ok], t[ok])[0]
-        lost = d > LOST_DIST_M
-        ax.plot(e[lost, 0], e[lost, 1], ".", color="#d62728", ms=2, label="lost (> 0.5 m)")
-        ax.set_title(m, fontsize=10)
-        ax.set_aspect("equal")
-        ax.tick_params(labelsize=7)
-    for ax in axes[len(ms):]:
-        ax.set_visible(False)
-    axes[0].legend(fontsize=7, loc="best")
-    fig.suptitle(f"{scenario.name}: trajectories on the map", fontsize=11)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=90)
-    return path
-
-
-def fig_error_distance(scenario: Scenario, rows: pd.DataFrame, path: Path) -> Path:
-    """Distance error (log scale) over the true distance travelled, one line per matcher."""
-    from .figures import colours
-
-    ms = _order(rows["matcher"].unique())
-    col = colours(ms)
-    fig = Figure(figsize=(8, 3.6), layout="constrained")
-    ax = fig.subplots()
-    for m in ms:
-        g = rows[rows["matcher"] == m]
-        t, e = pose_columns(g, "true"), pose_columns(g, "est")
-        ok = np.isfinite(t).all(axis=1)
-        if ok.sum() < 2:
-            continue
-        ax.plot(path_length(t[ok]), np.maximum(errors(e[ok], t[ok])[0], 1e-3), lw=0.8,
-                color=col[m], label=m)
-    ax.axhline(LOST_DIST_M, color="grey", ls="--", lw=0.8)
-    ax.set_yscale("log")
-    ax.set_xlabel("distance travelled (m)")
-    ax.set_ylabel("distance error (m)")
-    ax.set_title(f"{scenario.name}: error over distance travelled (dashed: lost)", fontsize=10)
-    ax.legend(fontsize=7, ncol=3)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=90)
-    return path
 
 
 def own_score_table(df: pd.DataFrame, thresholds: Thresholds = DEFAULT) -> str:
@@ -330,7 +262,7 @@ def relations_tables(df: pd.DataFrame, datasets: dict[str, Scenario]) -> str:
         relations = read_relations(path)
         stamp = {s.scan_id: s.stamp for s in read_scans(sc)}
         rows = []
-        for m in _order(g["matcher"]):
+        for m in order(g["matcher"]):
             r = g[g["matcher"] == m]
             st = r["scan_id"].map(stamp).to_numpy(float)
             est = r[["est_x", "est_y", "est_theta"]].apply(pd.to_numeric, errors="coerce").to_numpy(float)
