@@ -130,7 +130,7 @@ def resolve(name: str, params: dict, seen: tuple[str, ...] = ()) -> tuple[str, d
         p = table[name]
         base, inner = resolve(p.matcher, _expand(p.params, (*seen, name)), (*seen, name))
         return base, merge(inner, params)
-    labelled = label_params(name) if ":" not in name else None
+    labelled = label_params(name)
     if labelled is not None:
         base, own = labelled
         base, inner = resolve(base, own, (*seen, name))
