@@ -9,7 +9,7 @@ from tfloc.core.matcher import get_matcher
 from tfloc.core.presets import label_params, merge, preset_params, presets, resolve
 from tfloc.errors import ConfigError, MatcherError
 from tfloc.harness.config import MatcherSpec
-from tfloc.harness.fingerprint import build_matcher
+from tfloc.harness.preflight import build_matcher
 
 
 @pytest.mark.parametrize("name", sorted(presets()))

@@ -4,7 +4,6 @@ start table."""
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
@@ -20,7 +19,7 @@ from tfloc.evaluation.global_start import (
     score_start,
     starts_without_pose,
 )
-from tfloc.io.estimates import result_row
+from tfloc.io.estimates import result_row, rows_frame
 from tfloc.io.scenario import read_scans, read_scenario
 
 SCEN = Path(__file__).resolve().parents[2] / "data" / "scenarios"
@@ -114,15 +113,14 @@ def test_amcl_with_global_localization_says_so_in_its_first_row(tmp_path) -> Non
     far = [type(scans[0])(scans[0].scan_id, scans[0].group, scans[0].ranges, Pose(20.0, -5.0, 2.0),
                           scans[0].true, scans[0].line, stamp=scans[0].stamp, odom=scans[0].odom), *scans[1:]]
     again = track(sc, far, AmclTracker(global_localization=True, seed=2))
-    infos = [json.loads(r["info"]) for r in rows]
+    infos = [r.info for r in rows]
     assert infos[0]["start"] == "global" and all("start" not in i for i in infos[1:])
-    assert [(r["est_x"], r["est_y"], r["est_theta"]) for r in rows] == \
-        [(r["est_x"], r["est_y"], r["est_theta"]) for r in again]
-    local = json.loads(track(sc, scans[:2], AmclTracker())[0]["info"])
+    assert [(r.est_x, r.est_y, r.est_theta) for r in rows] == [(r.est_x, r.est_y, r.est_theta) for r in again]
+    local = track(sc, scans[:2], AmclTracker())[0].info
     assert "start" not in local
 
 
-def _rows(name: str, label: str, poses: np.ndarray, scans, info0: dict) -> list[dict]:
+def _rows(name: str, label: str, poses: np.ndarray, scans, info0: dict) -> list:
     return [result_row(name, label, s.scan_id, s.group, true=s.true, init=Pose.from_array(p),
                        est=Pose.from_array(p), status="ok", wall_s=0.001, cpu_s=0.001,
                        info=info0 if k == 0 else {})
@@ -143,7 +141,7 @@ def test_report_start_table(tmp_path, global_label) -> None:
     never = elsewhere(true, Pose(3.0, 0.0, 0.0))                    # never right
     rows = (_rows(name, "finds", found, scans, {"start": "global"} if global_label else {})
             + _rows(name, "given", true, scans, {}) + _rows(name, "never", never, scans, {}))
-    df = pd.DataFrame(rows).astype(str)
+    df = rows_frame(rows)
     text = tracking_section(df, {name: sc}, {}, tmp_path, figures=False)
     if not global_label:
         assert "the start**" not in text and not (tmp_path / "start.csv").exists()

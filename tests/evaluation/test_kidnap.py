@@ -21,7 +21,7 @@ from tfloc.evaluation.kidnap import (
     score_kidnaps,
 )
 from tfloc.harness.track import odom_deltas
-from tfloc.io.estimates import result_row
+from tfloc.io.estimates import result_row, rows_frame
 from tfloc.io.scenario import SEQUENCE, read_scans, read_scenario
 
 SCEN = Path(__file__).resolve().parents[2] / "data" / "scenarios"
@@ -127,7 +127,7 @@ def test_report_kidnap_table(tmp_path) -> None:
         for label, pose in (("late", late), ("lost", lost)):
             rows.append(result_row(name, label, s.scan_id, s.group, true=s.true, init=pose, est=pose,
                                    status="ok", wall_s=0.002, cpu_s=0.002, info={}))
-    df = pd.DataFrame(rows).astype(str)
+    df = rows_frame(rows)
     text = tracking_section(df, {name: sc}, {}, tmp_path, figures=False)
     assert "**kidnap: kidnap events** (1 sequence: seq-kidnap-b)" in text
     late = next(x for x in text.splitlines() if x.startswith("| late") and "/" in x).split("|")
@@ -152,7 +152,7 @@ def test_tf_plus_recover_finds_itself_after_a_kidnap_and_tf_plus_does_not() -> N
     event = [s.scan_id for s in scans].index(sc.extra["kidnaps"][0])
 
     def scored(name: str):
-        df = pd.DataFrame(track(sc, scans, get_matcher(name)))
+        df = rows_frame(track(sc, scans, get_matcher(name)))
         pose = lambda p: df[[f"{p}_x", f"{p}_y", f"{p}_theta"]].to_numpy(float)  # noqa: E731
         return score_kidnaps(pose("est"), pose("true"), pose("init"), [event]), df
 

@@ -16,7 +16,7 @@ from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate
 from tfloc.core.thresholds import Thresholds
 from tfloc.harness.track import dead_reckoning, track
-from tfloc.io.estimates import COLUMNS
+from tfloc.io.estimates import COLUMNS, to_record
 from tfloc.io.scenario import Scan, read_scans, read_scenario, write_scenario
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -53,24 +53,24 @@ def test_guess_is_last_estimate_composed_with_odometry(tmp_path):
     sc = read_scenario(_copy(tmp_path / "a", 20))
     scans = read_scans(sc)
     rows = track(sc, scans, Shift())
-    assert [r["scan_id"] for r in rows] == [s.scan_id for s in scans] and list(rows[0]) == COLUMNS
+    assert [r.scan_id for r in rows] == [s.scan_id for s in scans] and list(to_record(rows[0])) == COLUMNS
     for k in range(1, len(rows)):
-        last = Pose(rows[k - 1]["est_x"], rows[k - 1]["est_y"], rows[k - 1]["est_theta"])
+        last = Pose(rows[k - 1].est_x, rows[k - 1].est_y, rows[k - 1].est_theta)
         want = last.compose(scans[k - 1].odom.between(scans[k].odom))
-        assert (rows[k]["init_x"], rows[k]["init_y"]) == pytest.approx((want.x, want.y), abs=1e-12)
+        assert (rows[k].init_x, rows[k].init_y) == pytest.approx((want.x, want.y), abs=1e-12)
         line = scans[k].line
         if line % 10 == 3:
-            assert rows[k]["status"] == "failed" and rows[k]["est_x"] == pytest.approx(want.x)
+            assert str(rows[k].status) == "failed" and rows[k].est_x == pytest.approx(want.x)
         elif line % 10 == 7:
-            assert rows[k]["status"].startswith("error:RuntimeError: boom")
-            assert rows[k]["est_x"] == pytest.approx(want.x)
+            assert str(rows[k].status).startswith("error:RuntimeError: boom")
+            assert rows[k].est_x == pytest.approx(want.x)
         else:
-            assert rows[k]["status"] == "ok" and rows[k]["est_x"] == pytest.approx(want.x + 0.01)
+            assert str(rows[k].status) == "ok" and rows[k].est_x == pytest.approx(want.x + 0.01)
     for r, scan in zip(rows, scans, strict=True):  # errors where the truth is known; no outcome without thresholds
-        est = Pose(r["est_x"], r["est_y"], r["est_theta"])
-        assert (r["dist_err_m"], r["orient_err_rad"]) == est.error_to(scan.true) and r["outcome"] == ""
+        est = Pose(r.est_x, r.est_y, r.est_theta)
+        assert (r.dist_err_m, r.orient_err_rad) == est.error_to(scan.true) and r.outcome == ""
     scored = track(sc, scans, Shift(), thresholds=Thresholds(0.015, 2.0))
-    assert {r["outcome"] for r in scored} == {"success", "unscored", "no-answer"}
+    assert {r.outcome for r in scored} == {"success", "unscored", "no-answer"}
 
 
 def test_blanked_truth_gives_the_same_estimates(tmp_path):
@@ -79,12 +79,12 @@ def test_blanked_truth_gives_the_same_estimates(tmp_path):
     a = read_scenario(_copy(tmp_path / "a", 40))
     b = read_scenario(_copy(tmp_path / "b", 40, blank_truth=True))
     ra, rb = track(a, read_scans(a), m), track(b, read_scans(b), m)
-    est = lambda rows: np.array([[r["est_x"], r["est_y"], r["est_theta"]] for r in rows])  # noqa: E731
+    est = lambda rows: np.array([[r.est_x, r.est_y, r.est_theta] for r in rows])  # noqa: E731
     assert np.array_equal(est(ra), est(rb))
-    assert all(r["true_x"] == "" for r in rb) and all(r["true_x"] != "" for r in ra)
-    assert [r["status"] for r in ra] == ["ok"] * 40
+    assert all(r.true_x is None for r in rb) and all(r.true_x is not None for r in ra)
+    assert [str(r.status) for r in ra] == ["ok"] * 40
     # and it tracks: the answers are near the truth (a test that can fail)
-    err = [math.hypot(r["est_x"] - r["true_x"], r["est_y"] - r["true_y"]) for r in ra]
+    err = [math.hypot(r.est_x - r.true_x, r.est_y - r.true_y) for r in ra]
     assert max(err) < 0.05
 
 
@@ -93,8 +93,8 @@ def test_dead_reckoning_is_the_odometry_from_the_start(tmp_path):
     scans = read_scans(sc)
     rows = dead_reckoning(sc, scans)
     end = scans[0].initial.compose(scans[0].odom.between(scans[-1].odom))
-    assert (rows[-1]["est_x"], rows[-1]["est_y"]) == pytest.approx((end.x, end.y), abs=1e-9)
-    assert {r["matcher"] for r in rows} == {"odometry"}
+    assert (rows[-1].est_x, rows[-1].est_y) == pytest.approx((end.x, end.y), abs=1e-9)
+    assert {r.matcher for r in rows} == {"odometry"}
 
 
 def test_cli_track_writes_est_csv(tmp_path, capsys):
@@ -123,10 +123,10 @@ def test_run_sequence_is_one_task(tmp_path):
 
     root = _copy(tmp_path / "a", 8)
     rows = run_sequence(str(root), "tfp", "tf-plus", '{"grid_step": 0.1}')
-    assert [r["matcher"] for r in rows] == ["tfp"] * 8 and {r["status"] for r in rows} == {"ok"}
+    assert [r.matcher for r in rows] == ["tfp"] * 8 and {str(r.status) for r in rows} == {"ok"}
     odo = run_sequence(str(root), "odometry", "odometry")
     ref = dead_reckoning(read_scenario(root), read_scans(read_scenario(root)))
-    pose = lambda r: (r["est_x"], r["est_y"], r["est_theta"])  # noqa: E731
+    pose = lambda r: (r.est_x, r.est_y, r.est_theta)  # noqa: E731
     assert [pose(r) for r in odo] == [pose(r) for r in ref]
 
 
@@ -138,6 +138,6 @@ def test_rows_are_read_back_by_the_results_reader(tmp_path):
     with (tmp_path / "estimates.csv").open("w", newline="") as fh:
         w = csv.DictWriter(fh, COLUMNS)
         w.writeheader()
-        w.writerows(rows)
+        w.writerows(to_record(r) for r in rows)
     df = read_estimates(tmp_path)
     assert len(df) == 6 and set(df["status"]) <= {"ok", "failed", "error:RuntimeError: boom"}

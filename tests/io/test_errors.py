@@ -82,8 +82,11 @@ def test_bad_scenario_json(tmp_path):
     (tmp_path / "scenario.json").write_text(json.dumps({"name": "x", "map": "m.geojson", "laser": {}}))
     with pytest.raises(DatasetError, match="bad 'laser' field"):
         read_scenario(tmp_path)
-    with pytest.raises(DatasetError, match="not a scenario dataset"):
+    with pytest.raises(DatasetError, match="nothing: no such directory"):
         read_scenario(tmp_path / "nothing")
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(DatasetError, match="not a scenario dataset"):
+        read_scenario(tmp_path / "empty")
 
 
 def test_problem_validation(test_room, lms200):

@@ -5,10 +5,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import pandas as pd
-
 from tfloc.harness.track import dead_reckoning
-from tfloc.io.estimates import result_row
+from tfloc.io.estimates import result_row, rows_frame
 from tfloc.io.maps import load_map
 from tfloc.io.scenario import read_scans, read_scenario
 from tfloc.report.tracking import sequence_scores, tracking_section
@@ -16,7 +14,7 @@ from tfloc.report.tracking import sequence_scores, tracking_section
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def _rows(name: str, n: int, lost_from: int | None = None) -> list[dict]:
+def _rows(name: str, n: int, lost_from: int | None = None) -> list:
     sc = read_scenario(ROOT / "data" / "scenarios" / name)
     scans = read_scans(sc)[:n]
     out = dead_reckoning(sc, scans, dataset=name)
@@ -28,8 +26,7 @@ def _rows(name: str, n: int, lost_from: int | None = None) -> list[dict]:
 
 
 def test_tables_and_figures(tmp_path):
-    df = pd.DataFrame(_rows("seq-rate-1hz-a", 40) + _rows("seq-rate-1hz-b", 40, lost_from=30)
-                      + _rows("seq-quick", 30)).astype(str)
+    df = rows_frame(_rows("seq-rate-1hz-a", 40) + _rows("seq-rate-1hz-b", 40, lost_from=30) + _rows("seq-quick", 30))
     names = df["dataset"].unique()
     ds = {n: read_scenario(ROOT / "data" / "scenarios" / n) for n in names}
     s = sequence_scores(df, ds)
@@ -58,7 +55,7 @@ def test_a_sequence_with_relations_gets_the_relation_errors_and_a_set_of_buildin
             pose = s.true if s.true is not None else s.odom     # truth where known
             rows.append(result_row(name, "perfect", s.scan_id, s.group, true=s.true, init=pose, est=pose,
                                    status="ok", wall_s=0.001, cpu_s=0.001, info={}))
-    df = pd.DataFrame(rows).astype(str)
+    df = rows_frame(rows)
     text = relations_tables(df, datasets)
     assert "real-csail-native: relation errors" in text and "Cartographer (Hess et al. 2016" in text
     assert "real-aces-native: relation" not in text                      # no relations file named

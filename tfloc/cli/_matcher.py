@@ -7,7 +7,7 @@ import tomllib
 
 from tfloc.errors import ConfigError
 from tfloc.harness.config import MatcherSpec
-from tfloc.harness.fingerprint import build_matcher
+from tfloc.harness.preflight import build_matcher
 from tfloc.harness.workspace import load_matcher
 
 

@@ -24,6 +24,7 @@ from pathlib import Path
 from tqdm import tqdm
 
 from tfloc.core.matcher import check_solvable
+from tfloc.core.result import Status, StatusKind
 from tfloc.core.tracker import has_single_scan_mode
 from tfloc.errors import ConfigError, InvalidProblemError
 from tfloc.harness.threads import limit_threads
@@ -90,16 +91,16 @@ def _localize(matcher, scenario, scan, counts: dict, first: bool) -> list:
         check_solvable(matcher, problem)
     except InvalidProblemError as exc:
         counts["invalid"] += 1
-        return [scan.scan_id, matcher.name, *[""] * 8, f"invalid:{exc}"]
+        return [scan.scan_id, matcher.name, *[""] * 8, str(Status.of(StatusKind.INVALID, str(exc)))]
     try:
         if first:  # untimed; a scan-to-scan map is new for each problem, so not warmed here
             warm(matcher, problem_of(scenario, scan))
         t = timed_localize(matcher, problem)
     except Exception as exc:  # noqa: BLE001 - a failing matcher is a result, as in tfloc bench
         counts["error"] += 1
-        return [scan.scan_id, matcher.name, *[""] * 8, f"error:{type(exc).__name__}: {exc}".replace("\n", " ")[:300]]
+        return [scan.scan_id, matcher.name, *[""] * 8, str(Status.of(StatusKind.ERROR, f"{type(exc).__name__}: {exc}"))]
     est = t.estimate
     status = status_of(est)
-    counts[status] += 1
+    counts[status.kind.value] += 1
     return [scan.scan_id, matcher.name, f"{est.pose.x:.6f}", f"{est.pose.y:.6f}", f"{est.pose.theta:.7f}",
-            f"{t.wall_s:.6f}", f"{t.cpu_s:.6f}", int(est.converged), est.iterations, est.evaluations, status]
+            f"{t.wall_s:.6f}", f"{t.cpu_s:.6f}", int(est.converged), est.iterations, est.evaluations, str(status)]

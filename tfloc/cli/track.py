@@ -86,8 +86,7 @@ def run(args: argparse.Namespace) -> int:
         show(args, watch.result(rows), scenario, scans[0])
     counts: dict[str, int] = {}
     for r in rows:
-        kind = r["status"].partition(":")[0]
-        counts[kind] = counts.get(kind, 0) + 1
+        counts[r.status.kind.value] = counts.get(r.status.kind.value, 0) + 1
     print(f"wrote {args.out}: {len(rows)} scans; " + ", ".join(f"{k} {v}" for k, v in counts.items()),
           file=sys.stderr)
     line = score_line(rows)
@@ -96,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
     return 3 if counts.get("error") else 0
 
 
-def score_line(rows: list[dict]) -> str:
+def score_line(rows: list) -> str:
     """One line scoring the track where the dataset has truth: tracked share of the truth-bearing
     scans, APE, losses and jumps > 1 m, median CPU per step (empty without truth)."""
     from tfloc.evaluation.trajectory import JUMP_M, score_rows
@@ -158,7 +157,7 @@ def show(args: argparse.Namespace, snap, scenario, first_scan) -> None:
         print(f"wrote {args.figure}", file=sys.stderr)
 
 
-def write_track(path: Path, rows: list[dict]) -> None:
+def write_track(path: Path, rows: list) -> None:
     """``est.csv``: :data:`COLUMNS`, one row per scan in order (metres, radians, seconds)."""
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -166,7 +165,7 @@ def write_track(path: Path, rows: list[dict]) -> None:
             w = csv.writer(fh)
             w.writerow(COLUMNS)
             for r in rows:
-                w.writerow([r["scan_id"], f"{r['est_x']:.6f}", f"{r['est_y']:.6f}",
-                            f"{r['est_theta']:.7f}", r["status"], f"{r['cpu_s']:.6f}"])
+                w.writerow([r.scan_id, f"{r.est_x:.6f}", f"{r.est_y:.6f}", f"{r.est_theta:.7f}", str(r.status),
+                            "" if r.cpu_s is None else f"{r.cpu_s:.6f}"])
     except OSError as exc:
         raise ResultsError(f"{path}: cannot write ({exc.strerror or exc})") from None

@@ -36,6 +36,7 @@ import pandas as pd
 
 from tfloc.core.thresholds import Thresholds
 from tfloc.datasets.protocol import ANGLE_BINS_DEG, DIST_BINS_M
+from tfloc.io.estimates import status_kinds
 
 from .outcome import (
     DIVERGED,
@@ -162,12 +163,12 @@ def _stats(s: pd.Series, name: str, unit: str) -> dict[str, float]:
 def group_metrics(g: pd.DataFrame) -> dict[str, float]:
     """All metrics of one group of :func:`prepare`-d rows (see :data:`METRIC_COLUMNS`)."""
     n_truth = int(g["truth"].sum())
-    status = g["status"].fillna("").astype(str)
+    kind = status_kinds(g["status"].fillna(""))
     m: dict[str, float] = {
         "n": len(g), "n_truth": n_truth, "n_est": int(g["estimate"].sum()),
         "n_excluded": n_truth - int(g["estimate"].sum()),
-        "n_timeout": int((status == "timeout").sum()), "n_error": int(status.str.startswith("error:").sum()),
-        "n_invalid": int(status.str.startswith("invalid:").sum())}
+        "n_timeout": int((kind == "timeout").sum()), "n_error": int((kind == "error").sum()),
+        "n_invalid": int((kind == "invalid").sum())}
     m.update(_stats(g["dist_err_cm"], "dist", "cm"))
     m.update(_stats(g["orient_err_deg"], "orient", "deg"))
     for k in ("dist", "orient"):

@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from tfloc.core.pose import Pose, angdiff
+from tfloc.core.result import kind_of_status
 from tfloc.core.thresholds import Thresholds
 from tfloc.errors import ResultsError
 
@@ -154,11 +155,11 @@ def _num(row: Mapping, key: str) -> float:
 def result_from_row(row: Mapping[str, Any], thresholds: Thresholds, where: str = "row") -> ScanResult | None:
     """Score an ``estimates.csv`` row (strings or numbers, :data:`tfloc.io.estimates.COLUMNS`);
     ``None`` for a row without truth or with an ``invalid:`` status (no problem was posed)."""
-    status = str(row.get("status", ""))
+    kind = kind_of_status(str(row.get("status", "")))
     truth = Pose(*(_num(row, f"true_{c}") for c in ("x", "y", "theta")))
-    if status.startswith("invalid") or not truth.is_finite():
+    if kind == "invalid" or not truth.is_finite():
         return None
-    answer = Pose(*(_num(row, f"est_{c}") for c in ("x", "y", "theta"))) if status == "ok" else None
+    answer = Pose(*(_num(row, f"est_{c}") for c in ("x", "y", "theta"))) if kind == "ok" else None
     r = scan_result(str(row.get("dataset", "")), str(row.get("matcher", "")), truth, answer,
                     hypotheses_from_info(row.get("info"), where), thresholds,
                     _num(row, "score_est"), _num(row, "score_true"), _num(row, "cpu_s"))

@@ -197,7 +197,10 @@ def score_rows(rows, thresholds: Thresholds = DEFAULT) -> TrackScore:
     scan order, columns ``est_*``, ``true_*``, ``cpu_s``; empty truth = NaN)."""
     import pandas as pd
 
-    df = pd.DataFrame(rows)
+    from tfloc.core.result import ResultRow
+    from tfloc.io.estimates import rows_frame
+
+    df = rows_frame(rows) if isinstance(rows, list) and rows and isinstance(rows[0], ResultRow) else pd.DataFrame(rows)
     num = lambda cols: df[cols].apply(pd.to_numeric, errors="coerce").to_numpy(float)  # noqa: E731
     cpu = pd.to_numeric(df["cpu_s"], errors="coerce").dropna().to_numpy(float)
     pred = num(["init_x", "init_y", "init_theta"]) if "init_x" in df else None

@@ -25,10 +25,11 @@ import sys
 import uuid
 from collections.abc import Callable, Iterator
 
+from tfloc.core.result import ResultRow
 from tfloc.errors import ConfigError
 
-from .runner import Executor
-from .task import Task, failure_row
+from .runner import Executor, worker_died
+from .task import Task, error_status, failure_row
 
 INSTALL_HINT = "pip install tfloc[dask]"
 _LOCAL = re.compile(r"local:(\d+)")
@@ -135,7 +136,7 @@ def execute_dask(address: str, sec=None) -> Executor:
     _require_distributed()
 
     def execute(tasks: list[Task], jobs: int, timeout_s: float,
-                on_row: Callable[[dict], None]) -> None:
+                on_row: Callable[[ResultRow | list[ResultRow]], None]) -> None:
         from distributed import as_completed
         from distributed.scheduler import KilledWorker
 
@@ -155,9 +156,9 @@ def execute_dask(address: str, sec=None) -> Executor:
                 try:
                     row = fut.result()
                 except KilledWorker as exc:
-                    row = failure_row(t, f"error:worker died ({exc})")
+                    row = failure_row(t, worker_died(exc))
                 except Exception as exc:  # noqa: BLE001 - a failed task is a row, not a crash
-                    row = failure_row(t, f"error:{type(exc).__name__}: {exc}")
+                    row = failure_row(t, error_status(exc))
                 on_row(row)
                 fut.release()
 

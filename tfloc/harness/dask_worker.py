@@ -15,12 +15,13 @@ import multiprocessing
 import os
 import threading
 from pathlib import Path
-from typing import Any
 
 from distributed import WorkerPlugin, get_worker
 from pebble import ProcessPool
 
-from .runner import _init_worker, collect
+from tfloc.core.result import ResultRow, StatusKind
+
+from .runner import WORKER_DIED, _init_worker, collect
 from .task import Task, run_task, warm_up
 
 PLUGIN_NAME = "tfloc-task-pool"
@@ -49,7 +50,7 @@ class TaskPool(WorkerPlugin):
             self.pool.join(timeout=10)
             self.pool = None
 
-    def run(self, task: Task, timeout_s: float) -> dict[str, Any] | list[dict[str, Any]]:
+    def run(self, task: Task, timeout_s: float) -> ResultRow | list[ResultRow]:
         """Warm up (untimed, once per dataset and matcher), then run ``task`` within its own time
         limit, else ``timeout_s``."""
         timeout_s = task.timeout_s or timeout_s
@@ -67,13 +68,13 @@ class TaskPool(WorkerPlugin):
                 pass
         row = collect(self.pool.schedule(run_task, args=(task,), timeout=timeout_s), task)
         last = row[-1] if isinstance(row, list) else row
-        if last.get("status") == "timeout" or str(last.get("status")).startswith("error:worker died"):
+        if last.status.kind is StatusKind.TIMEOUT or last.status.message.startswith(WORKER_DIED):
             with self.lock:  # its process was replaced: the next tasks warm up again
                 self.warm.clear()
         return row
 
 
-def run_on_worker(task: Task, timeout_s: float) -> dict[str, Any] | list[dict[str, Any]]:
+def run_on_worker(task: Task, timeout_s: float) -> ResultRow | list[ResultRow]:
     """The Dask task: one (scan, matcher) pair or one (sequence, matcher), run in this worker's
     :class:`TaskPool`."""
     return get_worker().plugins[PLUGIN_NAME].run(task, timeout_s)

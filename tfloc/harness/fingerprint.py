@@ -1,8 +1,4 @@
-"""A run is one configuration: the matchers built before the run, and the run's fingerprint.
-
-:func:`build_matchers` builds every matcher of a run once, in the calling process, before any
-task starts or any file is written: a misspelled parameter or a bad value stops the run with one
-line naming the configuration key (``x.toml: [params.csm-corr] search_radiuss: …``).
+"""A run is one configuration: its fingerprint, everything that decides its rows.
 
 :func:`fingerprint` is everything that decides a run's rows: a content hash (SHA-256) of each
 dataset's ``scans.csv``, ``scenario.json`` and map file(s), each matcher label with its *resolved*
@@ -16,72 +12,16 @@ finished row holds (timed-out rows can be run again with ``--retry-errors``).
 
 from __future__ import annotations
 
-import dataclasses
 import hashlib
 import json
 from pathlib import Path
 from typing import Any
 
-from tfloc.core.matcher import factory_of
-from tfloc.core.presets import resolve
-from tfloc.errors import ConfigError, LibraryMissingError, MatcherError, ParameterError
 from tfloc.io.maps import map_files
-from tfloc.io.scenario import read_scenario
+from tfloc.io.scenario import Scenario
 
-from .config import MatcherSpec, RunConfig
-from .identity import matcher_code, tfloc_code
-from .workspace import load_matcher
-
-
-def build_matcher(spec: MatcherSpec) -> dict[str, Any]:
-    """Build the matcher of ``spec`` (cached per process) and return its resolved parameters.
-
-    Raises :class:`ConfigError` naming the configuration key of a bad parameter."""
-    try:
-        m = load_matcher(spec.name, spec.params_json)
-    except ParameterError as exc:
-        key = spec.key_of(exc.names[0]) if exc.names else spec.where or f"matcher {spec.label}"
-        raise ConfigError(f"{key}: {exc}") from None
-    except MatcherError as exc:
-        raise ConfigError(f"{spec.where or 'matchers'}: {exc}") from None
-    except Exception as exc:  # noqa: BLE001 - a third-party factory may raise anything
-        raise ConfigError(f"{spec.where or 'matchers'}: matcher {spec.name!r} cannot be built with "
-                          f"{spec.params}: {type(exc).__name__}: {exc}") from None
-    cfg = getattr(m, "config", None)
-    if dataclasses.is_dataclass(cfg) and not isinstance(cfg, type):
-        return json.loads(json.dumps(dataclasses.asdict(cfg), default=str))
-    return spec.params
-
-
-def build_matchers(config: RunConfig) -> dict[str, dict[str, Any]]:
-    """Every matcher of the run built once: label → name, the registered matcher it stands for
-    (a preset's or a label's), resolved parameters and the code that answers."""
-    out = {}
-    for m in config.matchers:
-        params = build_matcher(m)
-        out[m.label] = {"name": m.name, "matcher": resolve(m.name, {})[0], "params": params,
-                        **matcher_code(factory_of(m.name))}
-    return out
-
-
-def available(config: RunConfig, log=None) -> RunConfig:
-    """``config`` without the matchers whose library is not installed (e.g. ``karto`` on Python
-    ≥ 3.12, where its library has no wheel), each left out with one line to ``log``; the other
-    matchers still run. Raises :class:`ConfigError` if none is left."""
-    keep = []
-    for m in config.matchers:
-        try:
-            load_matcher(m.name, m.params_json)
-        except LibraryMissingError as exc:
-            if log is not None:
-                log(f"matcher {m.label} left out of this run: {exc}")
-            continue
-        except Exception:  # noqa: BLE001 - build_matcher reports every other problem
-            pass
-        keep.append(m)
-    if not keep:
-        raise ConfigError(f"run {config.name!r}: no matcher of the run can be built here")
-    return config if len(keep) == len(config.matchers) else config.with_overrides(matchers=tuple(keep))
+from .config import RunConfig
+from .identity import tfloc_code
 
 
 def _sha256(path: Path) -> str | None:
@@ -95,19 +35,21 @@ def _sha256(path: Path) -> str | None:
     return h.hexdigest()
 
 
-def dataset_hashes(path: Path) -> dict[str, Any]:
+def dataset_hashes(scenario: Scenario) -> dict[str, Any]:
     """Content hashes of a dataset's files (``map:<name>`` for its map file(s))."""
-    scenario = read_scenario(path)
-    out = {"scenario.json": _sha256(Path(path) / "scenario.json"), "scans.csv": _sha256(scenario.scans_path)}
+    out = {"scenario.json": _sha256(Path(scenario.root) / "scenario.json"), "scans.csv": _sha256(scenario.scans_path)}
     for f in map_files(scenario.map_path):
         out[f"map:{f.name}"] = _sha256(f)
     return out
 
 
-def fingerprint(config: RunConfig, matchers: dict[str, dict[str, Any]]) -> dict[str, Any]:
-    """What decides the rows of a run (see the module notes); JSON-serialisable."""
+def fingerprint(config: RunConfig, matchers: dict[str, dict[str, Any]],
+                scenarios: list[Scenario]) -> dict[str, Any]:
+    """What decides the rows of a run (see the module notes; ``matchers`` as
+    :func:`tfloc.harness.preflight.build_matchers` gives them, ``scenarios`` the run's datasets,
+    read once); JSON-serialisable."""
     return {"tfloc": tfloc_code(),
-            "datasets": {read_scenario(d).name: dataset_hashes(d) for d in config.datasets},
+            "datasets": {sc.name: dataset_hashes(sc) for sc in scenarios},
             "matchers": matchers, "success": config.success.to_dict()}
 
 

@@ -7,9 +7,10 @@ BLAS, numba, OpenCV, open3d; :mod:`tfloc.harness.threads`) limited to one thread
 task's CPU time is one matcher on one core and ``jobs`` workers use ``jobs`` cores. ``run.json``
 records the load average when a session starts and ends (contention shows in wall time).
 
-Before anything is written, every matcher is built once in this process and the run's
-fingerprint is computed (:mod:`tfloc.harness.fingerprint`); an existing run directory is resumed
-only when its fingerprint is the same.
+Before anything is written, every matcher is built once in this process and every dataset read
+once (:mod:`tfloc.harness.preflight`), and the run's fingerprint is computed
+(:mod:`tfloc.harness.fingerprint`); an existing run directory is resumed only when its
+fingerprint is the same.
 """
 
 from __future__ import annotations
@@ -27,31 +28,36 @@ from pathlib import Path
 from pebble import ProcessExpired, ProcessPool
 from tqdm import tqdm
 
+from tfloc.core.result import ResultRow, Status, StatusKind
 from tfloc.core.tracker import has_single_scan_mode
 from tfloc.errors import ConfigError, ResultsError
 from tfloc.io.estimates import ResultWriter, done_keys, drop_rows
 from tfloc.io.rundir import RunDir
-from tfloc.io.scenario import SEQUENCE, iter_scans, read_scans, read_scenario
+from tfloc.io.scenario import SEQUENCE, Scenario, iter_scans, read_scans, read_scenario
 
 from .config import RunConfig
-from .fingerprint import available, build_matchers, differences, fingerprint
+from .fingerprint import differences
 from .identity import git_state
-from .task import Task, failure_row, run_task, warm_up
+from .preflight import Preflight, preflight
+from .task import Task, error_status, failure_row, run_task, warm_up
 from .threads import limit_threads
 from .workspace import load_matcher
 
+WORKER_DIED = "worker died"  # an error row's message when the task's process died
 PACKAGES = ("tfloc", "numpy", "scipy", "shapely", "numba", "pandas", "open3d", "kiss-icp",
             "opencv-python-headless", "small-gicp", "karto-scanmatcher", "pebble", "matplotlib",
             "llvmlite", "evo", "amcl")
 
 
-def make_tasks(config: RunConfig, log: Callable[[str], None] | None = None) -> list[Task]:
+def make_tasks(config: RunConfig, log: Callable[[str], None] | None = None,
+               scenarios: dict[Path, Scenario] | None = None) -> list[Task]:
     """Every task of a run, in dataset/scan order (validates datasets): one per (scan, matcher),
     and one per (sequence, matcher) on a sequence dataset. A tracker (no single-scan mode, e.g.
-    ``amcl``) is left out of the other datasets with one line to ``log``."""
+    ``amcl``) is left out of the other datasets with one line to ``log``. ``scenarios``: the
+    datasets as the preflight read them (read here otherwise)."""
     tasks = []
     for d in config.datasets:
-        scenario = read_scenario(d)
+        scenario = (scenarios or {}).get(Path(d)) or read_scenario(d)
         if scenario.mode == SEQUENCE:
             scans = read_scans(scenario)
             tasks += [Task(str(d), scenario.name, scans[-1].scan_id, m.label, m.name, m.params_json,
@@ -110,19 +116,20 @@ def environment() -> dict:
                         "node": platform.node()}}
 
 
-def session_doc(config: RunConfig, fp: dict | None) -> dict:
+def session_doc(pre: Preflight) -> dict:
     """What ``run.json`` records of a session besides the sessions themselves: the configuration,
-    the environment, the datasets (name → directory) and the fingerprint."""
-    scenarios = [read_scenario(d) for d in config.datasets]
+    the environment, the datasets (name → directory), what each declares and the fingerprint."""
+    config = pre.config
+    scenarios = [pre.scenarios[Path(d)] for d in config.datasets]
     return {"config": config.to_dict(), **environment(),
             "datasets": {sc.name: str(d) for sc, d in zip(scenarios, config.datasets, strict=True)},
             "declared": {sc.name: {"mode": sc.mode, "paper_scenarios": list(sc.paper_scenarios)}
                          for sc in scenarios},
-            "fingerprint": fp}
+            "fingerprint": pre.fingerprint()}
 
 
 def execute_local(tasks: list[Task], jobs: int, timeout_s: float,
-                  on_row: Callable[[dict | list[dict]], None]) -> None:
+                  on_row: Callable[[ResultRow | list[ResultRow]], None]) -> None:
     """Run ``tasks`` on a local process pool; every task ends in exactly one ``on_row`` call (a
     sequence task's with its list of rows)."""
     ctx = multiprocessing.get_context("spawn")
@@ -145,19 +152,24 @@ def execute_local(tasks: list[Task], jobs: int, timeout_s: float,
             raise
 
 
-def collect(fut, task: Task) -> dict | list[dict]:
+def collect(fut, task: Task) -> ResultRow | list[ResultRow]:
     """The row(s) of a pebble future of ``run_task(task)``: its result, or a timeout/error row."""
     try:
         return fut.result()
     except (TimeoutError, FutureTimeout):
-        return failure_row(task, "timeout")
+        return failure_row(task, Status(StatusKind.TIMEOUT))
     except ProcessExpired as exc:
-        return failure_row(task, f"error:worker died ({exc})")
+        return failure_row(task, worker_died(exc))
     except Exception as exc:  # noqa: BLE001
-        return failure_row(task, f"error:{type(exc).__name__}: {exc}")
+        return failure_row(task, error_status(exc))
 
 
-Executor = Callable[[list[Task], int, float, Callable[[dict | list[dict]], None]], None]
+def worker_died(exc: BaseException) -> Status:
+    """The status of a task whose worker process died under it."""
+    return Status.of(StatusKind.ERROR, f"{WORKER_DIED} ({exc})")
+
+
+Executor = Callable[[list[Task], int, float, Callable[[ResultRow | list[ResultRow]], None]], None]
 
 
 def _sequence_pairs(tasks: list[Task]) -> set[tuple[str, str]]:
@@ -189,10 +201,11 @@ def run(config: RunConfig, progress: bool | None = None, executor: Executor = ex
     removed (the file is rewritten atomically) and their tasks run again.
     """
     log = lambda line: print(line, file=sys.stderr)  # noqa: E731
-    config = available(config, log=log)
+    pre = preflight(config, log=log)
+    config = pre.config
     rd = RunDir(Path(config.out))
-    fp = fingerprint(config, build_matchers(config))
-    tasks = make_tasks(config, log)
+    fp = pre.fingerprint()
+    tasks = make_tasks(config, log, pre.scenarios)
     try:
         done = done_keys(rd.estimates) if rd.path.is_dir() else set()
     except ResultsError:  # damaged, or written by another version: only --regenerate goes on
@@ -222,7 +235,7 @@ def run(config: RunConfig, progress: bool | None = None, executor: Executor = ex
         drop_rows(rd.estimates, done - drop)
         todo = [t for t in tasks if t.key not in done or t.key in retry]
     rd.make()
-    rd.start_session(session_doc(config, fp), len(tasks), len(tasks) - len(todo), load_average())
+    rd.start_session(session_doc(pre), len(tasks), len(tasks) - len(todo), load_average())
     if not todo:
         log(f"{rd.path}: already complete: 0 tasks run (--regenerate runs it again)")
         return rd.path
@@ -233,11 +246,11 @@ def run(config: RunConfig, progress: bool | None = None, executor: Executor = ex
                disable=None if progress is None else not progress, smoothing=0.05, mininterval=1.0)
     failures = 0
     with ResultWriter(rd.estimates) as writer:
-        def on_row(rows: dict | list[dict]) -> None:
+        def on_row(rows: ResultRow | list[ResultRow]) -> None:
             nonlocal failures
             for row in rows if isinstance(rows, list) else [rows]:  # a sequence's last row last
                 writer.write(row)
-                failures += str(row.get("status", "ok")).startswith(("error", "timeout"))
+                failures += row.status.kind in (StatusKind.ERROR, StatusKind.TIMEOUT)
             bar.update(1)
             if failures:
                 bar.set_postfix(errors=failures, refresh=False)

@@ -70,8 +70,9 @@ from tfloc.maps.grid import GridMap
 from tfloc.maps.vector import VectorMap
 
 from .config import MatcherSpec
-from .fingerprint import build_matcher, differences
+from .fingerprint import differences
 from .identity import tfloc_code
+from .preflight import build_matcher
 from .runner import environment, load_average
 from .timing import pinned, rotated
 from .workspace import status_of, timed, timed_localize, warm
@@ -272,7 +273,7 @@ def scan_row(lv: Level, scan: TileScan, name: str, matcher: Matcher, problem: Pr
     sys0 = _system_s()
     try:
         t = timed_localize(matcher, problem)
-        est, status, cpu_s, wall_s = t.estimate, status_of(t.estimate), t.cpu_s, t.wall_s
+        est, status, cpu_s, wall_s = t.estimate, str(status_of(t.estimate)), t.cpu_s, t.wall_s
     except Exception as exc:  # noqa: BLE001 - a raising matcher is a result
         est, status, cpu_s, wall_s = None, f"error:{type(exc).__name__}: {exc}"[:200], math.nan, math.nan
     sys_s = _system_s() - sys0
@@ -362,7 +363,7 @@ def _sha256(path: Path) -> str:
 
 def study_fingerprint(cfg: StudyConfig, matchers: Sequence[str]) -> dict[str, Any]:
     """What decides the study's rows: the tfloc version, the tile map's content hash, every
-    matcher with its resolved parameters (:func:`tfloc.harness.fingerprint.build_matcher`), the
+    matcher with its resolved parameters (:func:`tfloc.harness.preflight.build_matcher`), the
     success thresholds and the configuration; JSON-normalised."""
     path = Path(cfg.map_path)
     fp = {"tfloc": tfloc_code(), "datasets": {"map": {path.name: _sha256(path)}},

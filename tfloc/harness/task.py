@@ -18,13 +18,12 @@ function to the same columns). A global problem given to a local matcher is an `
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
 from tfloc.core.matcher import check_solvable
+from tfloc.core.result import ResultRow, Status, StatusKind
 from tfloc.core.thresholds import Thresholds
 from tfloc.errors import InvalidProblemError
 from tfloc.evaluation.outcome import AMBIGUOUS, NO_ANSWER, outcome
@@ -55,23 +54,21 @@ class Task:
         return (self.dataset_name, self.scan_id, self.label)
 
 
-def base_row(task: Task, scan: Scan | None) -> dict[str, Any]:
+def base_row(task: Task, scan: Scan | None) -> ResultRow:
     """The row of a task before its matcher answers: identity, truth and initial guess
     (:func:`tfloc.io.estimates.result_row`); also the row of a timeout or error."""
     return result_row(task.dataset_name, task.label, task.scan_id, scan.group if scan else "",
                       true=scan.true if scan else None, init=scan.initial if scan else None)
 
 
-def failure_row(task: Task, status: str, scan: Scan | None = None) -> dict[str, Any]:
+def failure_row(task: Task, status: Status, scan: Scan | None = None) -> ResultRow:
     """A row for a task that produced no estimate (timeout, crash, error)."""
     if scan is None:
         try:
             scan = load_dataset(task.dataset)[1].get(task.scan_id)
         except Exception:  # noqa: BLE001 - the row must be written whatever went wrong
             scan = None
-    row = base_row(task, scan)
-    row.update(status=status.replace("\n", " ")[:300], outcome=NO_ANSWER if scan and scan.true else "")
-    return row
+    return base_row(task, scan).with_(status=status, outcome=NO_ANSWER if scan and scan.true else "")
 
 
 _WARM: set[tuple[str, str, str]] = set()
@@ -99,7 +96,12 @@ def _posed(task: Task):
     return scenario, scan, matcher, problem
 
 
-def run_task(task: Task) -> dict[str, Any] | list[dict[str, Any]]:
+def error_status(exc: BaseException) -> Status:
+    """The status of a task whose matcher raised ``exc``."""
+    return Status.of(StatusKind.ERROR, f"{type(exc).__name__}: {exc}")
+
+
+def run_task(task: Task) -> ResultRow | list[ResultRow]:
     """Run one task; exceptions from the matcher become an ``error:`` row (never raised), a
     problem the data cannot pose (:class:`InvalidProblemError`) an ``invalid:`` row. A sequence
     task gives one row per scan (:func:`run_sequence_task`)."""
@@ -109,14 +111,14 @@ def run_task(task: Task) -> dict[str, Any] | list[dict[str, Any]]:
     try:
         scenario, scan, matcher, problem = _posed(task)
     except InvalidProblemError as exc:
-        return failure_row(task, f"invalid:{exc}", scan)
+        return failure_row(task, Status.of(StatusKind.INVALID, str(exc)), scan)
     except Exception as exc:  # noqa: BLE001 - a failing matcher is a result, not a crash
-        return failure_row(task, f"error:{type(exc).__name__}: {exc}", scan)
+        return failure_row(task, error_status(exc), scan)
     try:
         _warm_once(task, matcher, problem_of(scenario, scan))
         timed = timed_localize(matcher, problem)
     except Exception as exc:  # noqa: BLE001 - a failing matcher is a result, not a crash
-        return failure_row(task, f"error:{type(exc).__name__}: {exc}", scan)
+        return failure_row(task, error_status(exc), scan)
     est = timed.estimate
     status = status_of(est)
     info = est.info if not est.hypotheses else {**est.info, HYPOTHESES_KEY: hypotheses_info(est.hypotheses)}
@@ -125,19 +127,18 @@ def run_task(task: Task) -> dict[str, Any] | list[dict[str, Any]]:
                      wall_s=timed.wall_s, cpu_s=timed.cpu_s, info=info)
     if scan.true is None:
         return row
-    p, d, o = est.pose, row["dist_err_m"], row["orient_err_rad"]
+    p, d, o = est.pose, row.dist_err_m, row.orient_err_rad
     s_est = s_true = np.nan
     recorded = ""
-    if status == "ok" and not task.thresholds.success(d, o) and callable(getattr(matcher, "score", None)):
+    if status.ok and not task.thresholds.success(d, o) and callable(getattr(matcher, "score", None)):
         try:  # why did it fail? the matcher's own objective at its answer and at the truth
             s_est, s_true = float(matcher.score(problem, p)), float(matcher.score(problem, scan.true))
-            row.update(score_est=s_est, score_true=s_true)
+            row = row.with_(score_est=s_est, score_true=s_true)
         except Exception as exc:  # noqa: BLE001
             s_est = s_true = np.nan
             recorded = AMBIGUOUS
-            row["info"] = row["info"][:-1] + f',"score_error":{json.dumps(str(exc))}}}'
-    row["outcome"] = outcome(status == "ok", d, o, s_est, s_true, task.thresholds, recorded)
-    return row
+            row = row.with_(info={**(row.info or {}), "score_error": str(exc)})
+    return row.with_(outcome=outcome(status.ok, d, o, s_est, s_true, task.thresholds, recorded))
 
 
 def warm_up(task: Task) -> None:
@@ -152,7 +153,7 @@ def warm_up(task: Task) -> None:
         pass
 
 
-def run_sequence_task(task: Task) -> list[dict[str, Any]]:
+def run_sequence_task(task: Task) -> list[ResultRow]:
     """A whole sequence tracked (:func:`tfloc.harness.track.run_sequence`): one row per scan in
     order, scored by the one rule under the task's thresholds. A matcher that cannot be built is
     one ``error:`` row for the task."""
@@ -161,4 +162,4 @@ def run_sequence_task(task: Task) -> list[dict[str, Any]]:
     try:
         return run_sequence(task.dataset, task.label, task.matcher, task.params_json, task.thresholds)
     except Exception as exc:  # noqa: BLE001 - a failing matcher is a result, not a crash
-        return [failure_row(task, f"error:{type(exc).__name__}: {exc}")]
+        return [failure_row(task, error_status(exc))]

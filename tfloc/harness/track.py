@@ -20,9 +20,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from typing import Any
 
 from tfloc.core.pose import Pose
+from tfloc.core.result import ResultRow, Status, StatusKind
 from tfloc.core.thresholds import Thresholds
 from tfloc.core.tracker import DeadReckoning, as_tracker
 from tfloc.errors import DatasetError
@@ -53,7 +53,7 @@ def odom_deltas(scans: Sequence[Scan]) -> list[Pose]:
 
 def track(scenario: Scenario, scans: Sequence[Scan], matcher, *, label: str | None = None,
           dataset: str | None = None, map=None, thresholds: Thresholds | None = None,
-          progress: Callable[[int], None] | None = None) -> list[dict[str, Any]]:
+          progress: Callable[[int], None] | None = None) -> list[ResultRow]:
     """Run ``matcher`` (a single-scan matcher or a :class:`~tfloc.core.tracker.Tracker`) along
     the sequence ``scans`` of ``scenario``; one row per scan, in order (module notes).
     ``map`` overrides the dataset's map; ``thresholds`` fill each scored row's ``outcome``;
@@ -78,14 +78,14 @@ def track(scenario: Scenario, scans: Sequence[Scan], matcher, *, label: str | No
                 pose = pred
                 tracker.reset(pred)
         except Exception as exc:  # noqa: BLE001 - a raising tracker is a result; the run goes on
-            est, info, pose, wall_s, cpu_s = None, {}, pred, "", ""
-            status = f"error:{type(exc).__name__}: {exc}".replace("\n", " ")[:300]
+            est, info, pose, wall_s, cpu_s = None, {}, pred, None, None
+            status = Status.of(StatusKind.ERROR, f"{type(exc).__name__}: {exc}")
             tracker.reset(pred)
         row = result_row(dataset, label, scan.scan_id, scan.group, true=scan.true, init=pred, est=pose,
                          estimate=est, status=status, wall_s=wall_s, cpu_s=cpu_s, info=info)
         if thresholds is not None and scan.true is not None:
-            row["outcome"] = outcome(status == "ok", row["dist_err_m"], row["orient_err_rad"],
-                                     math.nan, math.nan, thresholds)
+            row = row.with_(outcome=outcome(status.ok, row.dist_err_m, row.orient_err_rad,
+                                            math.nan, math.nan, thresholds))
         rows.append(row)
         if progress is not None:
             progress(k)
@@ -93,7 +93,7 @@ def track(scenario: Scenario, scans: Sequence[Scan], matcher, *, label: str | No
 
 
 def dead_reckoning(scenario: Scenario, scans: Sequence[Scan], *, label: str = DeadReckoning.name,
-                   dataset: str | None = None) -> list[dict[str, Any]]:
+                   dataset: str | None = None) -> list[ResultRow]:
     """The floor every table shows: the prediction alone (the odometry composed from the start
     pose): :func:`track` with the registered matcher ``odometry``
     (:class:`~tfloc.core.tracker.DeadReckoning`)."""
@@ -101,7 +101,7 @@ def dead_reckoning(scenario: Scenario, scans: Sequence[Scan], *, label: str = De
 
 
 def run_sequence(dataset: str, label: str, matcher: str, params_json: str = "{}",
-                 thresholds: Thresholds | None = None) -> list[dict[str, Any]]:
+                 thresholds: Thresholds | None = None) -> list[ResultRow]:
     """One sequence task of a run, as a worker executes it: the dataset ``dataset`` (a directory)
     and the matcher ``matcher`` with ``params_json`` from the worker's workspace, the whole
     sequence tracked; the rows carry ``label`` as their matcher. Dataset errors raise

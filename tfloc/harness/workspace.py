@@ -25,6 +25,7 @@ from functools import lru_cache
 
 from tfloc.core.matcher import Matcher, get_matcher
 from tfloc.core.problem import Estimate, Problem
+from tfloc.core.result import OK, Status, StatusKind
 from tfloc.core.tracker import Tracker, kept_prediction
 from tfloc.io.scenario import Scan, Scenario, map_for, read_scans, read_scenario
 
@@ -114,7 +115,7 @@ def timed_step(tracker: Tracker, ranges, odom_delta, stamp: float, where: str) -
     return timed(tracker.step, ranges, odom_delta, stamp, where=where)
 
 
-def status_of(est: Estimate) -> str:
+def status_of(est: Estimate) -> Status:
     """``failed`` when the matcher declined (:attr:`Estimate.declined`) or a tracker kept its
     prediction, else ``ok``; whether it converged is reported separately."""
-    return "failed" if est.declined or kept_prediction(est) else "ok"
+    return Status(StatusKind.FAILED) if est.declined or kept_prediction(est) else OK

@@ -1,10 +1,13 @@
 """``estimates.csv``: the append-only results file of a run, safe to resume after a kill -9.
 
-One reader for every command (``report``, ``export``, ``real-note``, resume): :func:`read_rows`
-reads strictly through :mod:`tfloc.io.text`; a malformed file is a
-:class:`~tfloc.errors.ResultsError` naming ``file:line``. A row's ``status`` is ``ok``, ``failed``
-(the matcher declined or gave no finite pose), ``invalid:<reason>`` (the data poses no problem,
-e.g. the initial pose lies outside the map), ``timeout`` or ``error:<message>`` (the matcher raised).
+The edge where a :class:`~tfloc.core.result.ResultRow` becomes text and back (:func:`to_record`,
+:func:`from_record`); :func:`result_row` is the one builder of a row. One reader for every
+command (``report``, ``export``, ``real-note``, resume): :func:`read_rows` reads strictly through
+:mod:`tfloc.io.text`; a malformed file is a :class:`~tfloc.errors.ResultsError` naming
+``file:line``. :func:`read_estimates` (a file) and :func:`rows_frame` (rows in memory) give the
+same table for the evaluation. A row's ``status`` is ``ok``, ``failed`` (the matcher declined or
+gave no finite pose), ``invalid:<reason>`` (the data poses no problem, e.g. the initial pose lies
+outside the map), ``timeout`` or ``error:<message>`` (the matcher raised).
 """
 
 from __future__ import annotations
@@ -19,16 +22,12 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from tfloc.core.result import COLUMNS, OK, ResultRow, Status, StatusKind, kind_of_status
 from tfloc.errors import ResultsError
 
 from .atomic import replace_atomically
 from .text import csv_rows
 
-COLUMNS = ["dataset", "scan_id", "group", "matcher",
-           "true_x", "true_y", "true_theta", "init_x", "init_y", "init_theta",
-           "est_x", "est_y", "est_theta", "dist_err_m", "orient_err_rad",
-           "init_dist_err_m", "init_orient_err_rad", "runtime_s", "cpu_s", "converged", "iterations",
-           "evaluations", "status", "outcome", "score_est", "score_true", "info"]
 KEY = ("dataset", "scan_id", "matcher")
 #: the columns every reader needs (older runs may lack the others)
 REQUIRED = ("dataset", "scan_id", "group", "matcher", "true_x", "true_y", "true_theta", "init_x",
@@ -36,30 +35,33 @@ REQUIRED = ("dataset", "scan_id", "group", "matcher", "true_x", "true_y", "true_
             "init_dist_err_m", "init_orient_err_rad", "runtime_s", "converged", "iterations",
             "evaluations", "status", "outcome")
 TEXT = ("dataset", "scan_id", "group", "matcher", "status", "outcome", "info")
-STATUS_KINDS = ("ok", "failed", "invalid", "timeout", "error")
+STATUS_KINDS = tuple(k.value for k in StatusKind)
+#: the columns whose values are numbers (the rest are text; ``status`` and ``info`` are parsed)
+NUMERIC = tuple(c for c in COLUMNS if c not in TEXT)
+INTEGER = ("converged", "iterations", "evaluations")
 
 
 def pose_fields(prefix: str, pose) -> dict[str, Any]:
     """A pose (:class:`~tfloc.core.pose.Pose` or None) as the row's ``<prefix>_x/y/theta``
-    columns (empty when None)."""
+    fields (``None`` each when the pose is)."""
     if pose is None:
-        return {f"{prefix}_x": "", f"{prefix}_y": "", f"{prefix}_theta": ""}
+        return {f"{prefix}_x": None, f"{prefix}_y": None, f"{prefix}_theta": None}
     return {f"{prefix}_x": pose.x, f"{prefix}_y": pose.y, f"{prefix}_theta": pose.theta}
 
 
 def result_row(dataset: str, matcher: str, scan_id: str, group: str = "", *, true=None, init=None,
-               est=None, estimate=None, status: str = "", wall_s: float | str = "", cpu_s: float | str = "",
-               info: dict | None = None) -> dict[str, Any]:
-    """The one builder of a result row (:data:`COLUMNS`): identity, the true, initial and
-    estimated poses (:class:`~tfloc.core.pose.Pose` or ``None``), their errors where the truth
-    is known (:meth:`~tfloc.core.pose.Pose.error_to`), the times (seconds), the estimate's
-    counters (an :class:`~tfloc.core.problem.Estimate`, if any), ``status`` and ``info`` (as
-    JSON). ``outcome`` and ``score_*`` are the caller's (they need the thresholds and the
-    matcher)."""
-    row = {c: "" for c in COLUMNS}
-    row.update(dataset=dataset, scan_id=scan_id, group=group, matcher=matcher, status=status,
-               runtime_s=wall_s, cpu_s=cpu_s, **pose_fields("true", true), **pose_fields("init", init),
-               **pose_fields("est", est))
+               est=None, estimate=None, status: Status | str = OK, wall_s: float | None = None,
+               cpu_s: float | None = None, info: dict | None = None) -> ResultRow:
+    """The one builder of a result row: identity, the true, initial and estimated poses
+    (:class:`~tfloc.core.pose.Pose` or ``None``), their errors where the truth is known
+    (:meth:`~tfloc.core.pose.Pose.error_to`), the times (seconds), the estimate's counters (an
+    :class:`~tfloc.core.problem.Estimate`, if any), ``status`` and ``info``. ``outcome`` and
+    ``score_*`` are the caller's (they need the thresholds and the matcher)."""
+    if not isinstance(status, Status):
+        status = Status.parse(status) or Status.of(StatusKind.ERROR, f"unknown status {status!r}")
+    row: dict[str, Any] = dict(dataset=dataset, scan_id=scan_id, group=group, matcher=matcher, status=status,
+                               runtime_s=wall_s, cpu_s=cpu_s, info=info, **pose_fields("true", true),
+                               **pose_fields("init", init), **pose_fields("est", est))
     if true is not None and init is not None:
         row["init_dist_err_m"], row["init_orient_err_rad"] = init.error_to(true)
     if true is not None and est is not None:
@@ -67,18 +69,57 @@ def result_row(dataset: str, matcher: str, scan_id: str, group: str = "", *, tru
     if estimate is not None:
         row.update(converged=int(bool(estimate.converged)), iterations=estimate.iterations,
                    evaluations=estimate.evaluations)
-    if info is not None:
-        row["info"] = json.dumps(info, default=str, separators=(",", ":"))
-    return row
+    return ResultRow(**row)
 
 
 def status_kind(status: str) -> str | None:
     """``ok``, ``failed``, ``invalid``, ``timeout`` or ``error`` (``invalid:…``/``error:…`` carry a
-    message); ``None`` for anything else."""
-    kind = status.partition(":")[0]
-    if kind in ("invalid", "error"):
-        return kind if ":" in status else None
-    return kind if kind in STATUS_KINDS else None
+    message); ``None`` for anything else (:meth:`tfloc.core.result.Status.parse`)."""
+    return kind_of_status(status)
+
+
+def status_kinds(status: pd.Series) -> pd.Series:
+    """:func:`status_kind` of a column of statuses (a report's rows)."""
+    return status.astype(str).map(kind_of_status)
+
+
+def to_record(row: ResultRow) -> dict[str, str]:
+    """A row as the text of its ``estimates.csv`` cells (numbers to 9 significant digits,
+    ``None`` an empty cell, ``info`` compact JSON)."""
+    out = {}
+    for c in COLUMNS:
+        v = getattr(row, c)
+        if c == "info":
+            out[c] = "" if v is None else json.dumps(v, default=str, separators=(",", ":"))
+        elif c == "status":
+            out[c] = str(v)
+        else:
+            out[c] = "" if v is None else _fmt(v)
+    return out
+
+
+def _number(text: str, integer: bool) -> float | int | None:
+    text = text.strip()
+    if not text:
+        return None
+    v = float(text)
+    return int(v) if integer and v.is_integer() else v
+
+
+def from_record(record: dict[str, str]) -> ResultRow:
+    """The row written as ``record`` (cells as text; a column the file lacks is empty)."""
+    kw: dict[str, Any] = {}
+    for c in COLUMNS:
+        text = record.get(c) or ""
+        if c == "status":
+            kw[c] = Status.parse(text) or OK
+        elif c == "info":
+            kw[c] = json.loads(text) if text.strip() else None
+        elif c in TEXT:
+            kw[c] = text
+        else:
+            kw[c] = _number(text, c in INTEGER)
+    return ResultRow(**kw)
 
 
 def repair(path: Path) -> None:
@@ -179,9 +220,9 @@ class ResultWriter:
         self._fh.flush()
         os.fsync(self._fh.fileno())
 
-    def write(self, row: dict[str, Any]) -> None:
+    def write(self, row: ResultRow) -> None:
         try:
-            self._w.writerow({k: _fmt(v) for k, v in row.items()})
+            self._w.writerow(to_record(row))
             self._sync()
         except OSError as exc:
             raise self._failed(exc) from None
@@ -217,8 +258,17 @@ def read_estimates(run_dir: str | Path, required: tuple[str, ...] = REQUIRED) ->
     if Path(run_dir).is_dir():
         repair(path)
     header, rows = read_rows(path, required)
-    df = pd.DataFrame([r for _, r in rows], columns=header, dtype=object)
-    lines = np.array([line for line, _ in rows], dtype=int)
+    return _frame(header, [r for _, r in rows], [line for line, _ in rows], path)
+
+
+def rows_frame(rows: list[ResultRow]) -> pd.DataFrame:
+    """Rows in memory as the table :func:`read_estimates` gives for the same rows written."""
+    return _frame(COLUMNS, [to_record(r) for r in rows], list(range(2, len(rows) + 2)), Path("(rows)"))
+
+
+def _frame(header: list[str], records: list[dict], line_numbers: list[int], path: Path) -> pd.DataFrame:
+    df = pd.DataFrame(records, columns=header, dtype=object)
+    lines = np.array(line_numbers, dtype=int)
     for c in header:
         if c in TEXT:
             df[c] = df[c].astype(str)

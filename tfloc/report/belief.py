@@ -340,15 +340,13 @@ class Watch:
             return
         self.snapshot = take_snapshot(self.tracker, k, scan.scan_id, scan.ranges, self.angles, est, scan.true, {})
 
-    def result(self, rows: list[dict]) -> Snapshot | None:
-        """The snapshot with the row's estimate, prediction and ``info``; ``None`` if none was taken."""
+    def result(self, rows: list) -> Snapshot | None:
+        """The snapshot with the row's estimate, prediction and ``info`` (rows:
+        :class:`~tfloc.core.result.ResultRow`); ``None`` if none was taken."""
         import dataclasses
-        import json
 
         if self.snapshot is None:
             return None
         r = rows[self.snapshot.index]
-        pose = lambda p: Pose(float(r[f"{p}_x"]), float(r[f"{p}_y"]), float(r[f"{p}_theta"]))  # noqa: E731
-        info = r.get("info") or "{}"
-        return dataclasses.replace(self.snapshot, estimate=pose("est"), prediction=pose("init"),
-                                   info=json.loads(info) if isinstance(info, str) else dict(info))
+        return dataclasses.replace(self.snapshot, estimate=Pose(r.est_x, r.est_y, r.est_theta),
+                                   prediction=Pose(r.init_x, r.init_y, r.init_theta), info=dict(r.info or {}))

@@ -11,6 +11,7 @@ import pandas as pd
 
 from tfloc.core.thresholds import Thresholds
 from tfloc.evaluation.relocalization import free_area_m2, result_from_row, summarize
+from tfloc.io.estimates import status_kinds
 
 from .mdtable import num
 from .mdtable import table as md_table
@@ -30,7 +31,7 @@ def relocalization_section(df: pd.DataFrame, maps: dict[str, object], out_dir: P
     summary = summarize(results, area)
     pd.DataFrame([asdict(s) for s in summary]).to_csv(Path(out_dir) / "relocalization.csv", index=False,
                                                       float_format="%.6g")
-    invalid = df[df["status"].str.startswith("invalid:")].groupby("matcher").size()
+    invalid = df[status_kinds(df["status"]) == "invalid"].groupby("matcher").size()
     table = md_table(["dataset", "matcher", "n", "top-1 % [95 % CI]", "top-5 % [95 % CI]", "ambiguous %",
                       "no answer %", "CPU ms/scan (median)", "free area m²", "CPU ms per 100 m²"],
                      [[s.dataset, s.matcher, s.n, _pct(s.top1, s.top1_lo, s.top1_hi),

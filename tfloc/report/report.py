@@ -27,7 +27,7 @@ from tfloc.evaluation.summary import (
     write_summary,
 )
 from tfloc.harness.workspace import load_dataset, map_of
-from tfloc.io.estimates import status_kind
+from tfloc.io.estimates import status_kind, status_kinds
 from tfloc.io.lock import LOCK_NAME, find_lock, lock_differences, read_lock
 from tfloc.io.rundir import RunDir, RunInfo
 from tfloc.io.scenario import GLOBAL, SCAN_TO_SCAN, SEQUENCE
@@ -284,7 +284,7 @@ def render(run_dir: Path, run: dict, p: pd.DataFrame, thr: Thresholds, s2s: set[
         parts.append(landscape)
     parts.append("## Tasks without an answer (timeouts, errors)\n")
     parts.append(S.failures(p))
-    if p["status"].str.startswith("invalid:").any():
+    if (status_kinds(p["status"]) == "invalid").any():
         parts.append("## Tasks the data cannot pose (invalid)\n")
         parts.append("The scan's problem cannot be posed (e.g. its initial pose lies outside the map): no "
                      "matcher ran. These count as no-answer in the success rate, not as errors.\n")

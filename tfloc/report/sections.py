@@ -12,6 +12,7 @@ from tfloc.evaluation.metrics import summarize
 from tfloc.evaluation.outcome import OUTCOMES
 from tfloc.evaluation.paired import ALPHA
 from tfloc.evaluation.paper import PAPER_TF, TABLE_OF, paper_row
+from tfloc.io.estimates import status_kinds
 
 from .mdtable import num, pm, table
 
@@ -200,7 +201,7 @@ def runtime_only(g: pd.DataFrame) -> str:
 
 def failures(p: pd.DataFrame, limit: int = 5) -> str:
     """Timeouts and errors per matcher, with the most frequent error messages."""
-    bad = p[~p["status"].isin(["ok", "failed"]) & ~p["status"].str.startswith("invalid:")]
+    bad = p[status_kinds(p["status"]).isin(["timeout", "error"])]
     if bad.empty:
         return "No task timed out or raised an error.\n"
     out = []
@@ -230,7 +231,7 @@ def _p(p: float) -> str:
 def invalid(p: pd.DataFrame, limit: int = 5) -> str:
     """Tasks the data cannot pose (status ``invalid:``), per matcher, with their most frequent
     reasons (the ``file:line:`` of each is left out, so that equal reasons count together)."""
-    bad = p[p["status"].str.startswith("invalid:")]
+    bad = p[status_kinds(p["status"]) == "invalid"]
     out = []
     for matcher, g in bad.groupby("matcher", sort=True):
         why = g["status"].str.slice(len("invalid:")).str.replace(r"^\S*:\d+: ", "", regex=True)
