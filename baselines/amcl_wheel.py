@@ -50,7 +50,7 @@ from tfloc.errors import InvalidProblemError, ParameterError
 from tfloc.maps.cache import cached
 from tfloc.maps.grid import GridMap
 
-from ._amcl_map import VECTOR_MAP_RESOLUTION, amcl_grid  # noqa: F401 - shared with the port (amcl)
+from ._amcl_common import VECTOR_MAP_RESOLUTION, amcl_grid  # noqa: F401 - shared with the port (amcl)
 
 try:
     import amcl as _amcl

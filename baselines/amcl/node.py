@@ -1,12 +1,13 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later (a translation of nav2_amcl; see docs/baselines/amcl.md)
-"""``amcl``: Nav2's AMCL (``nav2_amcl``) ported to numba and run as a tracker, scan by scan.
+"""Translates ``nav2_amcl/src/amcl_node.cpp`` (``AmclNode``; ``include/nav2_amcl/amcl_node.hpp``):
+``amcl``, Nav2's AMCL ported to numba and run as a tracker, scan by scan.
 
-What runs is Nav2's filter as ``AmclNode`` drives it, ported function by function: ``pf.c``
-(KLD-sampling resampling, random-pose injection, kd-tree clustering), ``pf_pdf.c`` (``drand48``,
-Box–Muller), the differential and omni motion models, the likelihood-field (Nav2's default) and
-beam sensor models, the update gate ``shouldUpdateFilter``, the published pose = the heaviest
-cluster's mean, and global localization (particles uniform over free cells). Parameters carry
-Nav2's names and defaults, so ``--param`` reads like a Nav2 YAML. Units: metres, radians, seconds.
+What runs is Nav2's filter as ``AmclNode`` drives it; this module is the node: the parameters
+(Nav2's names and defaults, so ``--param`` reads like a Nav2 YAML), the update gate
+``shouldUpdateFilter``, initialisation (``handleInitialPose``, global localization: particles
+uniform over free cells), the published pose = the heaviest cluster's mean; the filter, maps,
+motion and laser models are the package's other modules, one per Nav2 source file
+(``pf/pf.py`` ↔ ``pf/pf.c``, …). Units: metres, radians, seconds.
 
 Why a port: the ``amcl`` wheel (``amcl-wheel``, the fidelity reference) compiles only the beam
 model, cannot set ``pf_err``/``pf_z``, publishes the whole set's mean, has no global
@@ -19,7 +20,7 @@ the odometry increments are integrated into an odometry pose; between filter upd
 is the last published one carried by the odometry (Nav2's map→odom transform); a start or
 ``reset`` pose is composed with the odometry up to the next scan (``handleInitialPose``).
 Departures (each a line in the code) and measurements: ``docs/baselines/amcl.md``. A translation
-of nav2_amcl's LGPL-2.1-or-later code, as are the ``_amcl_*`` modules (licence note in the docs).
+of nav2_amcl's LGPL-2.1-or-later code, as is every module of the package (licence note in the docs).
 """
 
 from __future__ import annotations
@@ -40,11 +41,17 @@ from tfloc.core.tracker import GLOBAL_START, START_KEY
 from tfloc.errors import InvalidProblemError, ParameterError
 from tfloc.maps.cache import cached
 
-from . import _amcl_motion as motion
-from . import _amcl_pf as pf
-from . import _amcl_sensor as sensor
-from ._amcl_map import NavMap, amcl_grid, nav_map, occ_dist
-from ._amcl_pdf import new_stream
+from .._amcl_common import amcl_grid
+from .angleutils import angle_diff
+from .map.map import NavMap, nav_map
+from .map.map_cspace import occ_dist
+from .motion_model.differential_motion_model import differential
+from .motion_model.omni_motion_model import omni
+from .pf import pf
+from .pf.pf_pdf import new_stream
+from .sensors.laser.beam_model import beam_model
+from .sensors.laser.laser import beam_step
+from .sensors.laser.likelihood_field_model import likelihood_field, likelihood_table
 
 DIFFERENTIAL = ("differential", "nav2_amcl::DifferentialMotionModel")
 OMNI = ("omni", "nav2_amcl::OmniMotionModel")
@@ -146,10 +153,10 @@ class AmclTracker:
         self._range_min = max(c.laser_min_range, 0.0)  # tfloc's laser reports no minimum range
         self._laser_max = float(laser.max_range)
         self._bearings = np.ascontiguousarray(laser.angles, dtype=float)
-        self._step = sensor.beam_step(self._bearings.size, c.max_beams)
+        self._step = beam_step(self._bearings.size, c.max_beams)
         if c.laser_model_type == "likelihood_field":
             key = ("amcl-likelihood", c.laser_likelihood_max_dist, c.z_hit, c.z_rand, c.sigma_hit, self._range_max)
-            self._table, self._off_map = cached(grid, key, lambda: sensor.likelihood_table(
+            self._table, self._off_map = cached(grid, key, lambda: likelihood_table(
                 occ_dist(grid, c.laser_likelihood_max_dist), c.z_hit, c.z_rand, c.sigma_hit,
                 self._range_max, c.laser_likelihood_max_dist))
         self._nav = nav
@@ -213,7 +220,7 @@ class AmclTracker:
             update = force = True
         else:
             delta = np.array([pose[0] - self._pf_odom[0], pose[1] - self._pf_odom[1],
-                              motion.angle_diff(pose[2], self._pf_odom[2])])
+                              angle_diff(pose[2], self._pf_odom[2])])
             update = bool(abs(delta[0]) > c.update_min_d or abs(delta[1]) > c.update_min_d
                           or abs(delta[2]) > c.update_min_a)
             if update:
@@ -301,9 +308,9 @@ class AmclTracker:
         c = self.config
         poses = self._set.poses.copy()
         if c.robot_model_type in OMNI:
-            motion.omni(self._rng, poses, pose, delta, c.alpha1, c.alpha2, c.alpha3, c.alpha4, c.alpha5)
+            omni(self._rng, poses, pose, delta, c.alpha1, c.alpha2, c.alpha3, c.alpha4, c.alpha5)
         else:
-            motion.differential(self._rng, poses, pose, delta, c.alpha1, c.alpha2, c.alpha3, c.alpha4)
+            differential(self._rng, poses, pose, delta, c.alpha1, c.alpha2, c.alpha3, c.alpha4)
         self._motion = (self._set.poses, poses, Pose.from_array(self._pf_odom).between(Pose.from_array(pose)))
         self._set = dataclasses.replace(self._set, poses=poses)
 
@@ -321,10 +328,10 @@ class AmclTracker:
         """The configured laser model: ``weights`` multiplied in place by each pose's factor; their sum."""
         c, nav = self.config, self._nav
         if c.laser_model_type == "beam":
-            return sensor.beam_model(poses, weights, scan, self._bearings, self._step, self._range_max,
+            return beam_model(poses, weights, scan, self._bearings, self._step, self._range_max,
                                      nav.occ_state, *nav.geometry, c.z_hit, c.z_short, c.z_max, c.z_rand,
                                      c.sigma_hit, c.lambda_short)
-        return sensor.likelihood_field(poses, weights, scan, self._bearings, self._step,
+        return likelihood_field(poses, weights, scan, self._bearings, self._step,
                                        self._range_max, self._table, self._off_map, *nav.geometry)
 
     def _scan(self, ranges: np.ndarray, where: str) -> np.ndarray:
