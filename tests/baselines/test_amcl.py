@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _amcl_cases import LASER, SPREAD, corridor, run_along
 from tfloc.baselines._amcl_common import amcl_grid
 from tfloc.baselines.amcl import AmclTracker
 from tfloc.baselines.amcl.map.map import nav_map
@@ -33,15 +34,12 @@ from tfloc.baselines.amcl.sensors.laser.likelihood_field_model import (
 )
 
 import tfloc
-from tfloc.core.laser import LaserSpec
 from tfloc.core.pose import Pose
 from tfloc.core.tracker import as_tracker, has_single_scan_mode, is_tracker
 from tfloc.errors import ParameterError
 from tfloc.maps.grid import GridMap
 
 MAPS = Path(__file__).resolve().parents[2] / "data" / "maps"
-LASER = LaserSpec.lms200()
-SPREAD = {"initial_sigma_xy": 0.5, "initial_sigma_theta": math.radians(15.0)}
 
 
 @pytest.fixture(scope="module")
@@ -55,19 +53,8 @@ def room():
 
 
 def run(vmap, truth: list[Pose], start: Pose, **params) -> tuple[np.ndarray, list, AmclTracker]:
-    """The tracker along ``truth`` (scans ray-cast in the grid AMCL gets, exact odometry): the
-    position errors (m), the estimates and the tracker."""
-    scans = amcl_grid(vmap).raycast(np.array([p.as_array() for p in truth]), LASER)
-    tracker = AmclTracker(**params)
-    tracker.start(vmap, LASER, start)
-    ests = [tracker.step(scans[k], truth[k - 1].between(p) if k else Pose(), 0.1 * k)
-            for k, p in enumerate(truth)]
-    return np.array([e.pose.distance_to(p) for e, p in zip(ests, truth, strict=True)]), ests, tracker
-
-
-def corridor(n: int = 170) -> list[Pose]:
-    """East along the office-1 corridor (y = 7.5 m), 0.1 m a scan."""
-    return [Pose(1.0 + 0.1 * k, 7.5, 0.0) for k in range(n)]
+    """An :class:`AmclTracker` along ``truth`` (:func:`_amcl_cases.run_along`)."""
+    return run_along(AmclTracker(**params), vmap, truth, start)
 
 
 def test_registered_as_the_amcl_tracker() -> None:
