@@ -25,8 +25,9 @@ the filter; the wheel's departures from Nav2 (``docs/baselines/amcl-wheel.md``),
 * No global localization; random particle injection draws from an unseeded ``std::mt19937``:
   such runs do not repeat.
 
-A vector map is rasterised at 5 cm (as a user exports it for Nav2), a grid map is used as it is;
-both are handed over in map_server's trinary form (occupied 100, free 0, unknown -1).
+A vector map is rasterised at 5 cm, a grid map used as it is, both handed over in map_server's
+trinary form (occupied 100, free 0, unknown -1); the grid, the scan's limits and the pose carried
+by the odometry are the port's code too (:mod:`tfloc.baselines._amcl_common`).
 """
 
 from __future__ import annotations
@@ -50,7 +51,7 @@ from tfloc.errors import InvalidProblemError, ParameterError
 from tfloc.maps.cache import cached
 from tfloc.maps.grid import GridMap
 
-from ._amcl_map import VECTOR_MAP_RESOLUTION, amcl_grid  # noqa: F401 - shared with the port (amcl)
+from ._amcl_common import ScanLimits, amcl_grid, carry, check_counts
 
 try:
     import amcl as _amcl
@@ -97,7 +98,7 @@ class Config:
     sigma_hit: float = 0.2  #: beam model: sd of the hit part (metres)
     lambda_short: float = 0.1  #: beam model: decay of the short part (1/m)
     laser_max_range: float = 100.0  #: range cap (metres; ≤ 0: the laser's)
-    laser_min_range: float = -1.0  #: ranges below are dropped (metres; < 0: none)
+    laser_min_range: float = -1.0  #: ranges at or below become the cap (metres; ≤ 0: none)
     update_min_d: float = 0.25  #: update after moving this far along x or y (metres)
     update_min_a: float = 0.2  #: ... or turning this far (radians)
     initial_sigma_xy: float = 0.0  #: sd of the initial particles in x and y (metres)
@@ -149,19 +150,14 @@ class AmclWheelTracker:
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
         self.config = resolve_params(Config, config, overrides)
         c = self.config
-        if c.min_particles > c.max_particles:
-            raise ParameterError(f"min_particles ({c.min_particles}) must not exceed max_particles "
-                                 f"({c.max_particles})", ("min_particles", "max_particles"))
+        check_counts(c.min_particles, c.max_particles, c.max_beams)
         if c.laser_model_type != "beam":
             raise ParameterError(f"laser_model_type must be 'beam', got {c.laser_model_type!r}: the amcl wheel "
                                  "compiles only AMCL's beam model (no likelihood field)", ("laser_model_type",))
-        if c.max_beams < 2:  # the beam model steps by (n - 1) / (max_beams - 1): 1 divides by zero
-            raise ParameterError(f"max_beams must be >= 2, got {c.max_beams}", ("max_beams",))
         if c.z_hit + c.z_short + c.z_max + c.z_rand <= 0:
             raise ParameterError("z_hit + z_short + z_max + z_rand must be > 0",
                                  ("z_hit", "z_short", "z_max", "z_rand"))
         self._filter = None
-        self._laser: LaserSpec | None = None
 
     # -- the Tracker protocol ------------------------------------------------------------------
     def start(self, map: Map, laser: LaserSpec, pose: Pose) -> None:
@@ -182,9 +178,8 @@ class AmclWheelTracker:
                        c.robot_model_type)
         f.set_map(occ)
         f.set_laser_pose(_amcl.Vector3D(0.0, 0.0, 0.0))
-        self._filter, self._laser = f, laser
-        self._range_max = (min(laser.max_range, c.laser_max_range) if c.laser_max_range > 0
-                           else laser.max_range)
+        self._filter = f
+        self._limits = ScanLimits.of(laser, c.laser_max_range, c.laser_min_range)
         self._bearings = np.asarray(laser.angles, dtype=float)
         self._odom = Pose(0.0, 0.0, 0.0)          # the integrated odometry (its own frame)
         self._odom_at_update: Pose | None = None  # odometry at the last filter update
@@ -208,11 +203,8 @@ class AmclWheelTracker:
         """The pose the next step starts from: the last estimate carried by the odometry."""
         if self._filter is None:
             raise RuntimeError("AmclWheelTracker.predict before start")
-        odom = self._odom.compose(odom_delta)
-        if self._init_at is not None:
-            pose, at = self._init_at
-            return pose.compose(at.between(odom))
-        return self._pose_at_update.compose(self._odom_at_update.between(odom))
+        pose, at = self._init_at or (self._pose_at_update, self._odom_at_update)
+        return carry(pose, at, self._odom.compose(odom_delta))
 
     def step(self, ranges: np.ndarray, odom_delta: Pose, stamp: float, where: str = "scan") -> Estimate:
         """One scan: integrate the odometry; update the filter when Nav2 would (the first scan,
@@ -222,19 +214,18 @@ class AmclWheelTracker:
             raise RuntimeError("AmclWheelTracker.step before start")
         self._odom = self._odom.compose(odom_delta)
         if self._init_at is not None:
-            pose, odom = self._init_at
-            self._initialise(pose.compose(odom.between(self._odom)))
+            self._initialise(carry(*self._init_at, self._odom))
             self._init_at = None
         update = self._odom_at_update is None or self._moved(self._odom_at_update, self._odom)
         if update:
-            self._filter.update(self._scan(ranges), _vec(self._odom))
+            self._filter.update(self._scan(ranges, where), _vec(self._odom))
             m = self._filter.get_pose_mean()
             self._pose_at_update = Pose(m.x, m.y, float(wrap_angle(m.theta)))
             self._odom_at_update = self._odom
             self.updates += 1
             pose = self._pose_at_update
         else:
-            pose = self._pose_at_update.compose(self._odom_at_update.between(self._odom))
+            pose = carry(self._pose_at_update, self._odom_at_update, self._odom)
         cov = np.array(self._filter.get_pose_covariance().to_list())
         info = {"updated": update, "cov_trace": float(np.trace(cov)),
                 "sigma_xy_m": float(math.sqrt(max(cov[0, 0] + cov[1, 1], 0.0))),
@@ -262,20 +253,11 @@ class AmclWheelTracker:
         return (abs(b.x - a.x) > c.update_min_d or abs(b.y - a.y) > c.update_min_d
                 or abs(float(wrap_angle(b.theta - a.theta))) > c.update_min_a)
 
-    def _scan(self, ranges: np.ndarray):  # noqa: ANN202 - an amcl.LaserScan
-        """The scan as Nav2 hands it to the sensor model (``AmclNode::updateFilter``): ``[range,
-        bearing]`` pairs; a no-return (inf, NaN, ≥ the laser's max range) is +inf, as a REP 117
-        driver reports it; readings ≤ the minimum range become ``range_max`` (Nav2: "amcl doesn't
-        (yet) have a concept of min range")."""
-        r = np.asarray(ranges, dtype=float)
-        if r.shape != self._bearings.shape:
-            raise InvalidProblemError(f"amcl: scan has {r.size} ranges, the laser {self._bearings.size} beams")
-        rmax = self._range_max
-        rmin = max(self.config.laser_min_range, 0.0)
-        with np.errstate(invalid="ignore"):
-            r = np.where(np.isfinite(r) & (r < self._laser.max_range), r, np.inf)
-            r = np.where(r <= rmin, rmax, r)
-        scan = _amcl.LaserScan(r.size, rmax)
+    def _scan(self, ranges: np.ndarray, where: str):  # noqa: ANN202 - an amcl.LaserScan
+        """The scan as Nav2 hands it to the sensor model (``AmclNode::updateFilter``, the ranges as
+        :class:`~tfloc.baselines._amcl_common.ScanLimits` leaves them): ``[range, bearing]`` pairs."""
+        r = self._limits.apply(ranges, where)
+        scan = _amcl.LaserScan(r.size, self._limits.range_max)
         scan.ranges = np.column_stack((r, self._bearings)).tolist()
         return scan
 

@@ -16,24 +16,30 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from tfloc.baselines import _amcl_kdtree as kd
-from tfloc.baselines import _amcl_motion as motion
-from tfloc.baselines import _amcl_pf as pf
-from tfloc.baselines import _amcl_sensor as sensor
-from tfloc.baselines._amcl_map import amcl_grid, nav_map, occ_dist
-from tfloc.baselines._amcl_pdf import drand48, new_stream
+from _amcl_cases import LASER, SPREAD, corridor, run_along
+from tfloc.baselines._amcl_common import amcl_grid
 from tfloc.baselines.amcl import AmclTracker
+from tfloc.baselines.amcl.map.map import nav_map
+from tfloc.baselines.amcl.map.map_cspace import occ_dist
+from tfloc.baselines.amcl.map.map_range import calc_range
+from tfloc.baselines.amcl.motion_model.differential_motion_model import differential
+from tfloc.baselines.amcl.motion_model.omni_motion_model import omni
+from tfloc.baselines.amcl.pf import pf
+from tfloc.baselines.amcl.pf import pf_kdtree as kd
+from tfloc.baselines.amcl.pf.pf_pdf import drand48, new_stream
+from tfloc.baselines.amcl.sensors.laser.beam_model import beam_model
+from tfloc.baselines.amcl.sensors.laser.likelihood_field_model import (
+    likelihood_field,
+    likelihood_table,
+)
 
 import tfloc
-from tfloc.core.laser import LaserSpec
 from tfloc.core.pose import Pose
 from tfloc.core.tracker import as_tracker, has_single_scan_mode, is_tracker
 from tfloc.errors import ParameterError
 from tfloc.maps.grid import GridMap
 
 MAPS = Path(__file__).resolve().parents[2] / "data" / "maps"
-LASER = LaserSpec.lms200()
-SPREAD = {"initial_sigma_xy": 0.5, "initial_sigma_theta": math.radians(15.0)}
 
 
 @pytest.fixture(scope="module")
@@ -47,19 +53,8 @@ def room():
 
 
 def run(vmap, truth: list[Pose], start: Pose, **params) -> tuple[np.ndarray, list, AmclTracker]:
-    """The tracker along ``truth`` (scans ray-cast in the grid AMCL gets, exact odometry): the
-    position errors (m), the estimates and the tracker."""
-    scans = amcl_grid(vmap).raycast(np.array([p.as_array() for p in truth]), LASER)
-    tracker = AmclTracker(**params)
-    tracker.start(vmap, LASER, start)
-    ests = [tracker.step(scans[k], truth[k - 1].between(p) if k else Pose(), 0.1 * k)
-            for k, p in enumerate(truth)]
-    return np.array([e.pose.distance_to(p) for e, p in zip(ests, truth, strict=True)]), ests, tracker
-
-
-def corridor(n: int = 170) -> list[Pose]:
-    """East along the office-1 corridor (y = 7.5 m), 0.1 m a scan."""
-    return [Pose(1.0 + 0.1 * k, 7.5, 0.0) for k in range(n)]
+    """An :class:`AmclTracker` along ``truth`` (:func:`_amcl_cases.run_along`)."""
+    return run_along(AmclTracker(**params), vmap, truth, start)
 
 
 def test_registered_as_the_amcl_tracker() -> None:
@@ -116,14 +111,14 @@ def test_likelihood_field_weights_at_known_distances() -> None:
     grid = wall_grid()
     nav = nav_map(grid)
     z_hit, z_rand, sigma, rmax, cap = 0.6, 0.3, 0.2, 8.0, 0.5
-    table, off = sensor.likelihood_table(occ_dist(grid, cap), z_hit, z_rand, sigma, rmax, cap)
+    table, off = likelihood_table(occ_dist(grid, cap), z_hit, z_rand, sigma, rmax, cap)
     pose = np.array([[0.52, 1.03, 0.0]])
     # x = 0.82: Nav2's MAP_GXWX gives floor(8.2 + 0.5) = cell 8 (two from the wall), although the
     # point lies in map_server's cell 8 too; x = 0.96 lies in cell 9 but Nav2 reads cell 10 (the wall)
     ranges = np.array([0.30, 0.44, 5.0, np.inf])
     bearings = np.zeros(4)
     w = np.ones(1)
-    total = sensor.likelihood_field(pose, w, ranges, bearings, 1, rmax, table, off, *nav.geometry)
+    total = likelihood_field(pose, w, ranges, bearings, 1, rmax, table, off, *nav.geometry)
 
     def pz3(z: float) -> float:
         return (z_hit * math.exp(-(z * z) / (2 * sigma * sigma)) + z_rand / rmax) ** 3
@@ -132,7 +127,7 @@ def test_likelihood_field_weights_at_known_distances() -> None:
     assert total == w[0] and w[0] == pytest.approx(expected, rel=1e-14)
     # a weight is multiplied, not replaced; a reading at range_max is ignored
     w = np.array([0.25])
-    sensor.likelihood_field(pose, w, np.array([rmax, np.nan]), np.zeros(2), 1, rmax, table, off, *nav.geometry)
+    likelihood_field(pose, w, np.array([rmax, np.nan]), np.zeros(2), 1, rmax, table, off, *nav.geometry)
     assert w[0] == 0.25
 
 
@@ -142,10 +137,10 @@ def test_beam_model_weights_a_known_range() -> None:
     grid = wall_grid()
     nav = nav_map(grid)
     pose = np.array([[0.52, 1.03, 0.0]])
-    expected_range = sensor.calc_range(nav.occ_state, *nav.geometry, 0.52, 1.03, 0.0, 8.0)
+    expected_range = calc_range(nav.occ_state, *nav.geometry, 0.52, 1.03, 0.0, 8.0)
     assert expected_range == pytest.approx(0.5)  # cells 5 → 10, Nav2's cell centres
     w = np.ones(1)
-    sensor.beam_model(pose, w, np.array([0.6]), np.zeros(1), 1, 8.0, nav.occ_state, *nav.geometry,
+    beam_model(pose, w, np.array([0.6]), np.zeros(1), 1, 8.0, nav.occ_state, *nav.geometry,
                       0.5, 0.05, 0.05, 0.5, 0.2, 0.1)
     z = 0.6 - expected_range
     assert w[0] == pytest.approx(1.0 + (0.5 * math.exp(-z * z / 0.08) + 0.5 / 8.0) ** 3, rel=1e-14)
@@ -259,9 +254,9 @@ def moments(model: str, delta: tuple, n: int = 200_000, **alphas) -> tuple[np.nd
     a = {"alpha1": 0.0, "alpha2": 0.0, "alpha3": 0.0, "alpha4": 0.0, "alpha5": 0.0, **alphas}
     d = np.array(delta, dtype=float)
     if model == "omni":
-        motion.omni(new_stream(7), poses, d, d, a["alpha1"], a["alpha2"], a["alpha3"], a["alpha4"], a["alpha5"])
+        omni(new_stream(7), poses, d, d, a["alpha1"], a["alpha2"], a["alpha3"], a["alpha4"], a["alpha5"])
     else:
-        motion.differential(new_stream(7), poses, d, d, a["alpha1"], a["alpha2"], a["alpha3"], a["alpha4"])
+        differential(new_stream(7), poses, d, d, a["alpha1"], a["alpha2"], a["alpha3"], a["alpha4"])
     return poses.mean(axis=0), poses.var(axis=0)
 
 

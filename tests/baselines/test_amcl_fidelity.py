@@ -22,12 +22,14 @@ import pytest
 from scipy import stats
 
 pytest.importorskip("amcl")
-from tfloc.baselines import _amcl_motion as motion  # noqa: E402
-from tfloc.baselines import _amcl_pf as pf  # noqa: E402
-from tfloc.baselines import _amcl_sensor as sensor  # noqa: E402
-from tfloc.baselines._amcl_map import amcl_grid, nav_map  # noqa: E402
-from tfloc.baselines._amcl_pdf import new_stream, srand48  # noqa: E402
+from tfloc.baselines._amcl_common import amcl_grid  # noqa: E402
 from tfloc.baselines.amcl import AmclTracker  # noqa: E402
+from tfloc.baselines.amcl.map.map import nav_map  # noqa: E402
+from tfloc.baselines.amcl.motion_model.differential_motion_model import differential  # noqa: E402
+from tfloc.baselines.amcl.pf import pf  # noqa: E402
+from tfloc.baselines.amcl.pf.pf_pdf import new_stream, srand48  # noqa: E402
+from tfloc.baselines.amcl.sensors.laser.beam_model import beam_model  # noqa: E402
+from tfloc.baselines.amcl.sensors.laser.laser import beam_step  # noqa: E402
 from tfloc.baselines.amcl_wheel import AmclWheelTracker, _pdf_seed_counter  # noqa: E402
 
 from tfloc.core.pose import Pose  # noqa: E402
@@ -58,7 +60,7 @@ def test_the_port_is_the_wheels_filter_bit_for_bit() -> None:
     nav = nav_map(amcl_grid(vmap))
     bearings = np.asarray(sc.laser.angles, dtype=float)
     rmax = sc.laser.max_range
-    step = sensor.beam_step(bearings.size, 60)
+    step = beam_step(bearings.size, 60)
     odom, prev, s, rng = Pose(), None, None, None
     for k, (scan, d) in enumerate(zip(scans, odom_deltas(scans), strict=True)):
         wheel.step(scan.ranges, d, 0.1 * k)
@@ -72,11 +74,11 @@ def test_the_port_is_the_wheels_filter_bit_for_bit() -> None:
         dth = pose[2] - prev[2]
         delta = np.array([pose[0] - prev[0], pose[1] - prev[1], math.atan2(math.sin(dth), math.cos(dth))])
         poses = s.poses.copy()  # the wheel moves the particles on every update, the first included
-        motion.differential(rng, poses, pose, delta, 0.2, 0.2, 0.2, 0.2)
+        differential(rng, poses, pose, delta, 0.2, 0.2, 0.2, 0.2)
         r = np.asarray(scan.ranges, dtype=float)
         r = np.where(np.isfinite(r) & (r < rmax), r, np.inf)
         w = s.weights.copy()
-        total = sensor.beam_model(poses, w, r, bearings, step, rmax, nav.occ_state, *nav.geometry,
+        total = beam_model(poses, w, r, bearings, step, rmax, nav.occ_state, *nav.geometry,
                                   0.5, 0.05, 0.05, 0.5, 0.2, 0.1)
         pf.normalise(w, total, 0.0, 0.0, 0.0, 0.0)
         s, _, _, _ = pf.resample(rng, dataclasses.replace(s, poses=poses, weights=w), 0.0, 0.0, 500, 2000,

@@ -14,20 +14,19 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _amcl_cases import LASER, SPREAD, corridor, run_along
 
 import tfloc
-from tfloc.core.laser import LaserSpec
 from tfloc.core.pose import Pose
 from tfloc.core.tracker import as_tracker, has_single_scan_mode, is_tracker
 from tfloc.errors import ParameterError
 
 pytest.importorskip("amcl")
 import amcl._amcl_impl  # noqa: E402
-from tfloc.baselines.amcl_wheel import AmclWheelTracker, _pdf_seed_counter, amcl_grid  # noqa: E402
+from tfloc.baselines._amcl_common import amcl_grid  # noqa: E402
+from tfloc.baselines.amcl_wheel import AmclWheelTracker, _pdf_seed_counter  # noqa: E402
 
 OFFICE = Path(__file__).resolve().parents[2] / "data" / "maps" / "office-1.geojson"
-LASER = LaserSpec.lms200()
-SPREAD = {"initial_sigma_xy": 0.5, "initial_sigma_theta": math.radians(15.0)}
 
 
 @pytest.fixture(scope="module")
@@ -38,20 +37,8 @@ def office():
 
 
 def track(vmap, truth: list[Pose], start: Pose, **params) -> tuple[np.ndarray, list, AmclWheelTracker]:
-    """Run the tracker along ``truth`` (scans ray-cast in the grid AMCL gets, exact odometry);
-    the position errors (m), the estimates and the tracker."""
-    grid = amcl_grid(vmap)
-    scans = grid.raycast(np.array([p.as_array() for p in truth]), LASER)
-    tracker = AmclWheelTracker(**params)
-    tracker.start(vmap, LASER, start)
-    ests = [tracker.step(scans[k], truth[k - 1].between(p) if k else Pose(0.0, 0.0, 0.0), 0.2 * k)
-            for k, p in enumerate(truth)]
-    return np.array([e.pose.distance_to(p) for e, p in zip(ests, truth, strict=True)]), ests, tracker
-
-
-def corridor(n: int = 170) -> list[Pose]:
-    """East along the office-1 corridor (y = 7.5 m, columns and doors on both sides), 0.1 m a scan."""
-    return [Pose(1.0 + 0.1 * k, 7.5, 0.0) for k in range(n)]
+    """An :class:`AmclWheelTracker` along ``truth`` (:func:`_amcl_cases.run_along`)."""
+    return run_along(AmclWheelTracker(**params), vmap, truth, start)
 
 
 def test_registered_as_a_tracker_without_a_single_scan_mode() -> None:

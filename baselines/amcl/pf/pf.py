@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later (a translation of nav2_amcl; see docs/baselines/amcl.md)
-"""Nav2's particle filter (``nav2_amcl/src/pf/pf.c``): initialisation, the sensor update's
-normalisation and running averages, KLD-sampling resampling with random-pose injection, and the
-cluster statistics the published pose comes from. Compiled with numba; a sample set is a
+"""Translates ``nav2_amcl/src/pf/pf.c`` (and ``AmclNode::uniformPoseGenerator`` of ``amcl_node.cpp``,
+the random-pose function pf.c calls back): Nav2's particle filter. Initialisation, the sensor
+update's normalisation and running averages, KLD-sampling resampling with random-pose injection,
+and the cluster statistics the published pose comes from. Compiled with numba; a sample set is a
 :class:`SampleSet` value, each step makes a new one.
 
 * ``pf_init`` (Gaussian around a pose) and ``pf_init_model`` (Nav2's ``uniformPoseGenerator``:
@@ -13,9 +14,9 @@ cluster statistics the published pose comes from. Compiled with numba; a sample 
   w_slow)`` a random pose, else a copy drawn from the weights) into a fresh kd-tree until the
   count exceeds ``pf_resample_limit(k)`` of its ``k`` bins (Fox's KLD bound) or reaches
   ``max_samples``; the averages reset after an injection; weights uniform.
-* ``pf_cluster_stats``: per cluster of the kd-tree (:mod:`tfloc.baselines._amcl_kdtree`) and for
-  the whole set: weight, mean (heading by its mean cosine and sine) and covariance (x, y, and
-  ``−2 ln R`` for the heading, R the unnormalised resultant length, as pf.c).
+* ``pf_cluster_stats``: per cluster of the kd-tree (:mod:`.pf_kdtree`) and for the whole set:
+  weight, mean (heading by its mean cosine and sine) and covariance (x, y, and ``−2 ln R`` for the
+  heading, R the unnormalised resultant length, as pf.c).
 
 Departure: the weighted draw finds the sample by bisection of the cumulative weights (the same
 sample as Nav2's linear scan, ``O(log n)`` instead of ``O(n)``); a draw beyond the last cumulative
@@ -30,8 +31,8 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from . import _amcl_kdtree as kd
-from ._amcl_pdf import drand48, gaussian_samples
+from . import pf_kdtree as kd
+from .pf_pdf import drand48, gaussian_samples
 
 
 @dataclass(frozen=True, eq=False)
@@ -217,7 +218,7 @@ def init_gaussian(state: np.ndarray, mean: np.ndarray, cov: np.ndarray, max_samp
 def init_uniform(state: np.ndarray, free_cells: np.ndarray, geometry: tuple, max_samples: int) -> SampleSet:
     """``pf_init_model`` with the uniform pose generator over ``free_cells`` (Nav2's global
     localization), weights ``1 / max_samples``; ``geometry`` as
-    :attr:`~tfloc.baselines._amcl_map.NavMap.geometry`."""
+    :attr:`~tfloc.baselines.amcl.map.map.NavMap.geometry`."""
     poses = _uniform_poses(state, free_cells, *geometry, max_samples)
     return clustered(poses, np.full(max_samples, 1.0 / max_samples))
 
@@ -313,7 +314,7 @@ def resample(state: np.ndarray, s: SampleSet, w_slow: float, w_fast: float, min_
              max_samples: int, pop_err: float, pop_z: float, free_cells: np.ndarray,
              geometry: tuple) -> tuple[SampleSet, float, float, int]:
     """``pf_update_resample``: the new set, ``w_slow``, ``w_fast`` and how many random poses were
-    injected; ``geometry`` as :attr:`~tfloc.baselines._amcl_map.NavMap.geometry`."""
+    injected; ``geometry`` as :attr:`~tfloc.baselines.amcl.map.map.NavMap.geometry`."""
     out, outw, bins, stats, conv, w_slow, w_fast, injected = _resample(
         state, s.poses, s.weights, w_slow, w_fast, min_samples, max_samples, pop_err, pop_z,
         free_cells, *geometry)

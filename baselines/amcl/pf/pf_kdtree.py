@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later (a translation of nav2_amcl; see docs/baselines/amcl.md)
-"""Nav2's pose histogram (``nav2_amcl/src/pf/pf_kdtree.c``), compiled with numba.
+"""Translates ``nav2_amcl/src/pf/pf_kdtree.c``: Nav2's pose histogram, compiled with numba.
 
 A pose falls in the bin ``floor((x, y, θ) / (0.5 m, 0.5 m, 10°))`` (θ as the particle carries it,
 not wrapped). The bins with samples are the leaves of a kd-tree, built insert by insert exactly as

@@ -1,12 +1,13 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later (a translation of nav2_amcl; see docs/baselines/amcl.md)
-"""``amcl``: Nav2's AMCL (``nav2_amcl``) ported to numba and run as a tracker, scan by scan.
+"""Translates ``nav2_amcl/src/amcl_node.cpp`` (``AmclNode``; ``include/nav2_amcl/amcl_node.hpp``):
+``amcl``, Nav2's AMCL ported to numba and run as a tracker, scan by scan.
 
-What runs is Nav2's filter as ``AmclNode`` drives it, ported function by function: ``pf.c``
-(KLD-sampling resampling, random-pose injection, kd-tree clustering), ``pf_pdf.c`` (``drand48``,
-Box–Muller), the differential and omni motion models, the likelihood-field (Nav2's default) and
-beam sensor models, the update gate ``shouldUpdateFilter``, the published pose = the heaviest
-cluster's mean, and global localization (particles uniform over free cells). Parameters carry
-Nav2's names and defaults, so ``--param`` reads like a Nav2 YAML. Units: metres, radians, seconds.
+What runs is Nav2's filter as ``AmclNode`` drives it; this module is the node: the parameters
+(Nav2's names and defaults, so ``--param`` reads like a Nav2 YAML), the update gate
+``shouldUpdateFilter``, initialisation (``handleInitialPose``, global localization: particles
+uniform over free cells), the published pose = the heaviest cluster's mean; the filter, maps,
+motion and laser models are the package's other modules, one per Nav2 source file
+(``pf/pf.py`` ↔ ``pf/pf.c``, …). Units: metres, radians, seconds.
 
 Why a port: the ``amcl`` wheel (``amcl-wheel``, the fidelity reference) compiles only the beam
 model, cannot set ``pf_err``/``pf_z``, publishes the whole set's mean, has no global
@@ -14,12 +15,13 @@ initialisation and draws injected poses from ``std::random_device``. Here every 
 one ``drand48`` stream per filter, reseeded with ``seed + i`` at the i-th (re)initialisation (as
 ``pf_pdf_gaussian_alloc`` reseeds with a counter): a run repeats bit for bit.
 
-Around the filter, as ``amcl-wheel``: a vector map is rasterised at 5 cm, a grid used as given;
-the odometry increments are integrated into an odometry pose; between filter updates the estimate
-is the last published one carried by the odometry (Nav2's map→odom transform); a start or
-``reset`` pose is composed with the odometry up to the next scan (``handleInitialPose``).
+Around the filter, as ``amcl-wheel`` and with its code (:mod:`tfloc.baselines._amcl_common`): a
+vector map is rasterised at 5 cm, a grid used as given; the odometry increments are integrated
+into an odometry pose; between filter updates the estimate is the last published one carried by
+the odometry (Nav2's map→odom transform); a start or ``reset`` pose is composed with the odometry
+up to the next scan (``handleInitialPose``).
 Departures (each a line in the code) and measurements: ``docs/baselines/amcl.md``. A translation
-of nav2_amcl's LGPL-2.1-or-later code, as are the ``_amcl_*`` modules (licence note in the docs).
+of nav2_amcl's LGPL-2.1-or-later code, as is every module of the package (licence note in the docs).
 """
 
 from __future__ import annotations
@@ -37,14 +39,20 @@ from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate
 from tfloc.core.tracker import GLOBAL_START, START_KEY
-from tfloc.errors import InvalidProblemError, ParameterError
+from tfloc.errors import InvalidProblemError
 from tfloc.maps.cache import cached
 
-from . import _amcl_motion as motion
-from . import _amcl_pf as pf
-from . import _amcl_sensor as sensor
-from ._amcl_map import NavMap, amcl_grid, nav_map, occ_dist
-from ._amcl_pdf import new_stream
+from .._amcl_common import ScanLimits, amcl_grid, carry, check_counts
+from .angleutils import angle_diff
+from .map.map import NavMap, nav_map
+from .map.map_cspace import occ_dist
+from .motion_model.differential_motion_model import differential
+from .motion_model.omni_motion_model import omni
+from .pf import pf
+from .pf.pf_pdf import new_stream
+from .sensors.laser.beam_model import beam_model
+from .sensors.laser.laser import beam_step
+from .sensors.laser.likelihood_field_model import likelihood_field, likelihood_table
 
 DIFFERENTIAL = ("differential", "nav2_amcl::DifferentialMotionModel")
 OMNI = ("omni", "nav2_amcl::OmniMotionModel")
@@ -111,11 +119,7 @@ class AmclTracker:
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
         self.config = resolve_params(Config, config, overrides)
         c = self.config
-        if c.min_particles > c.max_particles:  # Nav2 warns and raises max_particles instead
-            raise ParameterError(f"min_particles ({c.min_particles}) must not exceed max_particles "
-                                 f"({c.max_particles})", ("min_particles", "max_particles"))
-        if c.max_beams < 2:  # Nav2 then skips the sensor update without a word
-            raise ParameterError(f"max_beams must be >= 2, got {c.max_beams}", ("max_beams",))
+        check_counts(c.min_particles, c.max_particles, c.max_beams)
         self._nav: NavMap | None = None
         self._weighed = self._scan_used = self._motion = None  # what the accessors read (start resets them)
         self.reproducible = True  #: runs with the same seed repeat bit for bit
@@ -141,15 +145,13 @@ class AmclTracker:
         drawn = c.global_localization or c.recovery_alpha_slow > 0 or c.recovery_alpha_fast > 0
         if drawn and nav.free_cells.size == 0:
             raise InvalidProblemError(f"amcl: {grid.name} has no free cell to draw random poses from")
-        self._range_max = float(min(laser.max_range, c.laser_max_range) if c.laser_max_range > 0
-                                else laser.max_range)
-        self._range_min = max(c.laser_min_range, 0.0)  # tfloc's laser reports no minimum range
-        self._laser_max = float(laser.max_range)
+        self._limits = ScanLimits.of(laser, c.laser_max_range, c.laser_min_range)
+        self._range_max = self._limits.range_max
         self._bearings = np.ascontiguousarray(laser.angles, dtype=float)
-        self._step = sensor.beam_step(self._bearings.size, c.max_beams)
+        self._step = beam_step(self._bearings.size, c.max_beams)
         if c.laser_model_type == "likelihood_field":
             key = ("amcl-likelihood", c.laser_likelihood_max_dist, c.z_hit, c.z_rand, c.sigma_hit, self._range_max)
-            self._table, self._off_map = cached(grid, key, lambda: sensor.likelihood_table(
+            self._table, self._off_map = cached(grid, key, lambda: likelihood_table(
                 occ_dist(grid, c.laser_likelihood_max_dist), c.z_hit, c.z_rand, c.sigma_hit,
                 self._range_max, c.laser_likelihood_max_dist))
         self._nav = nav
@@ -179,11 +181,8 @@ class AmclTracker:
         """The pose the next step starts from: the last estimate carried by the odometry."""
         if self._nav is None:
             raise RuntimeError("AmclTracker.predict before start")
-        odom = self._odom.compose(odom_delta)
-        if self._pending is not None:
-            pose, at = self._pending
-            return pose.compose(at.between(odom))
-        return self._est.compose(self._est_odom.between(odom))
+        pose, at = self._pending or (self._est, self._est_odom)
+        return carry(pose, at, self._odom.compose(odom_delta))
 
     def reset(self, pose: Pose) -> None:
         """Put the belief at ``pose`` (the current scan's): the particles are drawn around it at
@@ -201,7 +200,7 @@ class AmclTracker:
         if self._nav is None:
             raise RuntimeError("AmclTracker.step before start")
         c = self.config
-        scan = self._scan(ranges, where)
+        scan = self._limits.apply(ranges, where)
         self._odom = self._odom.compose(odom_delta)
         pose = np.array([self._odom.x, self._odom.y, self._odom.theta])
         if self._pending is not None:
@@ -213,7 +212,7 @@ class AmclTracker:
             update = force = True
         else:
             delta = np.array([pose[0] - self._pf_odom[0], pose[1] - self._pf_odom[1],
-                              motion.angle_diff(pose[2], self._pf_odom[2])])
+                              angle_diff(pose[2], self._pf_odom[2])])
             update = bool(abs(delta[0]) > c.update_min_d or abs(delta[1]) > c.update_min_d
                           or abs(delta[2]) > c.update_min_a)
             if update:
@@ -233,7 +232,7 @@ class AmclTracker:
         if (resampled or force or not self._first_pose_sent) and k >= 0:
             self._est, self._est_odom = Pose.from_array(s.cluster_mean[k]), self._odom
             self._first_pose_sent = published = True
-        est = self._est if published else self._est.compose(self._est_odom.between(self._odom))
+        est = self._est if published else carry(self._est, self._est_odom, self._odom)
         info = {"updated": update, "resampled": resampled, "particles": s.count,
                 "clusters": int(s.cluster_weight.size), "bins": s.bins,
                 "cluster_weight": float(s.cluster_weight[k]) if k >= 0 else 0.0,
@@ -288,7 +287,7 @@ class AmclTracker:
         """``handleInitialPose``: ``pf_init`` around ``pose`` carried by the odometry since ``at``,
         covariance diag(σxy², σxy², σθ²)."""
         c = self.config
-        p = pose.compose(at.between(self._odom))
+        p = carry(pose, at, self._odom)
         cov = np.diag([c.initial_sigma_xy ** 2, c.initial_sigma_xy ** 2, c.initial_sigma_theta ** 2])
         self._rng = self._stream()
         self._set = pf.init_gaussian(self._rng, p.as_array(), cov, c.max_particles)
@@ -301,9 +300,9 @@ class AmclTracker:
         c = self.config
         poses = self._set.poses.copy()
         if c.robot_model_type in OMNI:
-            motion.omni(self._rng, poses, pose, delta, c.alpha1, c.alpha2, c.alpha3, c.alpha4, c.alpha5)
+            omni(self._rng, poses, pose, delta, c.alpha1, c.alpha2, c.alpha3, c.alpha4, c.alpha5)
         else:
-            motion.differential(self._rng, poses, pose, delta, c.alpha1, c.alpha2, c.alpha3, c.alpha4)
+            differential(self._rng, poses, pose, delta, c.alpha1, c.alpha2, c.alpha3, c.alpha4)
         self._motion = (self._set.poses, poses, Pose.from_array(self._pf_odom).between(Pose.from_array(pose)))
         self._set = dataclasses.replace(self._set, poses=poses)
 
@@ -321,19 +320,8 @@ class AmclTracker:
         """The configured laser model: ``weights`` multiplied in place by each pose's factor; their sum."""
         c, nav = self.config, self._nav
         if c.laser_model_type == "beam":
-            return sensor.beam_model(poses, weights, scan, self._bearings, self._step, self._range_max,
+            return beam_model(poses, weights, scan, self._bearings, self._step, self._range_max,
                                      nav.occ_state, *nav.geometry, c.z_hit, c.z_short, c.z_max, c.z_rand,
                                      c.sigma_hit, c.lambda_short)
-        return sensor.likelihood_field(poses, weights, scan, self._bearings, self._step,
+        return likelihood_field(poses, weights, scan, self._bearings, self._step,
                                        self._range_max, self._table, self._off_map, *nav.geometry)
-
-    def _scan(self, ranges: np.ndarray, where: str) -> np.ndarray:
-        """The ranges as ``AmclNode::updateFilter`` hands them over: a no-return (inf, NaN, ≥ the
-        laser's max range) is +inf (REP 117; NaN would poison the beam model's weights); a reading
-        at or below the minimum range becomes ``range_max``."""
-        r = np.asarray(ranges, dtype=float)
-        if r.shape != self._bearings.shape:
-            raise InvalidProblemError(f"{where}: amcl: scan has {r.size} ranges, the laser {self._bearings.size} beams")
-        with np.errstate(invalid="ignore"):
-            r = np.where(np.isfinite(r) & (r < self._laser_max), r, np.inf)
-            return np.ascontiguousarray(np.where(r <= self._range_min, self._range_max, r))
