@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-SOURCES = sorted([*(ROOT / "tfloc").rglob("*.py"), *(ROOT / "baselines").glob("*.py")])
+SOURCES = sorted([*(ROOT / "tfloc").rglob("*.py"), *(ROOT / "baselines").rglob("*.py")])
 MAX_LINES = 30
 
 
