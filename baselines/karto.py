@@ -12,7 +12,8 @@ wrapper's API and the measurements: ``docs/baselines/karto.md``):
   where a SLAM system's recorded scans would put the surface; the near face is biased short on
   thick walls.
 * **Two stages, Karto's loop-closure pattern**: a coarse search over the protocol's window without
-  penalties, then Karto's sequential defaults with its penalties.
+  penalties, then Karto's sequential defaults with its penalties (``coarse`` false: the latter
+  alone, as slam_toolbox's localization mode matches: preset ``karto-track``).
 * ``range_threshold`` = the laser's range (Karto's 40 m default sizes its grids for 40 m);
   ``converged`` = final response ≥ ``min_response``, a self-check.
 
@@ -64,6 +65,7 @@ class Config:
                  "min_response"),
         ("run-centre", "near-face"): ("base_surface",)}
 
+    coarse: bool = True  #: run the coarse stage first (false: the sequential matcher alone)
     coarse_search_size: float = 7.0  #: coarse stage: window width (metres: ±3.5 m, the protocol's)
     coarse_resolution: float = 0.1  #: coarse stage: cell (metres)
     coarse_smear_deviation: float = 0.1  #: coarse stage: Karto's smear deviation (metres)
@@ -145,13 +147,13 @@ class KartoMatcher:
         k.angle_variance_penalty, k.minimum_angle_penalty = c.angle_variance_penalty, c.minimum_angle_penalty
         return wrapper
 
-    def _stages(self) -> tuple[_Stage, _Stage]:
+    def _stages(self) -> tuple[_Stage, ...]:
         c = self.config
         coarse = _Stage(c.coarse_search_size, c.coarse_resolution, c.coarse_smear_deviation, False, True,
                         c.coarse_angle_offset_deg, c.use_response_expansion)
         fine = _Stage(c.fine_search_size, c.fine_resolution, c.fine_smear_deviation, True, True,
                       c.coarse_angle_offset_deg, c.use_response_expansion)
-        return coarse, fine
+        return (coarse, fine) if c.coarse else (fine,)
 
     def _threshold(self, laser: LaserSpec) -> float:
         return float(self.config.range_threshold or laser.max_range)
@@ -198,7 +200,7 @@ class KartoMatcher:
             responses.append(float(result.response))
         cov = np.asarray(result.covariance, dtype=float)
         return Estimate(pose, responses[-1] >= self.config.min_response, iterations=len(responses),
-                        info={"response": responses[-1], "coarse_response": responses[0],
+                        info={"response": responses[-1], "coarse_response": responses[0] if len(responses) > 1 else None,
                               "base_scans": len(base), "var_x_m2": float(cov[0, 0]),
                               "var_y_m2": float(cov[1, 1]), "var_theta_rad2": float(cov[2, 2])})
 

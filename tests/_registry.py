@@ -9,7 +9,14 @@ from importlib.metadata import entry_points
 
 import pytest
 
-from tfloc.core.matcher import GROUP, available_matchers, get_matcher, solves_global
+from tfloc.core.matcher import (
+    GROUP,
+    TRACKER,
+    available_matchers,
+    get_matcher,
+    kind_of,
+    solves_global,
+)
 from tfloc.core.tracker import has_single_scan_mode
 from tfloc.errors import LibraryMissingError
 
@@ -34,9 +41,10 @@ def build(name: str, **params):
 
 
 def kind(matcher) -> str:
-    """``tracker`` (start/step, no single-scan mode), ``global`` (answers problems without an
-    initial guess) or ``local``."""
-    if not has_single_scan_mode(matcher):
+    """``tracker`` (start/step, no single-scan mode, or a declared ``kind`` tracker: a matcher
+    that pulls towards its guess and is meant for sequences, e.g. ``cartographer-local``),
+    ``global`` (answers problems without an initial guess) or ``local``."""
+    if not has_single_scan_mode(matcher) or kind_of(matcher) == TRACKER:
         return "tracker"
     return "global" if solves_global(matcher) else "local"
 
@@ -45,5 +53,5 @@ def single_scan(name: str):
     """The matcher ``name`` for a single-scan test, or skip it if it is a tracker."""
     matcher = build(name)
     if kind(matcher) == "tracker":
-        pytest.skip("a tracker has no single-scan mode")
+        pytest.skip("a tracker: no single-scan mode, or meant for sequences only")
     return matcher
