@@ -9,8 +9,8 @@ the laser and the configuration alone (built once per map): per scan, one dispat
 
 Same arithmetic, same order, same kernels: the poses and costs are those of the staged path bit
 for bit (``tests/tfplus/test_pipeline.py`` runs both). The plan covers the default stage
-switches only (turning-function seeds and the heading sweep, the coarse grid, the refinement,
-``select="residual"``; on a vector map against virtual scans or the map itself, on a grid map
+switches (the heading sweep with or without turning-function seeds, the coarse grid, the
+refinement, ``select="residual"``; on a vector map against virtual scans or the map itself, on a grid map
 against the map itself); every other configuration, another kind of map, or a vector map whose
 free-space tests are not built, goes the staged way (:func:`plan_for` returns ``None``), and so
 does a scan whose lattice the compiled free-space test cannot decide (status
@@ -96,8 +96,7 @@ def plan_for(problem: Problem, cfg: TfPlusConfig) -> Plan | None:
 
 def _plan_of(map_: object, laser: LaserSpec, cfg: TfPlusConfig) -> Plan | None:
     """:func:`plan_for` without its memo of the last call."""
-    if not (cfg.tf_seed and cfg.heading_sweep and cfg.grid and cfg.refine
-            and cfg.select == "residual"):
+    if not (cfg.heading_sweep and cfg.grid and cfg.refine and cfg.select == "residual"):
         return None
     if isinstance(map_, VectorMap):
         if map_.area_rings() is None or map_.free_rings() is None:
@@ -126,7 +125,8 @@ def _build(map_: VectorMap | GridMap, laser: LaserSpec, cfg: TfPlusConfig, kind:
                 float(shape.line_threshold), bool(shape.close_through_origin),
                 shape.resampling == "path", _BINS, True, _pair_kernel(_BINS, _SMOOTHING),
                 int(np.floor(cfg.max_rotation / width)), int(cfg.rotation_seeds))
-    headings = (sweep(cfg.heading_span, cfg.heading_step), heading_offsets(cfg.heading_offsets))
+    headings = (sweep(cfg.heading_span, cfg.heading_step), heading_offsets(cfg.heading_offsets),
+                bool(cfg.tf_seed))
     corner = field.origin
     lattice = (_offsets(float(cfg.search_radius), float(cfg.grid_step)), field.table,
                float(corner[0]), float(corner[1]), field.resolution,
@@ -191,7 +191,11 @@ def _headings(theta: float, sweep: np.ndarray, offsets: np.ndarray, rotations: n
 def _seeded_headings(ranges: np.ndarray, virtual: np.ndarray, theta: float, beams: tuple,
                      rotation: tuple, headings: tuple) -> tuple[np.ndarray, np.ndarray, bool]:
     """The turning-function rotations of the real scan against the virtual one at the VP
-    (:func:`tfloc.tfplus.headings._scan_rotations`) and the coarse search's headings."""
+    (:func:`tfloc.tfplus.headings._scan_rotations`) and the coarse search's headings; without
+    seeds (``tf_seed`` off: ``headings[2]``) the sweep alone, ``virtual`` unread."""
+    if not headings[2]:
+        none = np.empty(0)
+        return none, _headings(theta, headings[0], headings[1], none, False), False
     spacing, window, straw_t, line_threshold, close, along, bins, skip, g2, k_max, count = rotation
     rots, seeded = _scan_rotations(ranges, virtual, beams[1], beams[6], spacing, window, straw_t,
                                    line_threshold, close, along, bins, skip, g2, k_max, count)
@@ -222,7 +226,8 @@ def _vector_coarse(ranges: np.ndarray, x: float, y: float, theta: float, beams: 
     points = _returns_to_points(ranges, directions, max_range)
     if points.shape[0] < min_returns:
         return TOO_FEW, points, np.empty(0), False, np.empty((0, 3)), 0
-    virtual = raycast_segments(_at(x, y, theta), angles, segs, max_range, index)[0]
+    virtual = (raycast_segments(_at(x, y, theta), angles, segs, max_range, index)[0]
+               if headings[2] else ranges)
     rots, heads, seeded = _seeded_headings(ranges, virtual, theta, beams, rotation, headings)
     offsets, table, corner_x, corner_y, res, clearance = lattice
     positions, decided = lattice_kernel(x, y, offsets, table, corner_x, corner_y, res, clearance,
@@ -322,7 +327,8 @@ def grid_pipeline_kernel(ranges: np.ndarray, x: float, y: float, theta: float, b
     points = _returns_to_points(ranges, directions, max_range)
     if points.shape[0] < min_returns:
         return _no_poses(TOO_FEW, points.shape[0], np.empty(0), False)
-    virtual = raycast_grid(_at(x, y, theta), angles, occupied, gx, gy, cell, max_range)[0]
+    virtual = (raycast_grid(_at(x, y, theta), angles, occupied, gx, gy, cell, max_range)[0]
+               if headings[2] else ranges)
     rots, heads, seeded = _seeded_headings(ranges, virtual, theta, beams, rotation, headings)
     offsets, table, corner_x, corner_y, res, clearance = lattice
     positions = grid_lattice_kernel(x, y, offsets, table, corner_x, corner_y, res, clearance,
