@@ -45,7 +45,7 @@ CHANGED = {"free_distance": 0.05, "short_residual": 0.05, "see_through_share": 0
            "object_extent": 1.2}
 
 
-@pytest.mark.parametrize("overrides", [{}, {"beam_check": False},
+@pytest.mark.parametrize("overrides", [{}, {"beam_check": False}, {"tf_seed": False},
                                        {"refinement": {"prune_after": 0}},
                                        {"refinement": {"iterations": 3, "prune_after": 3, "keep": 1}},
                                        {"coarse_points": 0, "candidates": 2},
@@ -64,7 +64,7 @@ def test_pipeline_equals_the_stages_on_a_vector_map(overrides, test_room, lms200
         assert _same(fused, staged), (overrides, seed)
 
 
-@pytest.mark.parametrize("overrides", [{}, {"refinement": {"faces": False}},
+@pytest.mark.parametrize("overrides", [{}, {"refinement": {"faces": False}}, {"tf_seed": False},
                                        {"refinement": {"prune_after": 0}}, CHANGED,
                                        {**CHANGED, "beam_check": False}])
 def test_pipeline_equals_the_stages_on_a_grid_map(overrides, test_room, lms200, monkeypatch):
@@ -81,7 +81,9 @@ def test_pipeline_equals_the_stages_on_a_grid_map(overrides, test_room, lms200, 
 @pytest.mark.parametrize(("name", "overrides"), [
     ("office-pool", {}), ("real-intel-scan-to-map", {}), ("real-csail-scan-to-map", {}),
     ("changed-clutter-25", {**CHANGED, "refine_to": "field"}),
-    ("real-intel-scan-to-map", CHANGED)])
+    ("real-intel-scan-to-map", CHANGED),
+    ("real-csail-scan-to-map", {"tf_seed": False, "search_radius": 0.3, "heading_span": 0.16,
+                                "candidates": 1})])
 def test_pipeline_equals_the_stages_on_bundled_scans(name, overrides, monkeypatch):
     scenario, scans = load_dataset(str(ROOT / "data" / "scenarios" / name))
     items = list(scans.values())
@@ -103,7 +105,7 @@ def test_too_few_returns_is_the_same_no_answer(lms200, monkeypatch):
     assert fused == staged and fused.info["status"] == "no-answer" and "2 returns" in fused.info["reason"]
 
 
-@pytest.mark.parametrize("overrides", [{"tf_seed": False}, {"heading_sweep": False},
+@pytest.mark.parametrize("overrides", [{"heading_sweep": False},
                                        {"grid": False}, {"refine": False}, {"select": "tf"},
                                        {"select": "virtual"}])
 def test_other_configurations_go_the_staged_way(overrides, test_room, lms200):

@@ -1,7 +1,9 @@
-"""tf-plus-track: a jump must be earned, an impossible odometry increment is doubted."""
+"""tf-plus-track: a jump must be earned, an impossible odometry increment is doubted, a trusted
+prediction is searched in its window and widened when the answer does not fit."""
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
@@ -10,10 +12,13 @@ import pytest
 
 import tfloc
 from tfloc.core.pose import Pose
-from tfloc.core.problem import Estimate
-from tfloc.harness.track import track
-from tfloc.io.scenario import read_scans, read_scenario
-from tfloc.tfplus.tracker import TfPlusTracker
+from tfloc.core.problem import Estimate, Problem
+from tfloc.harness.track import odom_deltas, track
+from tfloc.harness.workspace import load_dataset, map_of
+from tfloc.io.scenario import map_for, read_scans, read_scenario
+from tfloc.tfplus import pipeline
+from tfloc.tfplus.matcher import TurningFunctionPlusMatcher
+from tfloc.tfplus.tracker import TfPlusTracker, window_config
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -30,9 +35,9 @@ class Stub:
         return Estimate(pose, True, info={"status": "ok", "cost": cost})
 
 
-def _tracker(far, near, **cfg) -> TfPlusTracker:
+def _tracker(far, near, window=None, **cfg) -> TfPlusTracker:
     t = TfPlusTracker(**cfg)
-    t.matcher, t.near = Stub(far), Stub(near)
+    t.matcher, t.near, t.window = Stub(far), Stub(near), Stub(window or far)
     room = tfloc.load_map(ROOT / "data" / "maps" / "test-room.geojson")
     t.start(room, tfloc.LaserSpec.lms200(), Pose(2.0, 2.0, 0.0))
     return t
@@ -69,13 +74,112 @@ def test_an_impossible_increment_is_also_tried_as_no_motion():
     assert not t2.step(RANGES, Pose(0.1, 0.0, 0.1), 0.0).info["doubted_odometry"]
 
 
-def test_tracks_a_simulated_sequence_like_tf_plus():
+def test_a_trusted_prediction_is_searched_in_its_window_and_widened_when_it_does_not_fit():
+    near_answer = lambda g: (Pose(g.x + 0.02, g.y, g.theta), 0.01**2)    # noqa: E731
+    t = _tracker(near_answer, near_answer, lambda g: (Pose(g.x + 0.01, g.y, g.theta), 0.03**2))
+    first = t.step(RANGES, Pose(0.1, 0.0, 0.0), 0.0)          # not trusted yet: the protocol's window
+    assert first.info["kept"] == "far" and not t.window.asked and t.trusted
+    est = t.step(RANGES, Pose(0.1, 0.0, 0.0), 0.0)            # trusted, and the window's answer fits
+    assert est.info["kept"] == "window" and not est.info["widened"] and len(t.matcher.asked) == 1
+    assert est.pose.x == pytest.approx(2.23) and est.info["score"] == pytest.approx(0.03)
+    t.window.answers = lambda g: (g, 0.08**2)                  # residual 8 cm > widen_score: no fit
+    est = t.step(RANGES, Pose(0.1, 0.0, 0.0), 0.0)
+    assert est.info["widened"] and est.info["kept"] == "far" and len(t.matcher.asked) == 2
+    t.window.answers = lambda g: (Pose(g.x + 0.6, g.y, g.theta), 0.01**2)  # fits, but a jump
+    est = t.step(RANGES, Pose(0.1, 0.0, 0.0), 0.0)
+    assert est.info["widened"] and est.info["kept"] == "far" and len(t.matcher.asked) == 3
+    asked = len(t.window.asked)
+    assert t.step(RANGES, Pose(0.6, 0.0, 0.0), 0.0).info["doubted_odometry"]   # doubted: no window
+    assert len(t.window.asked) == asked
+
+
+def test_an_answer_that_does_not_fit_is_no_trusted_prediction():
+    t = _tracker(lambda g: (g, 0.07**2), lambda g: (g, 0.07**2))
+    t.step(RANGES, Pose(0.1, 0.0, 0.0), 0.0)
+    t.step(RANGES, Pose(0.1, 0.0, 0.0), 0.0)
+    assert not t.trusted and not t.window.asked and len(t.matcher.asked) == 2
+    t = _tracker(lambda g: (g, 0.01**2), lambda g: (g, 0.01**2), trusted_window=False)
+    t.step(RANGES, Pose(0.1, 0.0, 0.0), 0.0)
+    t.step(RANGES, Pose(0.1, 0.0, 0.0), 0.0)
+    assert not t.window.asked and len(t.matcher.asked) == 2
+
+
+def _seq_quick(n: int):
     sc = read_scenario(ROOT / "data" / "scenarios" / "seq-quick")
-    scans = read_scans(sc)[:40]
-    a = track(sc, scans, tfloc.get_matcher("tf-plus-track"))
+    return sc, read_scans(sc)[:n]
+
+
+def test_tracks_a_simulated_sequence_like_tf_plus():
+    """Without the window, exactly ``tf-plus`` on an easy route (no jump); with it, the window's
+    answers from the second scan on, the same poses to a few millimetres."""
+    sc, scans = _seq_quick(40)
     b = track(sc, scans, tfloc.get_matcher("tf-plus"))
-    assert [r["est_x"] for r in a] == [r["est_x"] for r in b]        # no jump on an easy route
-    assert all(r["status"] == "ok" for r in a)
+    a = track(sc, scans, tfloc.get_matcher("tf-plus-track", trusted_window=False))
+    assert [r["est_x"] for r in a] == [r["est_x"] for r in b]
+    w = track(sc, scans, tfloc.get_matcher("tf-plus-track"))
+    assert [json.loads(r["info"])["kept"] for r in w] == ["far"] + ["window"] * 39
+    assert all(r["status"] == "ok" for r in a + w)
+    for r, q in zip(w, b, strict=True):
+        p, o = Pose(r["est_x"], r["est_y"], r["est_theta"]), Pose(q["est_x"], q["est_y"], q["est_theta"])
+        d, turn = p.error_to(o)
+        assert d < 0.005 and turn < math.radians(0.2)
+
+
+@pytest.mark.parametrize(("widen_score", "recovers"), [(0.06, True), (1.0, False)])
+def test_a_kidnapped_prediction_widens_and_recovers(widen_score, recovers):
+    """The robot is carried 1 m sideways while the tracker trusts its prediction: the window's
+    answer does not fit, the protocol's window finds the robot (a jump it earns). Never widened
+    (``widen_score`` above any residual), the tracker stays lost: the rule is what recovers."""
+    sc, scans = _seq_quick(32)
+    t = tfloc.get_matcher("tf-plus-track", widen_score=widen_score)
+    the_map = map_for(sc, scans[0], {})
+    t.warm(the_map, sc.laser, scans[0].ranges, scans[0].initial)
+    t.start(the_map, sc.laser, scans[0].initial)
+    deltas = odom_deltas(scans)
+    for k in range(30):
+        est = t.step(scans[k].ranges, deltas[k], scans[k].stamp)
+    assert t.trusted and est.info["kept"] == "window"
+    t.pose = scans[29].true.compose(Pose(0.0, -1.0, 0.0))     # kidnapped; the tracker still trusts
+    est = t.step(scans[30].ranges, deltas[30], scans[30].stamp)
+    d, turn = est.pose.error_to(scans[30].true)
+    assert est.info["widened"] == recovers
+    assert (d < 0.02 and turn < math.radians(1.0)) if recovers else d > 0.5
+
+
+def test_window_answers_equal_the_full_search_s():
+    """From a guess inside the window, where the full search's answer lies in the window too, the
+    window's answer is that pose (to the refinement's convergence: the coarse searches start it
+    from different lattice poses) or does not fit and is widened. MIT CSAIL's corrected scans."""
+    scenario, by_id = load_dataset(str(ROOT / "data" / "scenarios" / "real-csail-scan-to-map"))
+    scans = list(by_id.values())[::12]
+    t = TfPlusTracker()
+    full, cfg = TurningFunctionPlusMatcher(), t.config
+    rng = np.random.default_rng(3)
+    apart = []
+    for k, scan in enumerate(scans):
+        guess = scan.true.compose(Pose(*rng.uniform(-0.15, 0.15, 2), rng.uniform(-0.2, 0.2)))
+        p = Problem(map_of(scenario, scan), scenario.laser, scan.ranges, guess)
+        if k == 0:
+            t.window.prepare(p)
+            full.prepare(p)
+            assert pipeline.plan_for(p, t.window.config) is not None      # one compiled call
+        a, b = t.window.localize(p), full.localize(p)
+        if b.pose.distance_to(guess) > cfg.window_m or not abs(b.pose.theta - guess.theta) < cfg.window_rad:
+            continue
+        if math.sqrt(a.info["cost"]) > cfg.widen_score:
+            continue                                                # widened: the full search answers
+        d, turn = a.pose.error_to(b.pose)
+        assert d < 0.03 and turn < math.radians(1.0), (scan.scan_id, d, turn)
+        apart.append(d)
+    assert len(apart) >= 25 and float(np.median(apart)) < 0.002
+
+
+def test_the_window_is_tf_plus_in_a_smaller_window():
+    cfg = TfPlusTracker(window_m=0.25, window_rad=0.1).config
+    w = window_config(cfg)
+    assert (w.search_radius, w.heading_span, w.tf_seed, w.candidates) == (0.25, 0.1, False, 1)
+    assert w.refinement.gate_end == cfg.local.refinement.gate_end and w.refinement.iterations == 4
+    assert window_config(TfPlusTracker(window_m=9.0, window_rad=3.0).config).search_radius == cfg.local.search_radius
 
 
 def test_its_residual_is_tf_plus_score():

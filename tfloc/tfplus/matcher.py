@@ -90,6 +90,8 @@ def tf_errs(problem: Problem, poses: np.ndarray, cfg: TfPlusConfig) -> np.ndarra
 def pick(cost: np.ndarray, poses: np.ndarray, vp: Pose, tie_tolerance: float) -> int:
     """Index of the answer: the lowest ``cost``, or, among the candidates within a factor
     ``1 + tie_tolerance`` of it (the scan cannot tell them apart), the one nearest the VP."""
+    if len(cost) == 1:
+        return 0
     costs = [float(c) for c in cost]        # a handful of candidates: plain floats
     best = min(costs)
     tied = [i for i, c in enumerate(costs) if c <= best * (1.0 + tie_tolerance)]

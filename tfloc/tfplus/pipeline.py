@@ -9,8 +9,8 @@ the laser and the configuration alone (built once per map): per scan, one dispat
 
 Same arithmetic, same order, same kernels: the poses and costs are those of the staged path bit
 for bit (``tests/tfplus/test_pipeline.py`` runs both). The plan covers the default stage
-switches only (turning-function seeds and the heading sweep, the coarse grid, the refinement,
-``select="residual"``; on a vector map against virtual scans or the map itself, on a grid map
+switches (the heading sweep with or without turning-function seeds, the coarse grid, the
+refinement, ``select="residual"``; on a vector map against virtual scans or the map itself, on a grid map
 against the map itself); every other configuration, another kind of map, or a vector map whose
 free-space tests are not built, goes the staged way (:func:`plan_for` returns ``None``), and so
 does a scan whose lattice the compiled free-space test cannot decide (status
@@ -96,8 +96,7 @@ def plan_for(problem: Problem, cfg: TfPlusConfig) -> Plan | None:
 
 def _plan_of(map_: object, laser: LaserSpec, cfg: TfPlusConfig) -> Plan | None:
     """:func:`plan_for` without its memo of the last call."""
-    if not (cfg.tf_seed and cfg.heading_sweep and cfg.grid and cfg.refine
-            and cfg.select == "residual"):
+    if not (cfg.heading_sweep and cfg.grid and cfg.refine and cfg.select == "residual"):
         return None
     if isinstance(map_, VectorMap):
         if map_.area_rings() is None or map_.free_rings() is None:
@@ -126,7 +125,8 @@ def _build(map_: VectorMap | GridMap, laser: LaserSpec, cfg: TfPlusConfig, kind:
                 float(shape.line_threshold), bool(shape.close_through_origin),
                 shape.resampling == "path", _BINS, True, _pair_kernel(_BINS, _SMOOTHING),
                 int(np.floor(cfg.max_rotation / width)), int(cfg.rotation_seeds))
-    headings = (sweep(cfg.heading_span, cfg.heading_step), heading_offsets(cfg.heading_offsets))
+    headings = (sweep(cfg.heading_span, cfg.heading_step), heading_offsets(cfg.heading_offsets),
+                bool(cfg.tf_seed))
     corner = field.origin
     lattice = (_offsets(float(cfg.search_radius), float(cfg.grid_step)), field.table,
                float(corner[0]), float(corner[1]), field.resolution,
@@ -191,7 +191,11 @@ def _headings(theta: float, sweep: np.ndarray, offsets: np.ndarray, rotations: n
 def _seeded_headings(ranges: np.ndarray, virtual: np.ndarray, theta: float, beams: tuple,
                      rotation: tuple, headings: tuple) -> tuple[np.ndarray, np.ndarray, bool]:
     """The turning-function rotations of the real scan against the virtual one at the VP
-    (:func:`tfloc.tfplus.headings._scan_rotations`) and the coarse search's headings."""
+    (:func:`tfloc.tfplus.headings._scan_rotations`) and the coarse search's headings; without
+    seeds (``tf_seed`` off: ``headings[2]``) the sweep alone, ``virtual`` unread."""
+    if not headings[2]:
+        none = np.empty(0)
+        return none, _headings(theta, headings[0], headings[1], none, False), False
     spacing, window, straw_t, line_threshold, close, along, bins, skip, g2, k_max, count = rotation
     rots, seeded = _scan_rotations(ranges, virtual, beams[1], beams[6], spacing, window, straw_t,
                                    line_threshold, close, along, bins, skip, g2, k_max, count)
@@ -222,7 +226,8 @@ def _vector_coarse(ranges: np.ndarray, x: float, y: float, theta: float, beams: 
     points = _returns_to_points(ranges, directions, max_range)
     if points.shape[0] < min_returns:
         return TOO_FEW, points, np.empty(0), False, np.empty((0, 3)), 0
-    virtual = raycast_segments(_at(x, y, theta), angles, segs, max_range, index)[0]
+    virtual = (raycast_segments(_at(x, y, theta), angles, segs, max_range, index)[0]
+               if headings[2] else ranges)
     rots, heads, seeded = _seeded_headings(ranges, virtual, theta, beams, rotation, headings)
     offsets, table, corner_x, corner_y, res, clearance = lattice
     positions, decided = lattice_kernel(x, y, offsets, table, corner_x, corner_y, res, clearance,
@@ -241,14 +246,76 @@ def _groups(ranges: np.ndarray, beams: tuple, select: tuple) -> np.ndarray:
 
 @njit(cache=True, nogil=True)
 def _vector_cost(ranges: np.ndarray, cands: np.ndarray, beams: tuple, view: tuple, inlier: float,
-                 beam_check: bool, select: tuple, groups: np.ndarray, segs: np.ndarray,
-                 index: tuple) -> np.ndarray:
-    """The selection cost of the refined candidates on a vector map."""
-    angles, directions, max_range = beams[0], beams[1], beams[6]
+                 beam_check: bool, select: tuple, groups: np.ndarray, vector: tuple) -> np.ndarray:
+    """The selection cost of the candidates on a vector map (``vector``: its segments and their
+    index)."""
     nearest, fx, fy, fres, map_points, map_normals = view
-    return vector_cost_kernel(nearest, fx, fy, fres, map_points, map_normals, ranges, directions,
-                              angles, max_range, cands, segs, index, inlier, beam_check,
+    return vector_cost_kernel(nearest, fx, fy, fres, map_points, map_normals, ranges, beams[1],
+                              beams[0], beams[6], cands, vector[0], vector[1], inlier, beam_check,
                               select[0], select[1], select[2], groups)
+
+
+@njit(cache=True, nogil=True)
+def _grid_cost(ranges: np.ndarray, cands: np.ndarray, beams: tuple, view: tuple, inlier: float,
+               beam_check: bool, select: tuple, groups: np.ndarray, grid: tuple) -> np.ndarray:
+    """The selection cost of the candidates on a grid map (``grid``: the plan's grid tuple)."""
+    nearest, fx, fy, fres, map_points, map_normals = view
+    occupied, gx, gy, cell, free, _ = grid
+    return grid_cost_kernel(nearest, fx, fy, fres, map_points, map_normals, ranges, beams[1],
+                            beams[0], beams[6], cands, occupied, gx, gy, cell, inlier, beam_check,
+                            free, select[0], select[1], select[2], groups)
+
+
+@njit(cache=True, nogil=True)
+def _vector_short(ranges: np.ndarray, cands: np.ndarray, beams: tuple, inlier: float,
+                  gate: float, groups: np.ndarray, vector: tuple) -> np.ndarray:
+    """The short returns ``(K, n)`` at the candidates on a vector map (its ray-cast ranges)."""
+    virtual = raycast_segments(cands, beams[0], vector[0], beams[6], vector[1])
+    return vector_short_mask(ranges, virtual, beams[6], gate)
+
+
+@njit(cache=True, nogil=True)
+def _grid_short(ranges: np.ndarray, cands: np.ndarray, beams: tuple, inlier: float, gate: float,
+                groups: np.ndarray, grid: tuple) -> np.ndarray:
+    """The short returns ``(K, n)`` at the candidates on a grid map (the grid walk's)."""
+    occupied, gx, gy, cell, free, _ = grid
+    return beam_flags_kernel(occupied, free, gx, gy, cell, cands, beams[0], ranges, beams[6],
+                             inlier, gate, False, groups >= 0)[1]
+
+
+def _refined_kernel(cost, short):
+    """The refinement against the map itself for one kind of map, whose selection cost and short
+    returns are ``cost`` and ``short`` (the ``_vector_*`` or ``_grid_*`` kernels above):
+    :func:`refine_to_field_kernel`, or with a ``gate`` (``short_refine``) each candidate on its
+    own returns (:mod:`tfloc.tfplus.unmapped`), pruned by the selection cost between the gate's
+    two parts. numba resolves ``cost`` and ``short`` when it compiles a pipeline kernel, whose
+    cache then holds them; called from Python the kernel made here would compile in every process
+    (a closure's cache key pickles the jitted functions it holds, each with a per-process id)."""
+
+    @njit(cache=True, nogil=True)
+    def refined(ranges: np.ndarray, points: np.ndarray, cands: np.ndarray, beams: tuple,
+                view: tuple, inlier: float, beam_check: bool, select: tuple, groups: np.ndarray,
+                gate: float, gate_parts: tuple, refine: tuple, min_returns: int,
+                where: tuple) -> np.ndarray:
+        if gate < 0.0:
+            return refine_to_field_kernel(view, points, cands, inlier, refine)
+        first, second, more, keep = gate_parts
+        for part in range(2 if more else 1):
+            if part == 1 and cands.shape[0] > keep:
+                costs = cost(ranges, cands, beams, view, inlier, beam_check, select, groups, where)
+                cands = cands[prune_index_kernel(cands, costs, keep, 0.05)]
+            unmapped = unmapped_kernel(short(ranges, cands, beams, inlier, gate, groups, where),
+                                       groups)
+            cands = refine_each_kernel(view, points, ranges, cands, inlier,
+                                       first if part == 0 else second, unmapped, beams[6],
+                                       min_returns, gate)
+        return cands
+
+    return refined
+
+
+_vector_refined = _refined_kernel(_vector_cost, _vector_short)
+_grid_refined = _refined_kernel(_grid_cost, _grid_short)
 
 
 @njit(cache=True, nogil=True)
@@ -271,7 +338,7 @@ def vector_pipeline_kernel(ranges: np.ndarray, x: float, y: float, theta: float,
                                  prune_after, keep, inlier)
     evaluations += cands.shape[0] * iterations
     cost = _vector_cost(ranges, cands, beams, view, inlier, beam_check, select,
-                        _groups(ranges, beams, select), segs, index)
+                        _groups(ranges, beams, select), (segs, index))
     return OK, points.shape[0], cands, cost, rots, seeded, evaluations
 
 
@@ -289,24 +356,11 @@ def vector_field_pipeline_kernel(ranges: np.ndarray, x: float, y: float, theta: 
     if status != OK:
         return _no_poses(status, points.shape[0], rots, seeded)
     groups = _groups(ranges, beams, select)
-    if gate >= 0.0:                       # unmapped returns left out (tfplus.unmapped)
-        angles, max_range = beams[0], beams[6]
-        first, second, more, keep = gate_parts
-        for part in range(2 if more else 1):
-            if part == 1 and cands.shape[0] > keep:
-                cost = _vector_cost(ranges, cands, beams, view, inlier, beam_check, select,
-                                    groups, segs, index)
-                cands = cands[prune_index_kernel(cands, cost, keep, 0.05)]
-            virtual = raycast_segments(cands, angles, segs, max_range, index)
-            short = unmapped_kernel(vector_short_mask(ranges, virtual, max_range, gate), groups)
-            cands = refine_each_kernel(view, points, ranges, cands, inlier,
-                                       first if part == 0 else second, short, max_range,
-                                       min_returns, gate)
-    else:
-        cands = refine_to_field_kernel(view, points, cands, inlier, refine)
+    cands = _vector_refined(ranges, points, cands, beams, view, inlier, beam_check, select, groups,
+                            gate, gate_parts, refine, min_returns, (segs, index))
     evaluations += cands.shape[0] * iterations
-    cost = _vector_cost(ranges, cands, beams, view, inlier, beam_check, select, groups, segs,
-                        index)
+    cost = _vector_cost(ranges, cands, beams, view, inlier, beam_check, select, groups,
+                        (segs, index))
     return OK, points.shape[0], cands, cost, rots, seeded, evaluations
 
 
@@ -317,40 +371,23 @@ def grid_pipeline_kernel(ranges: np.ndarray, x: float, y: float, theta: float, b
                          beam_check: bool, select: tuple, gate: float, gate_parts: tuple,
                          refine: tuple, grid: tuple) -> tuple:
     """:func:`run` on a grid map (``Plan.args``; see :func:`_build`)."""
-    angles, directions, cos_a, sin_a, angle_min, resolution, max_range = beams
+    angles, directions, max_range = beams[0], beams[1], beams[6]
     occupied, gx, gy, cell, free, distance = grid
     points = _returns_to_points(ranges, directions, max_range)
     if points.shape[0] < min_returns:
         return _no_poses(TOO_FEW, points.shape[0], np.empty(0), False)
-    virtual = raycast_grid(_at(x, y, theta), angles, occupied, gx, gy, cell, max_range)[0]
+    virtual = (raycast_grid(_at(x, y, theta), angles, occupied, gx, gy, cell, max_range)[0]
+               if headings[2] else ranges)
     rots, heads, seeded = _seeded_headings(ranges, virtual, theta, beams, rotation, headings)
     offsets, table, corner_x, corner_y, res, clearance = lattice
     positions = grid_lattice_kernel(x, y, offsets, table, corner_x, corner_y, res, clearance,
                                     gx, gy, cell, free, distance, 0.5 * cell)
     cands, evaluations = coarse_kernel(points, positions, x, y, heads, coarse)
     groups = _groups(ranges, beams, select)
-    nearest, fx, fy, fres, map_points, map_normals = view
-    if gate >= 0.0:                       # unmapped returns left out (tfplus.unmapped)
-        first, second, more, keep = gate_parts
-        for part in range(2 if more else 1):
-            if part == 1 and cands.shape[0] > keep:
-                cost = grid_cost_kernel(nearest, fx, fy, fres, map_points, map_normals, ranges,
-                                        directions, angles, max_range, cands, occupied, gx, gy,
-                                        cell, inlier, beam_check, free, select[0], select[1],
-                                        select[2], groups)
-                cands = cands[prune_index_kernel(cands, cost, keep, 0.05)]
-            short = unmapped_kernel(beam_flags_kernel(occupied, free, gx, gy, cell, cands, angles,
-                                                      ranges, max_range, inlier, gate, False,
-                                                      groups >= 0)[1], groups)
-            cands = refine_each_kernel(view, points, ranges, cands, inlier,
-                                       first if part == 0 else second, short, max_range,
-                                       min_returns, gate)
-    else:
-        cands = refine_to_field_kernel(view, points, cands, inlier, refine)
+    cands = _grid_refined(ranges, points, cands, beams, view, inlier, beam_check, select, groups,
+                          gate, gate_parts, refine, min_returns, grid)
     evaluations += cands.shape[0] * iterations
-    cost = grid_cost_kernel(nearest, fx, fy, fres, map_points, map_normals, ranges, directions,
-                            angles, max_range, cands, occupied, gx, gy, cell, inlier, beam_check,
-                            free, select[0], select[1], select[2], groups)
+    cost = _grid_cost(ranges, cands, beams, view, inlier, beam_check, select, groups, grid)
     return OK, points.shape[0], cands, cost, rots, seeded, evaluations
 
 
