@@ -1,15 +1,14 @@
 """A run's page: its provenance from ``run.json`` (commit, versions, machine, sessions' dates),
-its ``report.md``, ``timing.md`` and other notes rendered as HTML, with its figures copied beside
-the page so that it works from disk. A relative link of a report is kept where it points into
-the copied figures or to a rendered note (→ its anchor), pointed at the file's place in the
-results root where it exists, and dropped (its text kept) where nothing is there."""
+its ``report.md``, ``timing.md`` and other notes rendered as HTML. The page works from disk: a
+relative link or image of a note points at the file's place in the results root (the figures
+stay where the run wrote them, nothing is copied), a link to a rendered note at its anchor, and
+a link to nothing is dropped (its text kept)."""
 
 from __future__ import annotations
 
 import html
 import json
 import os
-import shutil
 from pathlib import Path
 from urllib.parse import unquote, urlsplit
 
@@ -17,7 +16,6 @@ from .html import markdown, shell
 
 #: the notes a run page renders, in this order (any other top-level *.md follows)
 NOTES = ("report.md", "timing.md", "NOTE.md", "robustness.md", "README.md")
-IMAGES = (".png", ".jpg", ".jpeg", ".svg", ".gif")
 
 
 def anchor(note: str) -> str:
@@ -55,8 +53,6 @@ def _retarget(url: str, run_dir: Path, page_dir: Path, rendered: set[str]) -> st
     if rel in rendered:
         return "#" + anchor(rel)
     target = (run_dir / rel).resolve()
-    if (page_dir / rel).is_file() and target.is_relative_to(run_dir.resolve()):
-        return url
     if target.exists():
         return os.path.relpath(target, page_dir).replace(os.sep, "/")
     return None
@@ -94,25 +90,9 @@ def note_html(text: str, run_dir: Path, page_dir: Path, rendered: set[str]) -> s
     return md.renderer.render(tokens, md.options, {})
 
 
-def copy_figures(run_dir: Path, page_dir: Path) -> int:
-    """The run's pictures (``figures/`` and top-level images) beside its page; how many."""
-    n = 0
-    for src in sorted(run_dir.rglob("*")):
-        if src.is_file() and src.suffix.lower() in IMAGES:
-            rel = src.relative_to(run_dir)
-            if rel.parts[0] not in ("figures",) and len(rel.parts) > 1:
-                continue
-            dst = page_dir / rel
-            dst.parent.mkdir(parents=True, exist_ok=True)
-            shutil.copy2(src, dst)
-            n += 1
-    return n
-
-
 def write_run_page(run_dir: Path, page_dir: Path, title: str, home: str) -> Path:
-    """``page_dir/index.html`` for the run in ``run_dir`` (figures copied); returns its path."""
+    """``page_dir/index.html`` for the run in ``run_dir``; returns its path."""
     page_dir.mkdir(parents=True, exist_ok=True)
-    copy_figures(run_dir, page_dir)
     try:
         run = json.loads((run_dir / "run.json").read_text(encoding="utf-8"))
     except (OSError, ValueError):
