@@ -61,7 +61,7 @@ def _names(cols: list[Column]) -> str:
 
 
 def _caveat(cols: list[Column]) -> str:
-    return (" (provisional: rows derived from the run's older tables, no paired test yet)"
+    return (" (provisional: rows from the run's older tables, no paired test yet)"
             if any(c.provisional for c in cols) else "")
 
 
@@ -106,7 +106,7 @@ def leader(board: Board, cols: list[Column], question: str, what: str) -> Statem
             if r.verdict == "tied":
                 tied.setdefault(r.next_matcher, []).append(c.scope)
         if _caveat(cols):
-            sep = "no paired test yet" + _caveat(cols)
+            sep = "provisional: rows from the run's older tables, no paired test yet"
         elif len(ahead) == len(cols):
             sep = "the paired test puts it ahead of the next on every one"
         else:

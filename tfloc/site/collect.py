@@ -63,6 +63,5 @@ def run_note(rr: RunRows | None, name: str) -> str:
     if not rr.source:
         return f"`results/{name}/`: no headline yet (run `tfloc report results/{name}`)"
     if rr.provisional:
-        return (f"`results/{name}/`: provisional, from `{rr.source}` (no `headline.csv` yet: no paired "
-                f"test, no best marked)")
+        return f"`results/{name}/`: provisional, from `{rr.source}` (no `headline.csv` yet)"
     return f"`results/{name}/`: `headline.csv`"

@@ -18,6 +18,8 @@ from .pages import COST
 
 BLOCK = re.compile(r"(<!-- tfloc:begin (?P<name>[\w.-]+) -->\n)(?P<body>.*?)(<!-- tfloc:end (?P=name) -->)", re.S)
 ADVICE = "advice"
+#: rows of a README table (``KEY-short``): the first matchers of its first column
+SHORT_ROWS = 5
 
 
 def _cell(c: Cell | None) -> str:
@@ -32,16 +34,21 @@ def board_markdown(board: Board, data: SiteData, short: bool = False) -> str:
     notes = [run_note(data.runs.get(r), r) for r in dict.fromkeys(c.run for c in board.columns)]
     page = next((p for p in data.pages if p.key == board.key.removesuffix("-short")), None)
     if page is not None and page.key != COST:
-        shown = {c.run for c in board.columns}
+        have = {c.run for c in board.columns}
         notes += [run_note(data.runs.get(r.dir), r.dir) for r in page.runs
-                  if r.dir not in shown and (r.short or not short)]
+                  if r.dir not in have and (r.short or not short)]
     if not board.columns:
         return "_Not yet: " + "; ".join(notes or ["no run"]) + "._\n"
     one_run = len({c.run for c in board.columns}) == 1
     heads = ["matcher"] + [c.label if one_run else f"{c.label} ({c.run})" for c in board.columns]
-    body = [[f"`{m}`"] + [_cell(board.cell(m, c)) for c in board.columns] for m in board.matchers]
+    shown = board.matchers[:SHORT_ROWS] if short else board.matchers
+    body = [[f"`{m}`"] + [_cell(board.cell(m, c)) for c in board.columns] for m in shown]
     out = table(heads, body, "l" + "r" * len(board.columns))
-    return out + "\n" + "Runs: " + "; ".join(notes) + ".\n"
+    more = len(board.matchers) - len(shown)
+    if more:
+        where = f" ({page.doc})" if page is not None and page.doc else ""
+        notes.insert(0, f"{more} more matcher{'s' * (more != 1)} on the site and in the full table{where}")
+    return out + "\n" + "; ".join(notes) + ".\n"
 
 
 def advice_markdown(data: SiteData) -> str:
