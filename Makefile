@@ -78,7 +78,7 @@ bench: $(STAMP)
 	$(BIN)/tfloc report results/global
 	$(BIN)/tfloc bench benchmarks/native.toml --datasets real-csail-native --out results/native-csail --jobs $(JOBS) --regenerate
 	$(BIN)/tfloc report results/native-csail
-	$(BIN)/tfloc site
+	$(BIN)/tfloc site --readme
 
 ## The leaderboards' site from the committed runs → results/site/index.html (opens from disk), and
 ## the README's and docs' generated blocks from the same rows.

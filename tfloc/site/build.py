@@ -1,5 +1,5 @@
 """Writing the site: ``OUT/index.html`` from :func:`tfloc.site.collect.collect`, one page per
-run under ``OUT/runs/NAME/`` with its figures, and the README's and docs' generated blocks
+run under ``OUT/runs/NAME/`` (its figures linked where the run wrote them), and the README's and docs' generated blocks
 refreshed from the same data. The only module of the package that writes files (besides the
 screenshots)."""
 
