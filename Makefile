@@ -9,7 +9,8 @@ JOBS   ?= 2
 LOCK   := requirements.lock
 UV_VERSION := 0.13.9
 
-.PHONY: install lock quick bench native global-full global-offices robustness robustness-full scaling scaling-quick ablation-real test test-cpu test-unit timing lint clean-venv real-data fuzz chaos
+## The site (tfloc site) is written at the end of make bench (results/site/) and make quick (results/site-quick/).
+.PHONY: install lock browser site quick bench native global-full global-offices robustness robustness-full scaling scaling-quick ablation-real test test-cpu test-unit timing lint clean-venv real-data fuzz chaos
 
 $(STAMP): pyproject.toml $(LOCK)
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -30,13 +31,15 @@ lock:
 install: $(STAMP)
 
 ## A quick first run (a few minutes): every matcher on the first 3 scans of every group of the
-## paper protocol, a quiet re-timing, and the full report → results/paper-protocol-quick/report.md
+## paper protocol, a quiet re-timing, and the full report → results/paper-protocol-quick/report.md;
+## one short simulated sequence tracked; their site → results/site-quick/index.html
 quick: $(STAMP)
 	$(BIN)/tfloc bench benchmarks/paper-protocol.toml --quick --jobs $(JOBS) --regenerate
 	$(BIN)/tfloc timing results/paper-protocol-quick --per-stratum 1
 	$(BIN)/tfloc report results/paper-protocol-quick
 	$(BIN)/tfloc bench benchmarks/sequences-quick.toml --jobs $(JOBS) --regenerate
 	$(BIN)/tfloc report results/sequences-quick
+	$(BIN)/tfloc site --only-quick
 
 ## The main job: every registered matcher on the bundled scenarios, a side-by-side timing pass
 ## of each run (timing.md), and the reports; then the reading study of the paper's method and the
@@ -75,6 +78,18 @@ bench: $(STAMP)
 	$(BIN)/tfloc report results/global
 	$(BIN)/tfloc bench benchmarks/native.toml --datasets real-csail-native --out results/native-csail --jobs $(JOBS) --regenerate
 	$(BIN)/tfloc report results/native-csail
+	$(BIN)/tfloc site --readme
+
+## The leaderboards' site from the committed runs → results/site/index.html (opens from disk), and
+## the README's and docs' generated blocks from the same rows.
+site: $(STAMP)
+	$(BIN)/tfloc site --readme
+
+## Headless Chromium and chromedriver from Debian's packages, for the site's browser test and
+## screenshots (installed when missing; no browser is downloaded at run time). .ci/run runs it.
+browser:
+	@command -v chromium >/dev/null && command -v chromedriver >/dev/null || \
+		(apt-get update && apt-get install -y chromium chromium-driver)
 
 ## Tracking the robots' own recordings at their native rate, every matcher, all three logs
 ## (22 627 scans) → results/native/ (benchmarks/native.toml; 20-40 min on 2 cores). make bench

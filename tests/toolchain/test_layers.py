@@ -29,6 +29,7 @@ LAYERS = (
     "tfloc.evaluation",  # success/outcome rule, metrics, summaries, paper values, relations, guard
     "tfloc.harness",     # run configurations, tasks, the local and Dask executors
     "tfloc.report",      # report.md, figures, tables, the relations note, TUM export
+    "tfloc.site",        # the static site and the README's generated blocks, from the run directories
     "tfloc.cli",         # one module per command
 )
 

@@ -6,7 +6,7 @@ before anything runs: a bad parameter stops the command at once, naming its conf
 Re-running the same command after an interruption (Ctrl-C, kill -9) resumes it. A run directory
 holds one configuration (run.json's fingerprint); another is refused there: use --regenerate or
 another --out. Every task ends in one row: ok, failed, invalid:<reason>, timeout or error:<message>
-(README.md, "A run is one configuration").
+(docs/running.md, "A run is one configuration").
 
 Exit status: 0 the run is complete (rows may be failed, invalid or timeout); 2 nothing was run
 (a bad configuration, dataset or parameter, a run of another configuration in --out, an output

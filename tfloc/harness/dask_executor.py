@@ -63,7 +63,7 @@ def security(address: str, tls_ca_file: str | None = None, tls_cert: str | None 
         host = address.partition("://")[2].rpartition(":")[0].strip("[]")
         if address.startswith("tcp://") and host not in ("127.0.0.1", "localhost", "::1"):
             print(f"tfloc bench: warning: {address} is plain TCP: no encryption, no authentication; anyone "
-                  "who can reach it can run code on the workers. Use tls:// (README: Running on a Dask "
+                  "who can reach it can run code on the workers. Use tls:// (docs/dask.md: Running on a Dask "
                   "cluster) or an SSH tunnel", file=sys.stderr)
         return None
     _require_distributed()

@@ -1,0 +1,67 @@
+"""Everything the site shows, read from a results root once: each page's runs' headline rows
+(:mod:`tfloc.site.rows`), the re-timings and the scaling slopes of the cost page, and the
+leaderboards and statements built from them. The only module of the package that reads the
+results root's tables; the renderers take what it returns."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+
+from .advice import Statement, statements
+from .board import Board, headline_board, unique_dirs
+from .cost import cpu_board, slopes_board
+from .pages import COST, Page, load_pages
+from .rows import RunRows, run_rows
+
+
+@dataclass
+class SiteData:
+    """The pages, their runs' rows by directory, the boards by page key (``cost``: the CPU
+    table, ``cost-slopes``: the scaling slopes; ``KEY-short``: the README's) and the statements."""
+
+    root: Path
+    pages: list[Page]
+    runs: dict[str, RunRows]
+    boards: dict[str, Board] = field(default_factory=dict)
+    statements: list[Statement] = field(default_factory=list)
+
+
+def _csv(path: Path) -> pd.DataFrame | None:
+    if not path.is_file():
+        return None
+    df = pd.read_csv(path, keep_default_na=False, na_values=[""])
+    return None if df.empty else df
+
+
+def collect(root: Path, quick: bool = False, pages: list[Page] | None = None) -> SiteData:
+    """Read the results root ``root`` for ``pages`` (default: ``pages.toml``'s; ``quick``:
+    ``make quick``'s runs) and build every board and statement."""
+    root = Path(root)
+    pages = pages if pages is not None else load_pages(quick=quick)
+    runs = {d: run_rows(root, d) for d in unique_dirs(pages)}
+    data = SiteData(root, pages, runs)
+    timing = {d: t for d in runs if (t := _csv(root / d / "timing.csv")) is not None}
+    for p in pages:
+        if p.key == COST:
+            data.boards[COST] = cpu_board(pages, runs, timing)
+            slopes = {r.dir: s for r in p.runs if (s := _csv(root / r.dir / "slopes.csv")) is not None}
+            data.boards[f"{COST}-slopes"] = slopes_board(slopes)
+            continue
+        data.boards[p.key] = headline_board(p, runs)
+        data.boards[f"{p.key}-short"] = headline_board(p, runs, short=True)
+    data.statements = statements(data.boards)
+    return data
+
+
+def run_note(rr: RunRows | None, name: str) -> str:
+    """Where a run's figures come from, or why it has none (Markdown inline)."""
+    if rr is None or not rr.exists:
+        return f"`results/{name}/`: not yet run"
+    if not rr.source:
+        return f"`results/{name}/`: no headline yet (run `tfloc report results/{name}`)"
+    if rr.provisional:
+        return f"`results/{name}/`: provisional, from `{rr.source}` (no `headline.csv` yet)"
+    return f"`results/{name}/`: `headline.csv`"
