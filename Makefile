@@ -5,12 +5,11 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.tfloc-installed
-JOBS   ?= 2
 LOCK   := requirements.lock
 UV_VERSION := 0.13.9
 
 ## The site (tfloc site) is written at the end of make bench (results/site/) and make quick (results/site-quick/).
-.PHONY: install lock browser site quick bench native global-full global-offices robustness robustness-full scaling scaling-quick ablation-real test test-cpu test-unit timing lint clean-venv real-data fuzz chaos
+.PHONY: install lock browser site quick bench native native-single-scan sequences-single-scan global-full global-offices robustness robustness-full scaling scaling-quick ablation-real test test-cpu test-unit timing lint clean-venv real-data fuzz chaos
 
 $(STAMP): pyproject.toml $(LOCK)
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -30,54 +29,20 @@ lock:
 
 install: $(STAMP)
 
-## A quick first run (a few minutes): every matcher on the first 3 scans of every group of the
-## paper protocol, a quiet re-timing, and the full report → results/paper-protocol-quick/report.md;
-## one short simulated sequence tracked; their site → results/site-quick/index.html
+## A quick first run (a few minutes): every single-scan matcher on the first 3 scans of every group
+## of the paper protocol with its quick timing pass and report, every tracker along one short
+## sequence, and their site → results/site-quick/index.html
 quick: $(STAMP)
-	$(BIN)/tfloc bench benchmarks/paper-protocol.toml --quick --jobs $(JOBS) --regenerate
-	$(BIN)/tfloc timing results/paper-protocol-quick --per-stratum 1
-	$(BIN)/tfloc report results/paper-protocol-quick
-	$(BIN)/tfloc bench benchmarks/sequences-quick.toml --jobs $(JOBS) --regenerate
-	$(BIN)/tfloc report results/sequences-quick
+	$(BIN)/tfloc bench benchmarks/paper-protocol.toml benchmarks/sequences-quick.toml --quick --regenerate
 	$(BIN)/tfloc site --only-quick
 
-## The main job: every registered matcher on the bundled scenarios, a side-by-side timing pass
-## of each run (timing.md), and the reports; then the reading study of the paper's method and the
-## tf-plus ablation. About 80 min on 2 cores (README).
+## The main job: every study below (each file declares its run and the steps that make its tables:
+## timing pass, report, robustness section, relations note, the global index), then the site and
+## the README's generated tables. About 100 min on 2 cores; run again, it resumes.
+STUDIES := paper-protocol real-csail-relations real-scan-to-map tf-readings tf-readings-heldout \
+	tfplus-ablation sequences kidnap kidnap-controls robustness scaling-quick global native-csail
 bench: $(STAMP)
-	$(BIN)/tfloc bench benchmarks/paper-protocol.toml --jobs $(JOBS) --regenerate
-	$(BIN)/tfloc timing results/paper-protocol
-	$(BIN)/tfloc report results/paper-protocol
-	$(BIN)/tfloc bench benchmarks/real-csail-relations.toml --jobs $(JOBS) --regenerate
-	$(BIN)/tfloc timing results/real-csail-relations
-	$(BIN)/tfloc report results/real-csail-relations
-	$(BIN)/tfloc real-note results/real-csail-relations
-	$(BIN)/tfloc bench benchmarks/real-scan-to-map.toml --jobs $(JOBS) --regenerate
-	$(BIN)/tfloc timing results/real-scan-to-map
-	$(BIN)/tfloc report results/real-scan-to-map
-	$(BIN)/tfloc bench benchmarks/tf-readings.toml --jobs $(JOBS) --regenerate
-	$(BIN)/tfloc report results/tf-readings
-	$(BIN)/tfloc bench benchmarks/tf-readings-heldout.toml --jobs $(JOBS) --regenerate
-	$(BIN)/tfloc report results/tf-readings-heldout
-	$(BIN)/tfloc bench benchmarks/tfplus-ablation.toml --jobs $(JOBS) --regenerate
-	$(BIN)/tfloc report results/tf-plus-ablation
-	$(BIN)/tfloc bench benchmarks/sequences.toml --jobs $(JOBS) --regenerate
-	$(BIN)/tfloc report results/sequences
-	$(BIN)/tfloc bench benchmarks/kidnap.toml --jobs $(JOBS) --regenerate
-	$(BIN)/tfloc report results/kidnap
-	$(BIN)/tfloc bench benchmarks/kidnap-controls.toml --jobs $(JOBS) --regenerate
-	$(BIN)/tfloc report results/kidnap-controls
-	$(BIN)/tfloc bench benchmarks/robustness.toml --jobs $(JOBS) --regenerate
-	$(BIN)/tfloc timing results/robustness
-	$(BIN)/tfloc report results/robustness
-	$(BIN)/tfloc robustness results/robustness
-	$(MAKE) scaling-quick
-	for d in global-office-1 global-office-2 global-office-3 real-intel-global real-csail-global real-aces-global; do \
-		$(BIN)/tfloc index --dataset data/scenarios/$$d || exit 1; done
-	$(BIN)/tfloc bench benchmarks/global.toml --jobs $(JOBS) --regenerate
-	$(BIN)/tfloc report results/global
-	$(BIN)/tfloc bench benchmarks/native.toml --datasets real-csail-native --out results/native-csail --jobs $(JOBS) --regenerate
-	$(BIN)/tfloc report results/native-csail
+	$(BIN)/tfloc bench $(STUDIES:%=benchmarks/%.toml) --regenerate
 	$(BIN)/tfloc site --readme
 
 ## The leaderboards' site from the committed runs → results/site/index.html (opens from disk), and
@@ -91,57 +56,15 @@ browser:
 	@command -v chromium >/dev/null && command -v chromedriver >/dev/null || \
 		(apt-get update && apt-get install -y chromium chromium-driver)
 
-## Tracking the robots' own recordings at their native rate, every matcher, all three logs
-## (22 627 scans) → results/native/ (benchmarks/native.toml; 20-40 min on 2 cores). make bench
-## runs its fixed subsample, MIT CSAIL only (1927 scans, with the relations), → results/native-csail/.
-native: $(STAMP)
-	$(BIN)/tfloc bench benchmarks/native.toml --jobs $(JOBS) --regenerate
-	$(BIN)/tfloc report results/native
+## Studies outside make bench, one line each (benchmarks/NAME.toml says what and how long):
+## native (every native recording, 22 627 scans, 20-40 min), native-single-scan (the same in the
+## single-scan protocol's configuration), sequences-single-scan, global-full (every global scan),
+## global-offices, robustness-full (every scan), scaling (the full study), ablation-real.
+native native-single-scan sequences-single-scan global-full global-offices robustness robustness-full scaling scaling-quick: $(STAMP)
+	$(BIN)/tfloc bench benchmarks/$@.toml --regenerate
 
-## Global localization on every scan of the global sets (issue 24) → results/global-full/.
-global-full: $(STAMP)
-	for d in global-office-1 global-office-2 global-office-3 real-intel-global real-csail-global real-aces-global; do \
-		$(BIN)/tfloc index --dataset data/scenarios/$$d || exit 1; done
-	$(BIN)/tfloc bench benchmarks/global-full.toml --jobs $(JOBS) --regenerate
-	$(BIN)/tfloc report results/global-full
-
-## tf-global against bnb-global on every scan of the three office global sets → results/global-offices/.
-global-offices: $(STAMP)
-	$(BIN)/tfloc bench benchmarks/global-offices.toml --jobs $(JOBS) --regenerate
-	$(BIN)/tfloc report results/global-offices
-
-## Issue 25: every matcher on every map style of the real logs and every changed world of the
-## simulated office (10 scans per offset group of each dataset; ~12 min on 2 quiet cores)
-## → results/robustness/robustness.md. robustness-full: every scan (~30 min).
-robustness: $(STAMP)
-	$(BIN)/tfloc bench benchmarks/robustness.toml --jobs $(JOBS) --regenerate
-	$(BIN)/tfloc timing results/robustness
-	$(BIN)/tfloc report results/robustness
-	$(BIN)/tfloc robustness results/robustness
-
-robustness-full: $(STAMP)
-	$(BIN)/tfloc bench benchmarks/robustness-full.toml --jobs $(JOBS) --regenerate
-	$(BIN)/tfloc timing results/robustness-full
-	$(BIN)/tfloc report results/robustness-full
-	$(BIN)/tfloc robustness results/robustness-full
-
-## The scaling study (tfloc scaling): every matcher's CPU per scan against map area (300-20 000 m²,
-## vector and 5 cm grid), beam count (181-1081) and initial offset, and each map's preparation
-## time and memory → results/scaling/ (README.md, scaling.png, study.json; ~15 min CPU, one pinned
-## core; resumed if interrupted).
-scaling: $(STAMP)
-	$(BIN)/tfloc scaling --out results/scaling --regenerate
-
-## Its fixed subsample, part of make bench: every axis and level, 9 scans per level, 9 per
-## offset bin → results/scaling-quick/ (~3 min CPU).
-scaling-quick: $(STAMP)
-	$(BIN)/tfloc scaling --quick --out results/scaling-quick --regenerate
-
-## tf-plus's stages switched off in turn on the real logs, as-built and thickened grids, csm-corr
-## beside it → results/tf-plus-ablation-real/ (benchmarks/tfplus-ablation-real.toml; ~10 min).
 ablation-real: $(STAMP)
-	$(BIN)/tfloc bench benchmarks/tfplus-ablation-real.toml --jobs $(JOBS) --regenerate
-	$(BIN)/tfloc report results/tf-plus-ablation-real
+	$(BIN)/tfloc bench benchmarks/tfplus-ablation-real.toml --regenerate
 
 ## Rebuild the real-log datasets and grid maps from data/real/ (deterministic).
 real-data: $(STAMP)

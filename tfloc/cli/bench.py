@@ -1,7 +1,10 @@
-"""Run registered matchers over scenario datasets and stream the results to RUN/estimates.csv.
+"""Run a study: matchers over scenario datasets, results streamed to RUN/estimates.csv, then the
+steps that make its tables.
 
-Either name datasets and matchers on the command line, or give a run configuration (TOML, see
-benchmarks/*.toml); options given on the command line override the file. Every matcher is built
+Either name datasets and matchers on the command line, or give study files (benchmarks/*.toml:
+each one run, then the steps it declares, e.g. steps = ["timing", "report"]; a file may extend
+another, extends = "robustness.toml"); options given on the command line override a single
+file. Every matcher is built
 before anything runs: a bad parameter stops the command at once, naming its configuration key.
 Re-running the same command after an interruption (Ctrl-C, kill -9) resumes it. A run directory
 holds one configuration (run.json's fingerprint); another is refused there: use --regenerate or
@@ -19,7 +22,8 @@ Run only configurations you trust; such matchers are refused without --allow-imp
 --quick runs the first 3 scans of every group of every dataset into RUN-quick (make quick).
 
 Examples:
-  tfloc bench benchmarks/paper-protocol.toml
+  tfloc bench benchmarks/paper-protocol.toml   # the run, its timing pass and its report
+  tfloc bench benchmarks/robustness.toml benchmarks/global.toml --regenerate
   tfloc bench benchmarks/paper-protocol.toml --quick   # → results/paper-protocol-quick
   tfloc bench data/scenarios/detail-1 --matchers tf,csm-corr --out results/try
   tfloc bench benchmarks/paper-protocol.toml --scheduler local:2   # a local Dask cluster
@@ -37,7 +41,14 @@ from pathlib import Path
 from tfloc.core.matcher import default_matchers
 from tfloc.core.thresholds import Thresholds
 from tfloc.errors import ConfigError
-from tfloc.harness.config import RunConfig, check_imports, load_config, parse_matchers
+from tfloc.harness.config import (
+    STEPS_BEFORE,
+    RunConfig,
+    Study,
+    check_imports,
+    load_study,
+    parse_matchers,
+)
 from tfloc.io.scenario import read_scenario
 
 from ._options import add_progress
@@ -47,8 +58,9 @@ QUICK_PER_GROUP = 3
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("inputs", nargs="+", metavar="CONFIG.toml | DATASET_DIR",
-                   help="a run configuration, or one or more scenario dataset directories")
+    p.add_argument("inputs", nargs="+", metavar="STUDY.toml | DATASET_DIR",
+                   help="one or more study files (run one after the other, each followed by its steps), "
+                        "or one or more scenario dataset directories")
     p.add_argument("--matchers", help="comma-separated matcher names or presets (default with datasets: "
                    "every registered matcher that solves their mode: the single-scan matchers on a "
                    "single-scan dataset, trackers and single-scan matchers on a sequence, the global "
@@ -87,6 +99,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--allow-import", action="store_true",
                    help="allow matchers named module:Class: they are imported, which runs the module's "
                         "code; only for configurations you trust")
+    p.add_argument("--no-steps", action="store_true",
+                   help="run the study's run only, not the steps its file declares (steps = [...]: "
+                        "index before the run; timing, report, robustness, real-note after it)")
     add_progress(p)
 
 
@@ -102,12 +117,23 @@ def only_datasets(cfg: RunConfig, names: list[str]) -> RunConfig:
                    skip_per_group=tuple((k, n) for k, n in cfg.skip_per_group if Path(k) in keep))
 
 
-def config_from_args(args: argparse.Namespace) -> RunConfig:
+def _overridden(args: argparse.Namespace) -> list[str]:
+    """The options that change one run's configuration (they apply to one study file only)."""
+    return [o for o, v in (("--matchers", args.matchers), ("--datasets", args.datasets), ("--out", args.out),
+                           ("--name", args.name)) if v]
+
+
+def config_from_args(args: argparse.Namespace, study: Study | None = None) -> RunConfig:
+    """The run of one study file (``study``) or of the dataset directories given, with the
+    command line's options on top."""
     tomls = [i for i in args.inputs if i.endswith(".toml")]
-    if tomls and len(args.inputs) > 1:
-        raise ConfigError("give either one run configuration (.toml) or dataset directories, not both")
+    if tomls and len(tomls) < len(args.inputs):
+        raise ConfigError("give either study files (.toml) or dataset directories, not both")
     if tomls:
-        cfg = load_config(tomls[0])
+        study = study or load_study(tomls[0])
+        if study.run is None:
+            raise ConfigError(f"{study.path}: a {study.kind} study has no run configuration")
+        cfg = study.run
         if args.matchers:
             cfg = cfg.with_overrides(matchers=parse_matchers(args.matchers.split(","), {}, "--matchers"))
         if args.datasets:
@@ -120,7 +146,7 @@ def config_from_args(args: argparse.Namespace) -> RunConfig:
         name = args.name or "run"
         cfg = RunConfig(name=name, out=args.out or Path("results") / name,
                         datasets=tuple(Path(d) for d in args.inputs),
-                        matchers=parse_matchers(names, {}, "--matchers"))
+                        matchers=parse_matchers(names, {}, "--matchers"), steps=())
     if args.quick:
         cfg = cfg.with_overrides(name=f"{cfg.name}-quick", out=cfg.out.with_name(f"{cfg.out.name}-quick"),
                                  limit_per_group=QUICK_PER_GROUP)
@@ -133,11 +159,34 @@ def config_from_args(args: argparse.Namespace) -> RunConfig:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ._study import run_scaling_study, run_steps
+
+    tomls = [i for i in args.inputs if i.endswith(".toml")]
+    if len(tomls) > 1 and _overridden(args):
+        raise ConfigError(f"{', '.join(_overridden(args))}: apply to one study file, not {len(tomls)}")
+    if not tomls:
+        return run_one(args, config_from_args(args))
+    studies = [load_study(t) for t in tomls]  # every file checked before any runs
+    code = 0
+    for study in studies:
+        if study.kind == "scaling":
+            code = max(code, run_scaling_study(study, args))
+            continue
+        cfg = config_from_args(args, study)
+        if not args.no_steps:
+            run_steps(cfg, [s for s in cfg.steps if s in STEPS_BEFORE], args.quick)
+        code = max(code, run_one(args, cfg))
+        if not args.no_steps:
+            run_steps(cfg, [s for s in cfg.steps if s not in STEPS_BEFORE], args.quick)
+    return code
+
+
+def run_one(args: argparse.Namespace, cfg: RunConfig) -> int:
+    """One run (resumed, or refused if ``--out`` holds another configuration); 3 if a task raised."""
     from tfloc.harness.runner import execute_local
     from tfloc.harness.runner import run as run_benchmark
     from tfloc.io.estimates import status_counts
 
-    cfg = config_from_args(args)
     check_imports(cfg, args.allow_import)
     tls = {k: getattr(args, k) for k in ("tls_ca_file", "tls_cert", "tls_key") if getattr(args, k)}
     if tls and not args.scheduler:

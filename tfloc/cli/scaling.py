@@ -96,23 +96,42 @@ def command_of(args: argparse.Namespace, out: Path) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from tqdm import tqdm
+    from dataclasses import asdict
 
-    from tfloc.harness.scaling import provenance, run_study
-    from tfloc.report.scaling import render
+    from tfloc.harness.scaling import StudyConfig
 
     cfg = config_from_args(args)
+    base = asdict(StudyConfig.quick() if args.quick else StudyConfig())
+    table = {k: v for k, v in asdict(cfg).items() if v != base[k]}
     out = args.out or Path("results") / ("scaling-quick" if args.quick else "scaling")
-    bar = tqdm(unit="scan", desc="scaling", disable=None if args.progress is None else not args.progress,
+    return run_config(table, args.quick, out, args.regenerate, args.progress, command_of(args, out))
+
+
+def run_config(table: dict, quick: bool, out: Path, regenerate: bool = False, progress: bool | None = None,
+               command: str = "") -> int:
+    """Run (or resume) the study with the fields ``table`` over the full or quick configuration,
+    then render its README and figure (``tfloc scaling`` and a scaling study file alike)."""
+    from tqdm import tqdm
+
+    from tfloc.errors import ConfigError
+    from tfloc.harness.scaling import StudyConfig, provenance, run_study
+    from tfloc.report.scaling import render
+
+    base = StudyConfig.quick() if quick else StudyConfig()
+    try:
+        cfg = replace(base, **{k: tuple(v) if isinstance(v, list) else v for k, v in table.items()})
+    except TypeError as exc:
+        raise ConfigError(f"[scaling]: {exc}") from None
+    bar = tqdm(unit="scan", desc="scaling", disable=None if progress is None else not progress,
                smoothing=0.05, mininterval=1.0)
 
-    def progress(done: int, total: int) -> None:
+    def step(done: int, total: int) -> None:
         bar.total = total
         bar.update(done - bar.n)
 
     try:
-        sd = run_study(cfg, out, log=lambda s: tqdm.write(s, file=sys.stderr), progress=progress,
-                       regenerate=args.regenerate, command=command_of(args, out))
+        sd = run_study(cfg, out, log=lambda s: tqdm.write(s, file=sys.stderr), progress=step,
+                       regenerate=regenerate, command=command)
     finally:
         bar.close()
     doc = sd.doc() or {}

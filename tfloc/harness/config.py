@@ -21,7 +21,10 @@ A run configuration file looks like (relative paths are relative to where tfloc 
     params = { }               # optional, over [params.tf]; label = "tf": optional label prefix
 
 ``skip_per_group`` skips the first N scans of each group (a held-out selection after a development
-split). A matcher named ``module:Class`` runs that module's code: :func:`check_imports` refuses it
+split). A configuration is a *study file* (:func:`load_study`): ``extends = "other.toml"`` takes
+that file's keys (tables merged key by key; ``name`` and ``out`` are never inherited) with its
+own on top, ``steps`` lists what makes its tables after the run (:data:`STEPS`; ``index`` runs
+before it) and ``kind = "scaling"`` with a ``[scaling]`` table is the scaling study. A matcher named ``module:Class`` runs that module's code: :func:`check_imports` refuses it
 unless imports are allowed (``tfloc bench --allow-import``). Each parameter remembers the key that
 set it, so that a bad one is reported by its key (``[params.csm-corr] search_radiuss``).
 """
@@ -38,6 +41,14 @@ from typing import Any
 from tfloc.core.thresholds import Thresholds
 from tfloc.errors import ConfigError
 from tfloc.io.text import parse_text
+
+#: steps a study file may declare: ``index`` (tf-global's place index of every dataset's map)
+#: runs before the run, the others after it in the order written
+STEPS_BEFORE = ("index",)
+STEPS_AFTER = ("timing", "report", "robustness", "real-note")
+STEPS = (*STEPS_BEFORE, *STEPS_AFTER)
+DEFAULT_STEPS = ("report",)
+KINDS = ("bench", "scaling")
 
 
 @dataclass(frozen=True)
@@ -82,6 +93,7 @@ class RunConfig:
     sequence_timeout_s: float = 3600.0
     success: Thresholds = Thresholds()
     skip_per_group: tuple[tuple[str, int], ...] = ()
+    steps: tuple[str, ...] = DEFAULT_STEPS
     extra: dict = field(default_factory=dict, compare=False)
 
     def skip(self, dataset: Path) -> int:
@@ -110,7 +122,7 @@ class RunConfig:
                 "jobs": self.jobs, "timeout_s": self.timeout_s, "limit_per_group": self.limit_per_group,
                 **({"sequence_timeout_s": self.sequence_timeout_s} if self.sequence_timeout_s != 3600.0 else {}),
                 **({"skip_per_group": dict(self.skip_per_group)} if self.skip_per_group else {}),
-                "success": self.success.to_dict(), **self.extra}
+                "success": self.success.to_dict(), "steps": list(self.steps), **self.extra}
 
 
 def _keys(params: dict, key: str) -> dict[str, str]:
@@ -211,12 +223,91 @@ def _skips(entries: list, where: str) -> tuple[tuple[str, int], ...]:
     return tuple(out)
 
 
-def load_config(path: str | Path) -> RunConfig:
-    """Read a run configuration TOML file; errors name the file and the key."""
-    path = Path(path)
+def merge_docs(base: dict, own: dict) -> dict:
+    """A study file's keys over the file it extends: tables merged key by key, anything else
+    replaced; ``name`` and ``out`` are the file's own (never inherited)."""
+    out = {k: v for k, v in base.items() if k not in ("name", "out")}
+    for k, v in own.items():
+        out[k] = merge_docs(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
+    return out
+
+
+def read_doc(path: Path, seen: tuple[Path, ...] = ()) -> dict:
+    """A study file's keys with what it ``extends`` resolved (relative to the file's folder)."""
     doc = parse_text(path, ConfigError, "run configuration", tomllib.loads, tomllib.TOMLDecodeError, "TOML")
+    parent = doc.pop("extends", None)
+    if parent is None:
+        return doc
+    if not isinstance(parent, str):
+        raise ConfigError(f"{path}: 'extends' must be the path of another study file")
+    target = (path.parent / parent).resolve()
+    if target in (*seen, path.resolve()):
+        raise ConfigError(f"{path}: extends {parent!r}, which extends it back")
+    if not target.is_file():
+        raise ConfigError(f"{path}: extends {parent!r}: no such file ({target})")
+    return merge_docs(read_doc(target, (*seen, path.resolve())), doc)
+
+
+def _steps(doc: dict, path: Path) -> tuple[str, ...]:
+    steps = doc.get("steps", list(DEFAULT_STEPS))
+    if not isinstance(steps, list) or not all(isinstance(x, str) for x in steps):
+        raise ConfigError(f"{path}: 'steps' must be a list of step names ({', '.join(STEPS)})")
+    unknown = [x for x in steps if x not in STEPS]
+    if unknown:
+        raise ConfigError(f"{path}: unknown step(s) {', '.join(unknown)}; known: {', '.join(STEPS)}")
+    return tuple(dict.fromkeys(steps))
+
+
+@dataclass(frozen=True)
+class Study:
+    """A study file: what ``tfloc bench FILE`` runs, then the steps that make its tables.
+    ``kind`` ``bench``: ``run`` (a :class:`RunConfig`); ``scaling``: ``scaling`` (the fields of
+    :class:`tfloc.harness.scaling.StudyConfig` to set, and ``quick``)."""
+
+    path: Path
+    name: str
+    out: Path
+    kind: str = "bench"
+    steps: tuple[str, ...] = DEFAULT_STEPS
+    run: RunConfig | None = None
+    scaling: dict = field(default_factory=dict, compare=False)
+    description: str = ""
+
+
+def load_study(path: str | Path) -> Study:
+    """Read a study file (module notes); errors name the file and the key."""
+    path = Path(path)
+    doc = read_doc(path)
+    kind = doc.get("kind", "bench")
+    if kind not in KINDS:
+        raise ConfigError(f"{path}: kind {kind!r} is not one of {', '.join(KINDS)}")
+    name = str(doc.get("name", path.stem))
+    out = Path(doc.get("out", f"results/{name}"))
+    steps = _steps(doc, path)
+    if kind == "scaling":
+        unknown = sorted(set(doc) - {"name", "out", "description", "kind", "steps", "scaling"})
+        if unknown:
+            raise ConfigError(f"{path}: unknown key(s) {', '.join(unknown)} (a scaling study)")
+        table = doc.get("scaling", {})
+        if not isinstance(table, dict):
+            raise ConfigError(f"{path}: [scaling] must be a table")
+        return Study(path, name, out, kind, steps, scaling=table, description=str(doc.get("description", "")))
+    cfg = config_of(doc, path)
+    return Study(path, cfg.name, cfg.out, kind, cfg.steps, run=cfg, description=str(doc.get("description", "")))
+
+
+def load_config(path: str | Path) -> RunConfig:
+    """Read a run configuration (a study file of kind ``bench``); errors name the file and the key."""
+    study = load_study(path)
+    if study.run is None:
+        raise ConfigError(f"{path}: a {study.kind} study, not a run configuration (run it with tfloc bench)")
+    return study.run
+
+
+def config_of(doc: dict, path: Path) -> RunConfig:
+    """The :class:`RunConfig` of a study file's keys (``extends`` resolved)."""
     known = {"name", "out", "datasets", "matchers", "jobs", "timeout_s", "limit_per_group",
-             "success", "params", "description", "sweep", "sequence_timeout_s"}
+             "success", "params", "description", "sweep", "sequence_timeout_s", "steps", "kind"}
     unknown = sorted(set(doc) - known)
     if unknown:
         raise ConfigError(f"{path}: unknown key(s) {', '.join(unknown)}")
@@ -237,7 +328,7 @@ def load_config(path: str | Path) -> RunConfig:
             jobs=int(doc.get("jobs", 2)), timeout_s=float(doc.get("timeout_s", 60.0)),
             sequence_timeout_s=float(doc.get("sequence_timeout_s", 3600.0)),
             limit_per_group=int(doc.get("limit_per_group", 0)),
-            success=Thresholds.from_dict(success),
+            success=Thresholds.from_dict(success), steps=_steps(doc, path),
             extra={k: doc[k] for k in ("description",) if k in doc})
     except (TypeError, ValueError) as exc:
         raise ConfigError(f"{path}: {exc}") from None
