@@ -16,6 +16,22 @@ def noisy_scan(m: Map, laser: LaserSpec, pose: Pose, seed: int = 0) -> np.ndarra
     return m.raycast(pose, laser) + np.random.default_rng(seed).normal(0, 0.01, laser.n_beams)
 
 
+def cost_cases(room: Map, laser: LaserSpec, grid: bool, n: int = 4):
+    """The selection cost's test scans: ``(map, view, ranges)`` for ``n`` noisy scans of ``room``
+    from :data:`TRUE` with no-return beams (every 17th) and beams seen through a wall (5-8), the
+    map the room or its 5 cm raster (``grid``), the view at 5 cm truncated at 0.3 m."""
+    from tfloc.maps.build import rasterize
+    from tfloc.tfplus.view import map_view
+
+    m = rasterize(room, 0.05) if grid else room
+    field = map_view(m, 0.05, 0.3, 0.3)
+    for seed in range(n):
+        ranges = noisy_scan(room, laser, TRUE, seed)
+        ranges[::17] = np.inf
+        ranges[5:9] += 0.5
+        yield m, field, ranges
+
+
 def few_returns_problem(laser: LaserSpec, returns: int) -> Problem:
     """A scan with only ``returns`` returns (2 m, from beam 90) in a 4 × 3 m room, guess (1, 1, 0)."""
     ranges = np.full(laser.n_beams, np.inf)

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _paths import ROOT
 from tfloc.baselines.amcl import AmclTracker
 
 from tfloc.cli import main
@@ -16,7 +17,6 @@ from tfloc.core.pose import Pose
 from tfloc.io.scenario import Scan, read_scans, read_scenario, write_scenario
 from tfloc.report.belief import Snapshot, motion_noise, summarize
 
-ROOT = Path(__file__).resolve().parents[2]
 QUICK = ROOT / "data" / "scenarios" / "seq-quick"
 
 

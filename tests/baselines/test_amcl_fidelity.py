@@ -15,10 +15,10 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
+from _paths import SCEN
 from scipy import stats
 
 pytest.importorskip("amcl")
@@ -37,7 +37,7 @@ from tfloc.evaluation.trajectory import score_rows  # noqa: E402
 from tfloc.harness.track import odom_deltas, track  # noqa: E402
 from tfloc.io.scenario import map_for, read_scans, read_scenario  # noqa: E402
 
-SCENARIOS = Path(__file__).resolve().parents[2] / "data" / "scenarios"
+SCENARIOS = SCEN
 #: the wheel's parameters, which it cannot change (pf_alloc's KLD bounds) or has (the beam model)
 WHEEL_PARAMS = {"laser_model_type": "beam", "pf_err": 0.01, "pf_z": 3.0}
 

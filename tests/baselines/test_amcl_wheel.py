@@ -15,10 +15,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 from _amcl_cases import LASER, SPREAD, corridor, run_along
+from _paths import MAPS
 
 import tfloc
 from tfloc.core.pose import Pose
-from tfloc.core.tracker import as_tracker, has_single_scan_mode, is_tracker
 from tfloc.errors import ParameterError
 
 pytest.importorskip("amcl")
@@ -26,7 +26,7 @@ import amcl._amcl_impl  # noqa: E402
 from tfloc.baselines._amcl_common import amcl_grid  # noqa: E402
 from tfloc.baselines.amcl_wheel import AmclWheelTracker, _pdf_seed_counter  # noqa: E402
 
-OFFICE = Path(__file__).resolve().parents[2] / "data" / "maps" / "office-1.geojson"
+OFFICE = MAPS / "office-1.geojson"
 
 
 @pytest.fixture(scope="module")
@@ -39,13 +39,6 @@ def office():
 def track(vmap, truth: list[Pose], start: Pose, **params) -> tuple[np.ndarray, list, AmclWheelTracker]:
     """An :class:`AmclWheelTracker` along ``truth`` (:func:`_amcl_cases.run_along`)."""
     return run_along(AmclWheelTracker(**params), vmap, truth, start)
-
-
-def test_registered_as_a_tracker_without_a_single_scan_mode() -> None:
-    tracker = tfloc.get_matcher("amcl-wheel")
-    assert isinstance(tracker, AmclWheelTracker) and tracker.name == "amcl-wheel"
-    assert is_tracker(tracker) and not has_single_scan_mode(tracker) and as_tracker(tracker) is tracker
-    assert has_single_scan_mode(tfloc.get_matcher("tf-plus"))
 
 
 @pytest.mark.parametrize("bad", [{"min_particles": 0}, {"min_particles": 600, "max_particles": 500},

@@ -12,10 +12,10 @@ from __future__ import annotations
 import csv
 import math
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
+from _paths import SCEN
 from tfloc.baselines._corner_match import search_hypotheses
 from tfloc.baselines.cv_corners import CvCornersMatcher
 
@@ -23,7 +23,7 @@ import tfloc
 from tfloc import LaserSpec, Pose, Problem, angdiff
 from tfloc.maps.scanmap import polyline_map_from_scan
 
-SCANS = Path(__file__).resolve().parents[2] / "data/scenarios/real-csail-relations/scans.csv"
+SCANS = SCEN / "real-csail-relations/scans.csv"
 LASER = LaserSpec.from_degrees(50.0, 180.0, 0.5, -90.0)   # as its scenario.json
 IDS = ("rel0001", "rel0002", "rel0003", "rel0004", "rel0005")
 

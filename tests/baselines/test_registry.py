@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _paths import ROOT
 from _registry import BASELINES, kind, single_scan
 from tfloc.baselines._geometry import matrix_to_pose, pose_to_matrix
 from tfloc.baselines.o3d_icp import Config as O3dConfig
@@ -18,8 +19,6 @@ from tfloc.baselines.o3d_icp import Config as O3dConfig
 from tfloc import Pose
 from tfloc.core.params import resolve_params
 from tfloc.errors import ParameterError
-
-ROOT = Path(__file__).resolve().parents[2]
 
 _SCRIPT = """
 import json, sys

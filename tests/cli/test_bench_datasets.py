@@ -6,11 +6,10 @@ import argparse
 from pathlib import Path
 
 import pytest
+from _paths import ROOT
 
 from tfloc.cli.bench import add_arguments, config_from_args
 from tfloc.errors import ConfigError
-
-ROOT = Path(__file__).resolve().parents[2]
 
 
 def _args(*argv: str) -> argparse.Namespace:

@@ -11,12 +11,12 @@ import sys
 from pathlib import Path
 
 import pytest
+from _paths import ROOT
 
 from tfloc.cli import build_parser
 from tfloc.cli.bench import config_from_args
 from tfloc.core.matcher import default_matchers
 
-ROOT = Path(__file__).resolve().parents[2]
 ENV = {**os.environ, "COLUMNS": "100", "PYTHONPATH": os.pathsep.join([str(ROOT / "tests"), str(ROOT)])}
 
 

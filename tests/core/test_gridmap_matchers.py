@@ -7,10 +7,9 @@ problem. Accuracy is the benchmarks' business, not this test's."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
+from _paths import MAPS
 
 from tfloc.core.laser import LaserSpec
 from tfloc.core.matcher import available_matchers, get_matcher
@@ -19,7 +18,7 @@ from tfloc.core.problem import Problem
 from tfloc.errors import MatcherError
 from tfloc.maps.build import rasterize
 
-ROOM = Path(__file__).resolve().parents[2] / "data" / "maps" / "test-room.geojson"
+ROOM = MAPS / "test-room.geojson"
 
 
 @pytest.mark.parametrize("name", available_matchers())

@@ -4,12 +4,11 @@ the bundled changed-* datasets bit for bit (tests/_committed.py)."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 import shapely
 from _committed import assert_same_file
+from _paths import SCEN
 
 from tfloc.core.laser import LaserSpec
 from tfloc.core.pose import Pose
@@ -26,8 +25,6 @@ from tfloc.datasets.rearranged import (
 from tfloc.io.scenario import read_scenario
 from tfloc.maps.vector import VectorMap
 
-ROOT = Path(__file__).resolve().parents[2]
-SCEN = ROOT / "data" / "scenarios"
 POSES = [Pose(2.0, 7.5, 0.0), Pose(10.0, 3.0, 1.2), Pose(17.0, 12.0, -2.0), Pose(6.5, 10.5, 2.5)]
 
 

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import shutil
-from pathlib import Path
 
 import numpy as np
 import pytest
 from _committed import assert_same_file
+from _paths import ROOT, SCEN
 
 from tfloc.core.matcher import check_solvable, get_matcher
 from tfloc.core.problem import Problem
@@ -20,9 +20,6 @@ from tfloc.datasets.global_sets import (
 from tfloc.errors import InvalidProblemError
 from tfloc.io.geojson import read_vector_map
 from tfloc.io.scenario import GLOBAL, map_for, read_scans, read_scenario
-
-ROOT = Path(__file__).resolve().parents[2]
-SCEN = ROOT / "data" / "scenarios"
 
 
 @pytest.mark.bitwise

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+from _paths import SCEN
 
 from tfloc.core.pose import Pose
 from tfloc.datasets.motion import (
@@ -110,11 +111,10 @@ def test_backward_steps_are_as_noisy_as_forward_ones():
 def test_scan_rate_does_not_change_the_odometry():
     """The 1 Hz sequence's odometry is the 10 Hz trajectory's, sampled (odometry has its own
     rate): over a 1 s gap its increment error is that of ten 0.1 m steps, not one 1 m step."""
-    from pathlib import Path
 
     from tfloc.io.scenario import read_scans, read_scenario
 
-    root = Path(__file__).resolve().parents[2] / "data" / "scenarios"
+    root = SCEN
     err = {}
     for name in ("seq-rate-1hz-b", "seq-easy-b"):
         s = read_scans(read_scenario(root / name))

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from _committed import assert_same_file
+from _paths import ROOT
 
 from tfloc.core.pose import angdiff
 from tfloc.datasets import spacing
@@ -24,7 +25,6 @@ from tfloc.datasets.relations import build_relations, overlap
 from tfloc.io.carmen import read_carmen
 from tfloc.io.scenario import map_for, read_scans, read_scenario
 
-ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "data"
 SCEN = DATA / "scenarios"
 

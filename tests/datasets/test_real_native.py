@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from _committed import assert_same_file
+from _paths import REAL, SCEN
 
 from tfloc.core.pose import Pose
 from tfloc.datasets.real import clean_ranges, front_scans
@@ -32,9 +33,6 @@ from tfloc.io.carmen import read_carmen, read_flaser_no_timestamps
 from tfloc.io.relations import Relation, read_relations
 from tfloc.io.scenario import read_scans, read_scenario
 
-ROOT = Path(__file__).resolve().parents[2]
-REAL = ROOT / "data" / "real"
-SCEN = ROOT / "data" / "scenarios"
 #: (key, scans in the dataset, truth-bearing scans, raw scans in the log)
 COUNTS = (("intel", 13462, 910, 13631), ("csail", 1927, 406, 1988), ("aces", 7238, 440, 7374))
 

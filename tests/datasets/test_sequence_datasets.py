@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from _committed import assert_same_file
+from _paths import ROOT
 
 from tfloc.core.laser import LaserSpec
 from tfloc.core.pose import Pose
@@ -18,7 +19,6 @@ from tfloc.datasets.sequences import BUNDLE, CONDITIONS, SequenceSpec, SimSpec, 
 from tfloc.errors import DatasetError
 from tfloc.io.scenario import SEQUENCE, Scan, read_scans, read_scenario, write_scenario
 
-ROOT = Path(__file__).resolve().parents[2]
 MAP = ROOT / "data" / "maps" / "test-room.geojson"
 LASER = LaserSpec.lms200()
 

@@ -5,11 +5,11 @@ start table."""
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
+from _paths import SCEN
 
 from tfloc.core.pose import Pose
 from tfloc.evaluation.global_start import (
@@ -21,8 +21,6 @@ from tfloc.evaluation.global_start import (
 )
 from tfloc.io.estimates import result_row, rows_frame
 from tfloc.io.scenario import read_scans, read_scenario
-
-SCEN = Path(__file__).resolve().parents[2] / "data" / "scenarios"
 
 
 def drive(n: int, step: float = 0.1, turn: float = 0.02) -> np.ndarray:

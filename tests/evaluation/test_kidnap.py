@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 from _committed import assert_same_file
+from _paths import SCEN
 
 from tfloc.core.pose import Pose
 from tfloc.datasets.kidnap import KIDNAP_BUNDLE, Kidnapping, generate_kidnap_sequences
@@ -23,8 +23,6 @@ from tfloc.evaluation.kidnap import (
 from tfloc.harness.track import odom_deltas
 from tfloc.io.estimates import result_row, rows_frame
 from tfloc.io.scenario import SEQUENCE, read_scans, read_scenario
-
-SCEN = Path(__file__).resolve().parents[2] / "data" / "scenarios"
 
 
 # -- metrics on hand-made trajectories ---------------------------------------------------------

@@ -3,18 +3,16 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
+from _paths import ROOT
 
 import tfloc
 from tfloc.cli import main
 from tfloc.core.pose import Pose
 from tfloc.datasets.motion import OdometryNoise, sample_increments
 from tfloc.evaluation.motion_fit import fit_motion_noise, fit_sigma_hit, update_intervals
-
-ROOT = Path(__file__).resolve().parents[2]
 
 
 def _walk(n: int, rng: np.random.Generator) -> list[Pose]:

@@ -8,11 +8,11 @@ import csv
 import shutil
 from pathlib import Path
 
+from _paths import ROOT
+
 from tfloc.harness.config import MatcherSpec, RunConfig
 from tfloc.harness.runner import make_tasks, run
 from tfloc.io.estimates import read_estimates
-
-ROOT = Path(__file__).resolve().parents[2]
 
 
 def _short_sequence(dst: Path, n: int = 12) -> Path:

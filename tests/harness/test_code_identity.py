@@ -10,10 +10,10 @@ import subprocess
 import sys
 from pathlib import Path
 
+from _paths import ROOT
+
 from tfloc.harness import identity
 from tfloc.harness.fingerprint import differences
-
-ROOT = Path(__file__).resolve().parents[2]
 
 PROBE = '''
 from tfloc import Estimate, Pose

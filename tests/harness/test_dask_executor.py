@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from _paths import ROOT
 
 distributed = pytest.importorskip("distributed")
 
@@ -24,7 +25,6 @@ from tfloc.harness.dask_executor import execute_dask  # noqa: E402
 from tfloc.harness.runner import run  # noqa: E402
 from tfloc.io.estimates import read_estimates  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[2]
 TESTS = Path(__file__).resolve().parents[1]
 ENV = {**os.environ, "PYTHONPATH": os.pathsep.join([str(TESTS), str(ROOT)])}
 KEY = ["dataset", "scan_id", "matcher"]

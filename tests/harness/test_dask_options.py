@@ -4,14 +4,12 @@ from __future__ import annotations
 
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
+from _paths import ROOT
 
 from tfloc.errors import ConfigError
 from tfloc.harness.dask_executor import execute_dask, parse_scheduler
-
-ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.mark.parametrize("address, parsed", [("local:3", ("local", 3)),

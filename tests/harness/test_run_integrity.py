@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from _paths import ROOT
 from test_runner import make_dataset
 
 from tfloc.core.pose import Pose
@@ -24,7 +25,6 @@ from tfloc.io import estimates as E
 from tfloc.io.estimates import read_estimates
 from tfloc.io.scenario import Scan, read_scans, read_scenario, write_scenario
 
-ROOT = Path(__file__).resolve().parents[2]
 TESTS = Path(__file__).resolve().parents[1]
 ENV = {**os.environ, "PYTHONPATH": os.pathsep.join([str(TESTS), str(ROOT)])}
 KEY = ["dataset", "scan_id", "matcher"]

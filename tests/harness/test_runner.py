@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from _paths import ROOT
 
 from tfloc.core.pose import Pose
 from tfloc.errors import DatasetError
@@ -20,7 +21,6 @@ from tfloc.harness.runner import run
 from tfloc.io.estimates import read_estimates
 from tfloc.io.scenario import Scan, write_scenario
 
-ROOT = Path(__file__).resolve().parents[2]
 ROOM = ROOT / "data" / "maps" / "test-room.geojson"
 TESTS = Path(__file__).resolve().parents[1]
 

@@ -6,12 +6,12 @@ from __future__ import annotations
 import json
 import math
 import shutil
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 import shapely
+from _paths import ROOT
 
 from tfloc.cli import main
 from tfloc.core.laser import LaserSpec
@@ -24,7 +24,6 @@ from tfloc.io.geojson import read_vector_map
 from tfloc.maps.build import rasterize
 from tfloc.maps.vector import VectorMap
 
-ROOT = Path(__file__).resolve().parents[2]
 OFFICE = ROOT / "data" / "maps" / "office-1.geojson"
 #: The tiny study: 2 areas × 2 kinds, the 4 lasers, the 3 offset bins; 2 scans each; 2 cheap matchers.
 TINY = ["--matchers", "tf-plus,cv-corners", "--areas", "300,1200", "--scans", "2", "--scans-per-bin", "2",

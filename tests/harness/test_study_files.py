@@ -11,6 +11,7 @@ import tomllib
 from pathlib import Path
 
 import pytest
+from _paths import ROOT
 from test_runner import make_dataset
 
 from tfloc.core.presets import presets, resolve
@@ -18,7 +19,6 @@ from tfloc.core.thresholds import Thresholds
 from tfloc.errors import ConfigError
 from tfloc.harness.config import DEFAULT_STEPS, RunConfig, load_study, read_doc
 
-ROOT = Path(__file__).resolve().parents[2]
 FILES = sorted((ROOT / "benchmarks").rglob("*.toml"))
 ENV = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "tests"), str(ROOT)])}
 

@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 import pytest
+from _paths import SCEN
 from test_runner import make_dataset
 
 from tfloc.errors import ConfigError
@@ -91,7 +92,7 @@ def test_a_dataset_entry_may_skip_the_first_scans_of_each_group(tmp_path):
     """A held-out selection: the scans after the first N of each group (a development split)."""
     from tfloc.harness.runner import make_tasks
 
-    pool = Path(__file__).resolve().parents[2] / "data" / "scenarios" / "office-pool"
+    pool = SCEN / "office-pool"
     path = tmp_path / "held-out.toml"
     path.write_text(f'matchers = ["csm-corr"]\ndatasets = [{{ path = "{pool}", skip_per_group = 178 }}]\n')
     cfg = load_config(path)

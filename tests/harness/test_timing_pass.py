@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from _paths import ROOT
 
 from tests._estimates import frame, row
 from tests.harness.test_runner import cfg, make_dataset
@@ -21,7 +22,6 @@ from tfloc.harness.config import MatcherSpec
 from tfloc.harness.runner import run
 from tfloc.harness.timing import TIMING_COLUMNS, run_timing, sample_scans
 
-ROOT = Path(__file__).resolve().parents[2]
 ENV = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "tests"), str(ROOT)])}
 
 

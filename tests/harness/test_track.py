@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _paths import ROOT
 
 from tfloc.cli import main
 from tfloc.core.matcher import get_matcher
@@ -19,7 +20,6 @@ from tfloc.harness.track import dead_reckoning, track
 from tfloc.io.estimates import COLUMNS, to_record
 from tfloc.io.scenario import Scan, read_scans, read_scenario, write_scenario
 
-ROOT = Path(__file__).resolve().parents[2]
 QUICK = ROOT / "data" / "scenarios" / "seq-quick"
 
 

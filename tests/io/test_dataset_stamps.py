@@ -3,17 +3,16 @@ back into Scan.stamp, checked like any number; datasets without it are unchanged
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
+from _paths import MAPS
 
 from tfloc.core.laser import LaserSpec
 from tfloc.core.pose import Pose
 from tfloc.errors import DatasetError
 from tfloc.io.scenario import Scan, read_scans, read_scenario, write_scenario
 
-MAP = Path(__file__).resolve().parents[2] / "data" / "maps" / "test-room.geojson"
+MAP = MAPS / "test-room.geojson"
 LASER = LaserSpec.lms200()
 
 

@@ -8,13 +8,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from _paths import ROOT
 
 import tfloc
 from tfloc import InvalidProblemError, MapFormatError, Pose, Problem
 from tfloc.errors import DatasetError
 from tfloc.io.scenario import Scan, read_scans, read_scenario, write_scenario
 
-ROOT = Path(__file__).resolve().parents[2]
 ROOM = ROOT / "data" / "maps" / "test-room.geojson"
 
 

@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 from _estimates import row, write_run
 from _fuzz import SETTINGS, Tally, damaged, finish, judge, mutated, write_files
+from _paths import ROOT
 from hypothesis import given
 
 import tfloc
@@ -29,7 +30,6 @@ from tfloc.io.rosmap import read_ros_map, write_ros_map
 from tfloc.io.scenario import Scan, read_scans, read_scenario, write_scenario
 from tfloc.maps.grid import GridMap
 
-ROOT = Path(__file__).resolve().parents[2]
 FIX = Path(__file__).parents[1] / "fixtures" / "real"
 ROOM = ROOT / "data" / "maps" / "test-room.geojson"
 LASER = tfloc.LaserSpec.from_degrees(8.0, 180.0, 2.0)  # 91 beams: small files, quick cases

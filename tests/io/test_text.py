@@ -8,13 +8,12 @@ import shutil
 from pathlib import Path
 
 import pytest
+from _paths import ROOT
 
 from tfloc.errors import DatasetError, MapFormatError
 from tfloc.io.geojson import read_vector_map
 from tfloc.io.scenario import read_scans, read_scenario
 from tfloc.io.text import read_text
-
-ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_bom_crlf_and_gzip_read_alike(tmp_path: Path) -> None:

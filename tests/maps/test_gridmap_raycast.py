@@ -3,17 +3,16 @@ Map protocol (is_free, in_bounds, sample_points, bounds)."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
+from _paths import MAPS
 
 from tfloc.core.laser import LaserSpec
 from tfloc.core.pose import Pose
 from tfloc.maps import GridMap, Map
 from tfloc.maps.build import grid_from_scans, rasterize
 
-ROOM = Path(__file__).resolve().parents[2] / "data" / "maps" / "test-room.geojson"
+ROOM = MAPS / "test-room.geojson"
 
 
 @pytest.fixture(scope="module")

@@ -3,19 +3,16 @@ the boundary, for the maps' free space (with and without clearance) and mapped a
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 import shapely
+from _paths import ROOT
 from shapely.geometry import Polygon, box
 
 from tfloc.io.maps import load_map
 from tfloc.maps import inside
 from tfloc.maps.inside import Rings
 from tfloc.maps.vector import VectorMap
-
-ROOT = Path(__file__).resolve().parents[2]
 
 
 def _points(geom, rng: np.random.Generator, n: int) -> np.ndarray:

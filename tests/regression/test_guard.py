@@ -8,15 +8,13 @@ tfloc/evaluation/guard.py for the tolerances and why). Update the reference deli
 from __future__ import annotations
 
 import os
-from pathlib import Path
 
 import pytest
+from _paths import ROOT
 
 from tfloc.cli.guard import run_subset
 from tfloc.evaluation import guard
 from tfloc.harness.config import load_config
-
-ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="module")

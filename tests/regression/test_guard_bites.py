@@ -3,16 +3,14 @@
 from __future__ import annotations
 
 import os
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from _paths import ROOT
 
 from tfloc.cli.guard import run_subset
 from tfloc.evaluation import guard
 from tfloc.harness.config import MatcherSpec, load_config
-
-ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_degraded_tf_is_caught(tmp_path):

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import shapely
+from _paths import MAPS
 
 import tfloc
 from tfloc.core.matcher import check_solvable, get_matcher, solves_global
@@ -97,7 +98,7 @@ def test_the_index_is_kept_in_memory_per_map(test_room, lms200, tmp_path) -> Non
 
 
 def _room_path() -> Path:
-    return Path(__file__).resolve().parents[2] / "data" / "maps" / "test-room.geojson"
+    return MAPS / "test-room.geojson"
 
 
 @pytest.fixture(scope="module")

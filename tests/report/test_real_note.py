@@ -7,12 +7,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from _paths import SCEN
 
 from tfloc.evaluation.relations import relation_stats
 from tfloc.io.scenario import read_scans, read_scenario
 from tfloc.report.relations_note import write_note
 
-DATASET = Path(__file__).resolve().parents[2] / "data" / "scenarios" / "real-csail-relations"
+DATASET = SCEN / "real-csail-relations"
 
 
 def test_relation_stats() -> None:

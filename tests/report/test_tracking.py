@@ -3,15 +3,13 @@ dead reckoning as the floor, and the figures."""
 
 from __future__ import annotations
 
-from pathlib import Path
+from _paths import ROOT, SCEN
 
 from tfloc.harness.track import dead_reckoning
 from tfloc.io.estimates import result_row, rows_frame
 from tfloc.io.maps import load_map
 from tfloc.io.scenario import read_scans, read_scenario
 from tfloc.report.tracking import sequence_scores, tracking_section
-
-ROOT = Path(__file__).resolve().parents[2]
 
 
 def _rows(name: str, n: int, lost_from: int | None = None) -> list:
@@ -46,7 +44,7 @@ def test_a_sequence_with_relations_gets_the_relation_errors_and_a_set_of_buildin
     from tfloc.io.scenario import read_scans, read_scenario
     from tfloc.report.tracking import relations_tables, sequence_scores, tracking_tables
 
-    root = Path(__file__).resolve().parents[2] / "data" / "scenarios"
+    root = SCEN
     rows, datasets = [], {}
     for name in ("real-csail-native", "real-aces-native"):
         sc = read_scenario(root / name)

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _paths import ROOT
 
 from tfloc.cli import main
 from tfloc.core.laser import LaserSpec
@@ -20,7 +21,6 @@ from tfloc.io.tum import read_tum, write_tum
 from tfloc.report.export import export_tum
 
 file_interface = pytest.importorskip("evo.tools.file_interface")
-ROOT = Path(__file__).resolve().parents[2]
 COLS = ["dataset", "scan_id", "group", "matcher", "true_x", "true_y", "true_theta", "init_x", "init_y",
         "init_theta", "est_x", "est_y", "est_theta", "status", "runtime_s"]
 

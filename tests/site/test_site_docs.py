@@ -8,12 +8,12 @@ import re
 from pathlib import Path
 
 import pytest
+from _paths import ROOT
 
 from tfloc.site.build import markdown_files
 from tfloc.site.collect import collect
 from tfloc.site.markdown import block_names, refresh
 
-ROOT = Path(__file__).resolve().parents[2]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
 FORBIDDEN = [r"20\d\d-\d\d-\d\d", r"\bissues?\s+#?\d+", r"\bthis\s+stop\b", r"\bstop\s+\d+"]
 MAX_README_LINES = 250

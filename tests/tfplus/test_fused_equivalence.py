@@ -9,7 +9,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 from _tf_cases import TRUE, noisy_scan
-from _tf_oracles import step_by_step_tf
 from _tfplus_oracles import step_by_step_tfplus
 from numba import njit
 
@@ -131,41 +130,6 @@ def test_grid_scores_on_a_lattice_equal_the_plain_sum(test_room, lms200) -> None
             fast = grid_scores_kernel(table, float(ox), float(oy), f.resolution, points,
                                       positions, headings, step)
             assert fast.tobytes() == plain.tobytes()
-
-
-def _office_problems(count: int):
-    """The first ``count`` scans of each offset cell of detail-1 (the furnished office)."""
-    from tfloc.harness.task import load_dataset, problem_of
-
-    scenario, scans = load_dataset(str(ROOT / "data" / "scenarios" / "detail-1"))
-    seen: dict[str, int] = {}
-    out = []
-    for s in scans.values():
-        if seen.get(s.group, 0) < count:
-            seen[s.group] = seen.get(s.group, 0) + 1
-            out.append(problem_of(scenario, s))
-    return out
-
-
-@pytest.mark.parametrize("name", ["tf", "tf-best"])
-def test_compiled_tf_search_gives_the_python_answers(name: str,
-                                                     monkeypatch: pytest.MonkeyPatch) -> None:
-    from tfloc.core.matcher import get_matcher
-
-    m = get_matcher(name)
-    for problem in _office_problems(1):
-        fast = m.localize(problem)
-        with monkeypatch.context() as mp:
-            step_by_step_tf(mp)
-            slow = m.localize(problem)
-        assert (fast.pose, fast.converged, fast.iterations, fast.evaluations, fast.info) == \
-            (slow.pose, slow.converged, slow.iterations, slow.evaluations, slow.info)
-
-
-def test_simplex_directions_drawn_at_once_equal_one_by_one() -> None:
-    rng = np.random.default_rng(7)
-    one_by_one = [rng.uniform(0.0, 2.0 * math.pi) for _ in range(8)]
-    assert np.array_equal(np.random.default_rng(7).uniform(0.0, 2.0 * math.pi, 8), one_by_one)
 
 
 @njit(cache=False)
@@ -345,17 +309,12 @@ def test_pairwise_sum_is_numpys_mean() -> None:
 
 @pytest.mark.parametrize("grid", [False, True])
 def test_compiled_selection_cost_equals_the_numpy_steps(grid: bool, test_room, lms200) -> None:
-    from tfloc.maps.build import rasterize
-    from tfloc.tfplus.cost import scan_cost, scan_cost_steps
-    from tfloc.tfplus.view import map_view
+    from _tf_cases import cost_cases
 
-    m = rasterize(test_room, 0.05) if grid else test_room
-    field = map_view(m, 0.05, 0.3, 0.3)
+    from tfloc.tfplus.cost import scan_cost, scan_cost_steps
+
     rng = np.random.default_rng(10)
-    for seed in range(4):
-        ranges = noisy_scan(test_room, lms200, TRUE, seed)
-        ranges[::17] = np.inf                     # no returns
-        ranges[5:9] += 0.5                        # seen through a wall
+    for m, field, ranges in cost_cases(test_room, lms200, grid):
         poses = np.vstack((TRUE.as_array(), _poses(rng, 3)))
         got = scan_cost(m, lms200, ranges, poses, 6, 0.1, True, field)
         ref = scan_cost_steps(m, lms200, ranges, poses, 6, 0.1, True, field)
@@ -428,30 +387,3 @@ def test_lattice_on_a_grid_map_equals_the_map_queries() -> None:
             keep &= grid.is_free(xy)
             got = lattice(grid, view, centre, 3.3, 0.2, clearance)
             assert got.tobytes() == xy[keep].tobytes()
-
-
-def test_compiled_tf_search_gives_up_to_python_near_boundaries(
-        test_room, lms200, monkeypatch: pytest.MonkeyPatch) -> None:
-    """With the compiled free test unsure within 0.5 m of the free space's boundary, the compiled
-    search gives up where its simplex comes near a wall (and Function1 asks shapely): the
-    answers stay the Python ones."""
-    from tfloc.core.matcher import get_matcher
-    from tfloc.core.problem import Problem
-    from tfloc.paper import matcher as paper_matcher
-
-    m = get_matcher("tf")
-    monkeypatch.setattr(paper_matcher, "SURE", 0.5)
-    ranges = noisy_scan(test_room, lms200, TRUE)
-    x0, y0, _, _ = test_room.bounds
-    gave_up = 0
-    for guess in (Pose(x0 + 0.3, TRUE.y, TRUE.theta), Pose(TRUE.x, y0 + 0.3, TRUE.theta + 0.1)):
-        problem = Problem(test_room, lms200, ranges, guess)
-        cost = paper_matcher._Cost(problem, m.config, paper_matcher.scan_turning_function(
-            problem.ranges, problem.laser, m.config.shape))
-        gave_up += m._search_compiled(problem, cost) is None
-        fast = m.localize(problem)
-        with monkeypatch.context() as mp:
-            step_by_step_tf(mp)
-            slow = m.localize(problem)
-        assert (fast.pose, fast.evaluations, fast.info) == (slow.pose, slow.evaluations, slow.info)
-    assert gave_up > 0

@@ -4,10 +4,9 @@ cover go the staged way."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
+from _paths import ROOT
 from _tf_cases import TRUE, few_returns_problem, noisy_scan
 from _tfplus_oracles import step_by_step_tfplus
 from shapely.geometry import box
@@ -17,8 +16,6 @@ from tfloc.harness.task import load_dataset, problem_of
 from tfloc.maps.build import rasterize
 from tfloc.tfplus import pipeline
 from tfloc.tfplus.matcher import TurningFunctionPlusMatcher
-
-ROOT = Path(__file__).resolve().parents[2]
 
 
 def _both(matcher: TurningFunctionPlusMatcher, problem: Problem,

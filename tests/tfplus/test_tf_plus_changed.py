@@ -6,11 +6,11 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
-from _tf_cases import TRUE, noisy_scan
+from _paths import ROOT
+from _tf_cases import TRUE, cost_cases, noisy_scan
 from shapely.geometry import Point, box
 
 from tfloc import Pose, VectorMap
@@ -33,7 +33,6 @@ from tfloc.tfplus.cost_kernel import beam_flags_kernel, see_through_kernel
 from tfloc.tfplus.matcher import TurningFunctionPlusMatcher
 from tfloc.tfplus.view import map_view
 
-ROOT = Path(__file__).resolve().parents[2]
 ROOM = VectorMap(outline=box(0, 0, 8, 6), name="room")
 LASER = LaserSpec.lms200()
 
@@ -131,14 +130,9 @@ def test_the_combined_march_sees_through_as_the_see_through_march() -> None:
 
 @pytest.mark.parametrize("grid", [False, True])
 def test_compiled_changed_world_cost_equals_the_numpy_steps(grid: bool, test_room, lms200) -> None:
-    m = rasterize(test_room, 0.05) if grid else test_room
-    field = map_view(m, 0.05, 0.3, 0.3)
     rng = np.random.default_rng(11)
-    for seed in range(4):
-        ranges = noisy_scan(test_room, lms200, TRUE, seed)
-        ranges[::17] = np.inf
-        ranges[5:9] += 0.5                        # seen through a wall
-        ranges[60:66] -= 1.0                      # an object in front of one
+    for seed, (m, field, ranges) in enumerate(cost_cases(test_room, lms200, grid)):
+        ranges[60:66] -= 1.0                      # an object in front of a wall
         poses = np.vstack((TRUE.as_array(), TRUE.as_array() + rng.normal(0, [0.3, 0.3, 0.05], (3, 3))))
         for extent in (None, 1.0):
             args = (m, lms200, ranges, poses, 6, 0.1, True, field, 0.05, 0.05, 0.3, extent)

@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
+from _paths import ROOT
 
 import tfloc
 from tfloc.core.pose import Pose
@@ -19,8 +19,6 @@ from tfloc.io.scenario import map_for, read_scans, read_scenario
 from tfloc.tfplus import pipeline
 from tfloc.tfplus.matcher import TurningFunctionPlusMatcher
 from tfloc.tfplus.tracker import TfPlusTracker, window_config
-
-ROOT = Path(__file__).resolve().parents[2]
 
 
 class Stub:

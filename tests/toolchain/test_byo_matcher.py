@@ -14,8 +14,7 @@ import sys
 from pathlib import Path
 
 import pytest
-
-ROOT = Path(__file__).resolve().parents[2]
+from _paths import ROOT
 
 
 def _blocks() -> list[tuple[str, str]]:

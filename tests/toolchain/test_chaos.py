@@ -21,12 +21,12 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from _paths import ROOT
 
 from tfloc.core.pose import Pose
 from tfloc.io.estimates import read_estimates, read_rows, repair
 from tfloc.io.scenario import Scan, write_scenario
 
-ROOT = Path(__file__).resolve().parents[2]
 TESTS = Path(__file__).resolve().parents[1]
 ENV = {**os.environ, "PYTHONPATH": os.pathsep.join([str(TESTS), str(ROOT)])}
 KEY = ["dataset", "scan_id", "matcher"]

@@ -7,8 +7,8 @@ import re
 from pathlib import Path
 
 import pytest
+from _paths import ROOT
 
-ROOT = Path(__file__).resolve().parents[2]
 SOURCES = sorted([*(ROOT / "tfloc").rglob("*.py"), *(ROOT / "baselines").rglob("*.py")])
 MAX_LINES = 30
 

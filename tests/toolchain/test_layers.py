@@ -11,8 +11,7 @@ import ast
 from pathlib import Path
 
 import pytest
-
-ROOT = Path(__file__).resolve().parents[2]
+from _paths import ROOT
 
 #: Bottom to top. Each entry is a module or package prefix of ``tfloc``.
 LAYERS = (

@@ -5,16 +5,14 @@ from __future__ import annotations
 
 import platform
 from importlib import metadata
-from pathlib import Path
 
 import pytest
+from _paths import ROOT
 from packaging.utils import canonicalize_name
 
 from tfloc.errors import ConfigError
 from tfloc.io.lock import LOCK_NAME, find_lock, lock_differences, read_lock
 from tfloc.report.report import lock_note
-
-ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_the_checkout_has_its_lock() -> None:

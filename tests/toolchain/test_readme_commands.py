@@ -9,7 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
+from _paths import ROOT
 
 
 def _quick_start_blocks() -> list[str]:

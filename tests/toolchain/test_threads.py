@@ -6,14 +6,13 @@ from __future__ import annotations
 import multiprocessing
 import time
 from concurrent.futures import ProcessPoolExecutor
-from pathlib import Path
 
 import pytest
+from _paths import ROOT
 from _registry import NAMES
 
 from tfloc.harness.runner import _init_worker
 
-ROOT = Path(__file__).resolve().parents[2]
 MATCHERS = tuple(NAMES)  # every registered matcher
 
 
