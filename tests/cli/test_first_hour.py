@@ -70,7 +70,7 @@ def test_a_misspelled_dataset_or_matcher_gets_the_close_names(tmp_path: Path) ->
     line = one_line(tfloc("bench", "data/scenarios/detial-1", "--matchers", "tf", "--out", str(tmp_path / "r")))
     assert "data/scenarios/detial-1: no such directory; did you mean data/scenarios/detail-1" in line
     line = one_line(tfloc("bench", "data/scenarios/detail-1", "--matchers", "csm-cor", "--out", str(tmp_path / "r")))
-    assert "unknown matcher 'csm-cor'; did you mean 'csm-corr'?" in line
+    assert "unknown matcher 'csm-cor'; did you mean 'csm-corr'" in line
     line = one_line(tfloc("track", "--dataset", "data/scenarios/seq-quick", "--matcher", "amcl-tunde"))
     assert "did you mean 'amcl-tuned'" in line
 
