@@ -4,6 +4,7 @@ kept byte for byte, and a malformed file named at its line."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -65,6 +66,10 @@ def test_the_cells_as_written():
     assert to_record(ROWS[PrepRow][1])["status"] == "skipped"
     assert to_record(ROWS[PrepRow][0])["cells"] == "2069000" and to_record(ROWS[PrepRow][0])["size"] == "5174.4"
     assert to_record(TimingRow("d", "s", "g", "m", 0, 1.23456, 2.0))["cpu_ms"] == "1.2346"  # timing.csv: %.4f
+    third = replace(ROWS[ScanRow][0], init_dist_m=1 / 3, cpu_ms=12345678.9)          # the study's: %.6g
+    assert (to_record(third)["init_dist_m"], to_record(third)["cpu_ms"]) == ("0.333333", "1.23457e+07")
+    assert to_record(replace(ROWS[PrepRow][0], prep_cpu_s=2 / 3))["prep_cpu_s"] == "0.666667"
+    assert to_record(replace(ROWS[SkipRow][0], size=1 / 3))["size"] == "0.333333"
     assert from_record(PrepRow, to_record(ROWS[PrepRow][1])).status is None
     assert from_record(ScanRow, to_record(ROWS[ScanRow][1])).status.kind is StatusKind.ERROR
 
