@@ -74,7 +74,7 @@ from .fingerprint import differences
 from .identity import tfloc_code
 from .preflight import build_matcher
 from .runner import environment, load_average
-from .timing import pinned, rotated
+from .pinning import pinned, rotated
 from .workspace import status_of, timed, timed_localize, warm
 
 SEED = 20261201
