@@ -127,7 +127,7 @@ robustness-full: $(STAMP)
 
 ## The scaling study (tfloc scaling): every matcher's CPU per scan against map area (300-20 000 m²,
 ## vector and 5 cm grid), beam count (181-1081) and initial offset, and each map's preparation
-## time and memory → results/scaling/ (README.md, scaling.png, study.json; ~15 min CPU, one pinned
+## time and memory → results/scaling/ (README.md, scaling.png, run.json; ~15 min CPU, one pinned
 ## core; resumed if interrupted).
 scaling: $(STAMP)
 	$(BIN)/tfloc scaling --out results/scaling --regenerate
