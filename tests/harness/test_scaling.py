@@ -1,5 +1,7 @@
 """The scaling study (tfloc scaling): tiling, the same scans at every size, the slope fits, and the
-verb end to end on a tiny configuration: its files, the harness's timer, resume and refusal."""
+verb end to end on a tiny configuration: its run directory (run.json, typed rows), the harness's
+timer, resume, refusal of another configuration, --regenerate, and the README drawn from the
+directory alone."""
 
 from __future__ import annotations
 
@@ -15,19 +17,31 @@ from _paths import ROOT
 
 from tfloc.cli import main
 from tfloc.core.laser import LaserSpec
+from tfloc.core.result import Status
+from tfloc.core.timing_rows import PrepRow, ScanRow, SkipRow
 from tfloc.datasets.tiling import Tiling, tile_vector_map, tiling_for_area
-from tfloc.errors import ConfigError
+from tfloc.errors import ConfigError, ResultsError
 from tfloc.evaluation.scaling import fit_loglog, level_table, slope_table
 from tfloc.harness import workspace
-from tfloc.harness.scaling import StudyConfig, StudyDir, run_study, study_matchers
+from tfloc.harness.scaling import scaling_study
+from tfloc.harness.scaling_config import StudyConfig
+from tfloc.harness.scaling_matchers import study_matchers
 from tfloc.io.geojson import read_vector_map
+from tfloc.io.rundir import RunDir
+from tfloc.io.timing_rows import FILES, read_rows, rows_frame, write_rows
 from tfloc.maps.build import rasterize
 from tfloc.maps.vector import VectorMap
+from tfloc.report.scaling import render_scaling
 
 OFFICE = ROOT / "data" / "maps" / "office-1.geojson"
 #: The tiny study: 2 areas × 2 kinds, the 4 lasers, the 3 offset bins; 2 scans each; 2 cheap matchers.
 TINY = ["--matchers", "tf-plus,cv-corners", "--areas", "300,1200", "--scans", "2", "--scans-per-bin", "2",
         "--map", str(OFFICE), "--no-progress"]
+
+
+def raw(out: Path) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
+    """The study's tables of scan, preparation and skip rows, read as typed rows."""
+    return tuple(rows_frame(read_rows(out / FILES[c], c), c) for c in (ScanRow, PrepRow, SkipRow))
 
 
 @pytest.fixture(scope="module")
@@ -132,12 +146,13 @@ def study(tmp_path_factory):
     return out, calls
 
 
-def test_the_verb_end_to_end_on_a_tiny_configuration(study):
+def test_the_verb_end_to_end_on_a_tiny_configuration(study, tmp_path):
     out, _ = study
     for f in ("scaling.csv", "prep.csv", "skips.csv", "levels.csv", "slopes.csv", "README.md", "scaling.png",
-              "study.json"):
+              "run.json"):
         assert (out / f).stat().st_size > 0, f
-    rows, prep, skips = StudyDir(out).raw()
+    assert not (out / "study.json").exists()
+    rows, prep, skips = raw(out)
     # every (axis, kind, level) × matcher × scan once
     area = rows[rows["axis"] == "area"]
     assert len(area) == 2 * 2 * 2 * 2 and len(rows[rows["axis"] == "beams"]) == 4 * 2 * 2
@@ -161,66 +176,122 @@ def test_the_verb_end_to_end_on_a_tiny_configuration(study):
     readme = (out / "README.md").read_text()
     assert "Written by `tfloc scaling`" in readme and "issue" not in readme
     assert "**tf-plus**" in readme and "CPU per scan against map area, 5 cm grid" in readme
-    # the record of the code and configuration that made it
-    doc = json.loads((out / "study.json").read_text())
-    assert doc["config"]["scans_per_level"] == 2 and doc["config"]["matchers"] == ["tf-plus", "cv-corners"]
+    assert "`run.json`: the configuration" in readme
+    # typed rows: statuses are Status, and the files are the rows written again, byte for byte
+    for cls in (ScanRow, PrepRow, SkipRow):
+        typed = read_rows(out / FILES[cls], cls)
+        assert cls is SkipRow or all(isinstance(r.status, Status) for r in typed)
+        write_rows(tmp_path / FILES[cls], typed, cls)
+        assert (tmp_path / FILES[cls]).read_text() == (out / FILES[cls]).read_text()
+    # run.json: a run directory's record of the code and configuration that made it
+    info = RunDir(out).info(required=True)
+    doc = info.doc
+    assert info.kind == "scaling" and [m["label"] for m in info.matchers] == ["tf-plus", "cv-corners"]
+    assert doc["config"]["scaling"]["scans_per_level"] == 2 and doc["config"]["scaling"]["matchers"] == [
+        "tf-plus", "cv-corners"]
+    assert info.datasets == {"office-1": OFFICE} and info.thresholds.dist_m == 0.1
     assert set(doc["fingerprint"]["matchers"]) == {"tf-plus", "cv-corners"}
+    assert doc["fingerprint"]["scaling"] == doc["config"]["scaling"]
     assert "commit" in doc["git"] and "dirty" in doc["git"] and doc["versions"]["numpy"]
-    assert doc["machine"]["python"] and doc["done"] == doc["levels"] and len(doc["levels"]) == 4 + 4 + 3
-    (session,) = doc["sessions"]
+    assert doc["machine"]["python"] and doc["machine"]["cpu"]
+    assert info.done == doc["levels"] and len(doc["levels"]) == 4 + 4 + 3
+    (session,) = info.sessions
     assert session["started"] <= session["ended"] and len(session["cores"]) == 1 and session["cpu_s"] > 0
+    assert session["loadavg_start"] and session["loadavg_end"] and session["tasks"] == 11 * 2 * 2
     assert doc["command"].startswith("tfloc scaling --out ")
+    assert StudyConfig.from_dict(doc["config"]["scaling"]) == StudyConfig(
+        map_path=str(OFFICE), areas_m2=(300.0, 1200.0), scans_per_level=2, scans_per_offset_bin=2,
+        matchers=("tf-plus", "cv-corners"))
 
 
 def test_the_study_times_with_the_harness_timer(study):
     out, calls = study
-    rows, _, _ = StudyDir(out).raw()
+    rows, _, _ = raw(out)
     timed = [1000.0 * t.cpu_s for name, t in calls if name == "localize"]
     assert len(timed) == len(rows)
     np.testing.assert_allclose(rows["cpu_ms"], timed, rtol=1e-5)
 
 
+def test_the_readme_is_drawn_from_the_run_directory_alone(study, tmp_path):
+    out, _ = study
+    copy = tmp_path / "copy"
+    copy.mkdir()
+    for f in ("run.json", "scaling.csv", "prep.csv", "skips.csv"):
+        shutil.copy(out / f, copy / f)
+    slopes = render_scaling(copy)
+    assert (copy / "README.md").read_text() == (out / "README.md").read_text()
+    assert (copy / "slopes.csv").read_text() == (out / "slopes.csv").read_text() and len(slopes)
+    (copy / "run.json").unlink()
+    with pytest.raises(ResultsError, match="no scaling study here"):
+        render_scaling(copy)
+
+
 def test_a_complete_study_is_only_redrawn(study, capsys):
     out, _ = study
-    before = {f: (out / f).read_text() for f in ("scaling.csv", "prep.csv", "README.md", "study.json")}
+    before = {f: (out / f).read_text() for f in ("scaling.csv", "prep.csv", "README.md", "run.json")}
     assert main(["scaling", "--out", str(out), *TINY]) == 0
     assert {f: (out / f).read_text() for f in before} == before
-    assert "slope" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert f"{out}: already complete: 0 levels run (--regenerate runs it again)" in err and "slope" in err
 
 
 def test_a_directory_of_another_configuration_is_refused(study, capsys):
     out, _ = study
-    before = (out / "scaling.csv").read_text()
+    before = {f: (out / f).read_text() for f in ("scaling.csv", "run.json")}
     assert main(["scaling", "--out", str(out), *TINY[:5], "3", *TINY[6:]]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "holds a study of another configuration" in err
-    assert "scans_per_level 2 → 3" in err and "--regenerate" in err
-    assert (out / "scaling.csv").read_text() == before
+    assert err == (f"tfloc scaling: error: {out} holds a study of another configuration: scans_per_level 2 → 3; "
+                   "to start it over give --regenerate, to keep it choose another --out")
+    assert {f: (out / f).read_text() for f in before} == before
 
 
-def test_an_interrupted_study_resumes_without_mixing_rows(study, tmp_path):
+def test_an_interrupted_study_resumes_without_mixing_rows(study, tmp_path, capsys):
     src, _ = study
     out = tmp_path / "cut"
     shutil.copytree(src, out)
-    doc = json.loads((out / "study.json").read_text())
-    doc["done"] = doc["done"][:-2]   # killed after the rows of the last two levels, before study.json
-    (out / "study.json").write_text(json.dumps(doc))
+    doc = json.loads((out / "run.json").read_text())
+    doc["done"] = doc["done"][:-2]   # killed after the rows of the last two levels, before run.json
+    (out / "run.json").write_text(json.dumps(doc))
     assert main(["scaling", "--out", str(out), *TINY]) == 0
-    rows, prep, _ = StudyDir(out).raw()
-    old, _, _ = StudyDir(src).raw()
+    assert f"{out}: resuming: 9 of 11 levels done by the same code and configuration" in capsys.readouterr().err
+    rows, prep, _ = raw(out)
+    old, _, _ = raw(src)
     assert len(rows) == len(old) and not rows.duplicated(["axis", "kind", "level", "matcher", "scan_id"]).any()
     assert len(prep) == 3 * 2 * 2
-    doc = json.loads((out / "study.json").read_text())
+    doc = json.loads((out / "run.json").read_text())
     assert doc["done"] == doc["levels"] and [s["levels_done_before"] for s in doc["sessions"]] == [0, 9]
+    assert [s["already_done"] for s in doc["sessions"]] == [0, 9 * 2 * 2]
+
+
+def test_regenerate_starts_another_configuration_or_an_old_directory_over(tmp_path):
+    small = StudyConfig(map_path=str(OFFICE), axes=("offset",), scans_per_offset_bin=1, matchers=("cv-corners",))
+    out = tmp_path / "study"
+    out.mkdir()
+    (out / "study.json").write_text("{}")           # a study made by an older tfloc
+    (out / "scaling.csv").write_text("matcher\n")
+    with pytest.raises(ConfigError, match="it records no fingerprint .*--regenerate"):
+        scaling_study(small, out, log=lambda s: None)
+    scaling_study(small, out, regenerate=True, log=lambda s: None)
+    assert not (out / "study.json").exists() and len(raw(out)[0]) == 3
+    bigger = StudyConfig.from_dict({"scans_per_offset_bin": 2}, base=small)
+    with pytest.raises(ConfigError, match="scans_per_offset_bin 1 → 2"):
+        scaling_study(bigger, out, log=lambda s: None)
+    scaling_study(bigger, out, regenerate=True, log=lambda s: None)
+    info = RunDir(out).info()
+    assert len(raw(out)[0]) == 6 and info.config["scaling"]["scans_per_offset_bin"] == 2 and len(info.sessions) == 1
+    logged: list[str] = []
+    scaling_study(bigger, out, regenerate=True, log=logged.append)   # complete: runs again
+    assert not any("already complete" in s for s in logged) and len(RunDir(out).info().sessions) == 1
 
 
 def test_a_matcher_over_budget_is_not_run_at_larger_levels(tmp_path):
     cfg = StudyConfig(map_path=str(OFFICE), areas_m2=(300.0, 1200.0, 5000.0), kinds=("vector",), axes=("area",),
                       scans_per_level=2, matchers=("tf-plus",), budget_ms=1e-6)
-    rows, prep, skips = run_study(cfg, tmp_path, log=lambda s: None).raw()
+    rows, prep, skips = raw(scaling_study(cfg, tmp_path, log=lambda s: None).path)
     assert set(rows["level"]) == {"1x1"}
     assert list(skips["level"]) == ["2x2", "4x4"] and skips["why"].str.contains("> 1e-06 ms at 1x1").all()
     assert list(prep.loc[prep["matcher"] == "tf-plus", "status"]) == ["ok", "skipped", "skipped"]
+    assert [r.status for r in read_rows(tmp_path / "prep.csv", PrepRow) if r.matcher == "tf-plus"][1:] == [None, None]
 
 
 def test_tiling_needs_a_closed_tile():
@@ -255,3 +326,14 @@ def test_bad_study_configurations_are_refused():
     with pytest.raises(ConfigError, match="scans per level 0"):
         StudyConfig(scans_per_level=0)
     assert StudyConfig.quick().scans_per_level == 9 and StudyConfig().scans_per_level == 45
+    # a study file's [scaling] table
+    cfg = StudyConfig.from_dict({"lasers": [[180, 1]], "areas_m2": [300, 1200], "matchers": ["tf-plus"],
+                                 "budget_ms": 100})
+    assert cfg.lasers == ((180.0, 1.0),) and cfg.areas_m2 == (300.0, 1200.0) and cfg.matchers == ("tf-plus",)
+    assert cfg.budget_ms == 100.0 and cfg.scans_per_level == 45
+    assert StudyConfig.from_dict({"budget_ms": 1.0}, base=StudyConfig.quick()).scans_per_level == 9
+    with pytest.raises(ConfigError, match="unknown field.*'scans'"):
+        StudyConfig.from_dict({"scans": 3})
+    for bad in ({"scans_per_level": 2.5}, {"matchers": "tf-plus"}, {"matchers": [1]}, {"warmup": True}):
+        with pytest.raises(ConfigError, match=f"field '{next(iter(bad))}'"):
+            StudyConfig.from_dict(bad)

@@ -1,9 +1,13 @@
-"""The side-by-side timing pass (tfloc timing RUN) and the quick run's configuration."""
+"""The side-by-side timing pass (tfloc timing RUN): the sample, the interleaving, the summary, its
+record in run.json (already complete, timed again for another configuration or a changed run,
+removed with the run) and the quick run's configuration."""
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -14,13 +18,15 @@ from _paths import ROOT
 
 from tests._estimates import frame, row
 from tests.harness.test_runner import cfg, make_dataset
-from tfloc.cli import build_parser
+from tfloc.cli import build_parser, main
 from tfloc.cli.bench import QUICK_PER_GROUP, config_from_args
+from tfloc.core.timing_rows import TimingRow
 from tfloc.errors import ConfigError
 from tfloc.evaluation.timing import reference_of, timing_summary
 from tfloc.harness.config import MatcherSpec
 from tfloc.harness.runner import run
-from tfloc.harness.timing import TIMING_COLUMNS, run_timing, sample_scans
+from tfloc.harness.timing import run_timing, sample_scans
+from tfloc.report.timing_pass import timing_pass
 
 ENV = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "tests"), str(ROOT)])}
 
@@ -64,25 +70,29 @@ def test_summary_ratios_and_the_runs_own_cpu_times():
         reference_of(["a"], "b")
 
 
+def _config(ds: Path, out: Path, *specs: MatcherSpec):
+    specs = specs or (MatcherSpec.make("tf-plus"), MatcherSpec.make("o3d-icp"),
+                      MatcherSpec.make("toy_matchers:Stay", label="stay"))
+    return cfg(ds, out, *specs, jobs=1, timeout_s=60.0)
+
+
 @pytest.fixture(scope="module")
 def small_run(tmp_path_factory, test_room, lms200):
     tmp = tmp_path_factory.mktemp("timing")
     ds = make_dataset(tmp / "ds", test_room, lms200, n=6)
-    return run(cfg(ds, tmp / "run", MatcherSpec.make("tf-plus"), MatcherSpec.make("o3d-icp"),
-                   MatcherSpec.make("toy_matchers:Stay", label="stay"), jobs=1, timeout_s=60.0),
-               progress=False)
+    return run(_config(ds, tmp / "run"), progress=False)
 
 
 def test_timing_pass_interleaves_matchers_and_restores_the_affinity(small_run):
     before = os.sched_getaffinity(0)
     rows, info = run_timing(small_run, per_stratum=2, warmup=1)
     assert os.sched_getaffinity(0) == before
-    assert list(rows.columns) == TIMING_COLUMNS
+    assert all(isinstance(r, TimingRow) for r in rows)
     assert len(rows) == 2 * 2 * 3  # 2 groups × 2 scans × 3 matchers
     # the order rotates scan by scan: each matcher is first on a different scan
-    first = rows[rows["position"] == 0]["matcher"].tolist()
+    first = [r.matcher for r in rows if r.position == 0]
     assert first == ["tf-plus", "o3d-icp", "stay", "tf-plus"]
-    assert (rows["cpu_ms"] > 0).all() and info["scans"] == 4 and len(info["cores"]) == 1
+    assert all(r.cpu_ms > 0 for r in rows) and info["scans"] == 4 and len(info["cores"]) == 1
 
 
 def test_timing_cli_writes_csv_and_markdown_and_the_report_links_it(small_run):
@@ -93,12 +103,88 @@ def test_timing_cli_writes_csv_and_markdown_and_the_report_links_it(small_run):
     md = (small_run / "timing.md").read_text()
     assert "CPU ratio to `o3d-icp` [95 % CI]" in md and "run / quiet" in md
     assert len(pd.read_csv(small_run / "timing.csv")) == 2 * 3
+    record = json.loads((small_run / "run.json").read_text())["timing"]
+    assert record["complete"] and record["fingerprint"]["reference"] == "o3d-icp"
+    assert len(record["sessions"]) == 1 and record["sessions"][0]["ended"] >= record["sessions"][0]["started"]
     from tfloc.report.report import write_report
 
     assert "[timing.md](timing.md)" in write_report(small_run, with_figures=False).report.read_text()
     bad = subprocess.run([sys.executable, "-m", "tfloc.cli", "timing", str(small_run), "--reference", "nope"],
                          cwd=ROOT, env=ENV, capture_output=True, text=True, timeout=120)
     assert bad.returncode == 2 and "reference matcher 'nope'" in bad.stderr
+
+
+def _copy(small_run: Path, tmp_path: Path) -> Path:
+    out = tmp_path / "run"
+    shutil.copytree(small_run, out)
+    return out
+
+
+def _doc(run_dir: Path) -> dict:
+    return json.loads((run_dir / "run.json").read_text())
+
+
+def test_a_complete_timing_pass_is_not_timed_again(small_run, tmp_path, monkeypatch, capsys):
+    run_dir = _copy(small_run, tmp_path)
+    timing_pass(run_dir, 1, 1, log=lambda s: None)
+    record = _doc(run_dir)["timing"]
+    assert record["complete"] and record["fingerprint"]["run"] == _doc(run_dir)["fingerprint"]
+    assert {k: record["fingerprint"][k] for k in ("per_stratum", "warmup", "reference")} == {
+        "per_stratum": 1, "warmup": 1, "reference": "tf-plus"}
+    before = {f: (run_dir / f).read_bytes() for f in ("timing.csv", "timing.md", "run.json")}
+
+    def no_timing(*args, **kwargs):
+        raise AssertionError("a current timing pass was timed again")
+
+    monkeypatch.setattr("tfloc.report.timing_pass.run_timing", no_timing)
+    logged: list[str] = []
+    assert timing_pass(run_dir, 1, 1, log=logged.append) == run_dir
+    assert logged == [f"{run_dir}: already complete: timing.md is current (--regenerate times it again)"]
+    assert main(["timing", str(run_dir), "--per-stratum", "1", "--warmup", "1"]) == 0
+    assert "already complete: timing.md is current" in capsys.readouterr().err
+    assert {f: (run_dir / f).read_bytes() for f in before} == before
+
+
+def test_another_configuration_or_a_changed_run_is_timed_again(small_run, tmp_path):
+    run_dir = _copy(small_run, tmp_path)
+    timing_pass(run_dir, 1, 1, log=lambda s: None)
+    logged: list[str] = []
+    timing_pass(run_dir, 2, 1, log=logged.append)
+    assert logged[0] == f"{run_dir}: timing again: per_stratum 1 → 2"
+    assert len(pd.read_csv(run_dir / "timing.csv")) == 2 * 2 * 3 and "2 scan(s) per dataset" in (
+        run_dir / "timing.md").read_text()
+    record = _doc(run_dir)["timing"]
+    assert record["fingerprint"]["per_stratum"] == 2 and len(record["sessions"]) == 1 and record["complete"]
+    doc = _doc(run_dir)                       # the run made again under other thresholds
+    doc["fingerprint"]["success"]["dist_m"] = 0.2
+    (run_dir / "run.json").write_text(json.dumps(doc))
+    logged.clear()
+    timing_pass(run_dir, 2, 1, log=logged.append)
+    assert logged[0] == f"{run_dir}: timing again: the run changed (success dist_m 0.1 → 0.2)"
+    doc = _doc(run_dir)                       # a pass cut off before it finished
+    doc["timing"]["complete"] = False
+    (run_dir / "run.json").write_text(json.dumps(doc))
+    logged.clear()
+    timing_pass(run_dir, 2, 1, log=logged.append)
+    assert logged[0] == f"{run_dir}: timing again: the last timing pass did not finish"
+    logged.clear()
+    timing_pass(run_dir, 2, 1, regenerate=True, log=logged.append)
+    assert logged[0] == f"{run_dir}: timing again (--regenerate)"
+    assert len(_doc(run_dir)["timing"]["sessions"]) == 1
+
+
+def test_bench_keeps_a_current_timing_pass_and_regenerate_removes_it(small_run, tmp_path):
+    run_dir = _copy(small_run, tmp_path)
+    timing_pass(run_dir, 1, 1, log=lambda s: None)
+    ds = Path(next(iter(_doc(run_dir)["datasets"].values())))
+    run(_config(ds, run_dir), progress=False)      # complete: nothing runs, a session is recorded
+    assert _doc(run_dir)["timing"]["complete"] and len(_doc(run_dir)["sessions"]) == 2
+    logged: list[str] = []
+    timing_pass(run_dir, 1, 1, log=logged.append)
+    assert logged == [f"{run_dir}: already complete: timing.md is current (--regenerate times it again)"]
+    run(_config(ds, run_dir, MatcherSpec.make("toy_matchers:Stay", label="stay")), progress=False, regenerate=True)
+    assert not (run_dir / "timing.csv").exists() and not (run_dir / "timing.md").exists()
+    assert "timing" not in _doc(run_dir)
 
 
 def _bench_args(*extra: str) -> argparse.Namespace:

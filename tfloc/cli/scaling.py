@@ -14,12 +14,13 @@ median exceeds the budget at a level (or whose preparation exceeds its budget) i
 the larger levels of that axis. Trackers without a single-scan mode, odometry and the global
 matchers are left out unless named (a tracker without a single-scan mode always is).
 
-OUT gets study.json (the configuration and its fingerprint, package versions, git commit and
-dirty flag, machine, each session's start and end), the raw rows scaling.csv, prep.csv and
-skips.csv (written after every level), then levels.csv, slopes.csv, scaling.png and README.md.
-Run again after an interruption, the same command resumes at the first level not done; on a
-complete study it only redraws the tables, figure and README. A directory holding a study of
-another configuration is refused (exit 2): give --regenerate to start it over, or another --out.
+OUT is a run directory: run.json (kind scaling: the configuration and its fingerprint, package
+versions, git commit and dirty flag, machine, each session's start and end, the levels done),
+the raw rows scaling.csv, prep.csv and skips.csv (written after every level), then levels.csv,
+slopes.csv, scaling.png and README.md. Run again after an interruption, the same command resumes
+at the first level not done; on a complete study it only redraws the tables, figure and README.
+A directory holding a study of another configuration is refused (exit 2) with one line naming
+what differs: give --regenerate to start it over, or another --out.
 
 Examples:
   tfloc scaling --out results/scaling   # the full study (make scaling)
@@ -77,7 +78,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def config_from_args(args: argparse.Namespace):
     """The study's configuration: the full or quick one, with the options given."""
-    from tfloc.harness.scaling import StudyConfig
+    from tfloc.harness.scaling_config import StudyConfig
 
     cfg = StudyConfig.quick() if args.quick else StudyConfig()
     given = {field: getattr(args, opt[2:].replace("-", "_")) for opt, (field, _, _) in OVERRIDES.items()}
@@ -85,7 +86,7 @@ def config_from_args(args: argparse.Namespace):
 
 
 def command_of(args: argparse.Namespace, out: Path) -> str:
-    """The command line that makes this study (recorded in study.json and the README)."""
+    """The command line that makes this study (recorded in run.json and the README)."""
     words = ["tfloc", "scaling", *(["--quick"] if args.quick else []), "--out", str(out)]
     for opt in OVERRIDES:
         v = getattr(args, opt[2:].replace("-", "_"))
@@ -109,19 +110,15 @@ def run(args: argparse.Namespace) -> int:
 
 def run_config(table: dict, quick: bool, out: Path, regenerate: bool = False, progress: bool | None = None,
                command: str = "") -> int:
-    """Run (or resume) the study with the fields ``table`` over the full or quick configuration,
-    then render its README and figure (``tfloc scaling`` and a scaling study file alike)."""
+    """Run (or resume) the study with the fields ``table`` over the full or quick configuration
+    (:meth:`StudyConfig.from_dict`), then render its README and figure from the run directory
+    (``tfloc scaling`` and a study file of kind scaling alike)."""
     from tqdm import tqdm
 
-    from tfloc.errors import ConfigError
-    from tfloc.harness.scaling import StudyConfig, provenance, run_study
-    from tfloc.report.scaling import render
+    from tfloc.harness.scaling import StudyConfig, scaling_study
+    from tfloc.report.scaling import render_scaling
 
-    base = StudyConfig.quick() if quick else StudyConfig()
-    try:
-        cfg = replace(base, **{k: tuple(v) if isinstance(v, list) else v for k, v in table.items()})
-    except TypeError as exc:
-        raise ConfigError(f"[scaling]: {exc}") from None
+    cfg = StudyConfig.from_dict(table, StudyConfig.quick() if quick else StudyConfig())
     bar = tqdm(unit="scan", desc="scaling", disable=None if progress is None else not progress,
                smoothing=0.05, mininterval=1.0)
 
@@ -130,14 +127,13 @@ def run_config(table: dict, quick: bool, out: Path, regenerate: bool = False, pr
         bar.update(done - bar.n)
 
     try:
-        sd = run_study(cfg, out, log=lambda s: tqdm.write(s, file=sys.stderr), progress=step,
-                       regenerate=regenerate, command=command)
+        rd = scaling_study(cfg, out, regenerate=regenerate, progress=step,
+                           log=lambda s: tqdm.write(s, file=sys.stderr), command=command)
     finally:
         bar.close()
-    doc = sd.doc() or {}
-    slopes = render(sd.path, *sd.raw(), doc.get("config", {}), provenance(doc))
+    slopes = render_scaling(rd.path)
     if len(slopes):
         print(slopes[["axis", "kind", "matcher", "slope", "first_ms", "last_ms"]].to_string(
             index=False, float_format=lambda v: f"{v:.2f}"), file=sys.stderr)
-    print(f"scaling: {sd.path / 'README.md'}", file=sys.stderr)
+    print(f"scaling: {rd.path / 'README.md'}", file=sys.stderr)
     return 0

@@ -6,6 +6,11 @@ timing.md gives the median CPU ms per matcher with bootstrap intervals, the rati
 reference matcher, and the run's own CPU times on the same scans (see tfloc.harness.timing).
 make bench runs it after the accuracy runs; tfloc report links timing.md when present.
 
+RUN/run.json records the pass (its fingerprint: the run's, --per-stratum, --seed, --warmup,
+--reference, the sample and the code timed; its sessions). Run again on a run whose pass is
+complete and current, it says so and times nothing; a pass of other options, a run whose rows
+or code changed, or an interrupted pass is timed again; --regenerate always times again.
+
 Examples:
   tfloc timing results/paper-protocol
   tfloc timing results/paper-protocol --per-stratum 10 --cores 1 --reference o3d-icp
@@ -29,42 +34,34 @@ def _cores(text: str) -> list[int]:
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("run", type=Path, metavar="RUN", help="run directory (estimates.csv, run.json)")
-    p.add_argument("--per-stratum", type=int, default=4,
+    p.add_argument("--per-stratum", type=int, default=None,
                    help="scans per dataset × group (default 4)")
     p.add_argument("--seed", type=int, default=None, help="sampling seed (default: fixed)")
     p.add_argument("--cores", type=_cores, default=None,
                    help="comma-separated cores to pin the process to (default: the last allowed core)")
     p.add_argument("--reference", default=None, help="reference matcher of the ratios (default: tf-plus, "
                    "else the first)")
-    p.add_argument("--warmup", type=int, default=2, help="untimed localize calls per dataset and matcher (default 2)")
+    p.add_argument("--warmup", type=int, default=None, help="untimed localize calls per dataset and matcher (default 2)")
+    p.add_argument("--regenerate", action="store_true",
+                   help="time again even if the run's timing pass is complete and current")
 
 
 def run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
-    from tfloc.errors import ConfigError
-    from tfloc.evaluation.timing import reference_of, timing_summary
-    from tfloc.harness.timing import SEED, read_run, run_timing
-    from tfloc.report.timing import write_timing
+    from tfloc.report.timing_pass import timing_pass
 
-    df, run_info = read_run(args.run)
-    try:
-        reference = reference_of([m["label"] for m in run_info.matchers], args.reference)
-    except ValueError as exc:
-        raise ConfigError(str(exc)) from None
-    bar = tqdm(unit="scan", desc="timing", disable=not sys.stderr.isatty())
+    bars: list[tqdm] = []  # made at the first scan timed (none when the pass is current)
 
     def progress(done: int, total: int) -> None:
-        bar.total = total
-        bar.update(done - bar.n)
+        if not bars:
+            bars.append(tqdm(total=total, unit="scan", desc="timing", disable=not sys.stderr.isatty()))
+        bars[0].update(done - bars[0].n)
 
-    rows, info = run_timing(args.run, args.per_stratum, SEED if args.seed is None else args.seed, args.cores,
-                            args.warmup, progress, run=(df, run_info))
-    bar.close()
-    summary = timing_summary(rows, reference, df)
-    csv_path, md_path = write_timing(args.run, rows, summary, reference, info,
-                                     run_info.name or args.run.name)
-    print(summary[["matcher", "cpu_median_ms", "ratio_to_reference", "run_over_quiet"]].to_string(
-        index=False, float_format=lambda v: f"{v:.2f}"), file=sys.stderr)
-    print(f"timing: {md_path} ({csv_path.name})", file=sys.stderr)
+    try:
+        timing_pass(args.run, args.per_stratum, args.warmup, args.reference, args.regenerate, progress,
+                    seed=args.seed, cores=args.cores, log=lambda s: tqdm.write(s, file=sys.stderr))
+    finally:
+        for bar in bars:
+            bar.close()
     return 0

@@ -17,19 +17,18 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from tfloc.core.timing_rows import PrepRow, ScanRow, SkipRow
+from tfloc.io.timing_rows import columns
+
 #: A slope of log cost against log size above this counts as "grows".
 GROWS_SLOPE = 0.2
 
-#: Columns of the study's per-scan rows (``scaling.csv``).
-SCAN_COLUMNS = ["matcher", "axis", "kind", "level", "size", "tiles", "beams", "fov_deg", "scan_id",
-                "offset_bin", "init_dist_m", "position", "cpu_ms", "sys_ms", "wall_ms", "dist_err_m",
-                "orient_err_deg", "success", "status"]
-#: Columns of the preparation rows (``prep.csv``): one per (matcher, map); matcher ``(map)`` is
-#: the map itself (building it; its own arrays).
-PREP_COLUMNS = ["matcher", "kind", "tiles", "size", "cells", "segments", "prep_cpu_s",
-                "prep_wall_s", "rss_delta_mb", "peak_mb", "status"]
-#: Columns of the rows of matchers not run at a level (``skips.csv``).
-SKIP_COLUMNS = ["axis", "kind", "level", "size", "matcher", "why"]
+#: Columns of the study's tables: the fields of its typed rows (``scaling.csv``, ``prep.csv``
+#: with matcher ``(map)`` for the map itself, ``skips.csv``), whose tables
+#: (:func:`tfloc.io.timing_rows.rows_frame`) the functions below read.
+SCAN_COLUMNS = columns(ScanRow)
+PREP_COLUMNS = columns(PrepRow)
+SKIP_COLUMNS = columns(SkipRow)
 
 
 @dataclass(frozen=True)

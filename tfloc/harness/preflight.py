@@ -47,15 +47,18 @@ def build_matcher(spec: MatcherSpec) -> dict[str, Any]:
     return spec.params
 
 
+def matcher_record(spec: MatcherSpec) -> dict[str, Any]:
+    """The matcher of ``spec`` built once (:func:`build_matcher`): its name, the registered matcher
+    it stands for (a preset's or a label's), resolved parameters and the code that answers; what a
+    fingerprint records of it."""
+    params = build_matcher(spec)
+    return {"name": spec.name, "matcher": resolve(spec.name, {})[0], "params": params,
+            **matcher_code(factory_of(spec.name))}
+
+
 def build_matchers(config: RunConfig) -> dict[str, dict[str, Any]]:
-    """Every matcher of the run built once: label → name, the registered matcher it stands for
-    (a preset's or a label's), resolved parameters and the code that answers."""
-    out = {}
-    for m in config.matchers:
-        params = build_matcher(m)
-        out[m.label] = {"name": m.name, "matcher": resolve(m.name, {})[0], "params": params,
-                        **matcher_code(factory_of(m.name))}
-    return out
+    """Every matcher of the run built once: label → :func:`matcher_record`."""
+    return {m.label: matcher_record(m) for m in config.matchers}
 
 
 def available(config: RunConfig, log=None) -> RunConfig:

@@ -102,8 +102,19 @@ def load_average() -> list[float] | None:
         return None
 
 
+def cpu_model() -> str:
+    """The CPU's model name (``/proc/cpuinfo``), else :func:`platform.processor`."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor()
+
+
 def environment() -> dict:
-    """Package versions, git commit and machine, for ``run.json``."""
+    """Package versions, git commit and machine (with the CPU's model), for ``run.json``."""
     versions = {}
     for pkg in PACKAGES:
         try:
@@ -112,7 +123,7 @@ def environment() -> dict:
             versions[pkg] = None
     return {"versions": versions, "git": git_state(),
             "machine": {"platform": platform.platform(), "processor": platform.processor(),
-                        "cpu_count": os.cpu_count(), "python": sys.version.split()[0],
+                        "cpu": cpu_model(), "cpu_count": os.cpu_count(), "python": sys.version.split()[0],
                         "node": platform.node()}}
 
 

@@ -8,46 +8,76 @@ conditions:
 * **Sample**: per stratum (dataset × group, e.g. one offset cell) ``per_stratum`` scans drawn
   with a seeded generator from the scans every matcher of the run answered (a scan on which a
   matcher timed out or raised in the run is left out: it would dominate the pass's time).
-* **One process pinned to the configured cores** (``os.sched_setaffinity``), every library on
-  one thread (:func:`tfloc.harness.threads.limit_threads`).
+* **One process pinned to the configured cores**, every library on one thread, the matchers
+  interleaved scan by scan in rotated order (:mod:`tfloc.harness.pinning`).
 * **Warm-up**: for each dataset and matcher, :func:`tfloc.harness.workspace.warm` and ``warmup``
   untimed ``localize`` calls on sampled scans (kernels, map-only structures, the allocator).
-* **Interleaved**: scan by scan, every matcher once, the order rotated by one per scan, so slow
-  drifts of the machine (load, frequency) hit every matcher alike.
 * Each call is timed by CPU time (``time.process_time``) and wall time (``time.perf_counter``).
 
-:func:`run_timing` returns one row per (scan, matcher) (``TIMING_COLUMNS``); ``tfloc timing``
-writes them to ``RUN/timing.csv`` and the summary (:mod:`tfloc.evaluation.timing`) to
-``RUN/timing.md``.
-
-The pinning (:func:`pinned`) and the interleaving (:func:`rotated`) are also the scaling study's
-(:mod:`tfloc.harness.scaling`).
+:func:`run_timing` returns one :class:`~tfloc.core.timing_rows.TimingRow` per (scan, matcher).
+A pass is one configuration (:func:`timing_fingerprint`: the run's fingerprint, the pass's
+:class:`TimingParams`, the sample drawn and the code timed), recorded in the run's ``run.json``
+(:meth:`~tfloc.io.rundir.RunDir.start_timing`); :func:`stale` says why a recorded pass is not
+current. :func:`tfloc.report.timing_pass.timing_pass` runs it end to end (``tfloc timing``):
+``RUN/timing.csv``, ``RUN/timing.md``. A pass is short and runs whole: an interrupted one is
+timed again from the start, never resumed.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
-import os
 import time
-from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import TypeVar
 
 import numpy as np
 import pandas as pd
 
+from tfloc.core.timing_rows import TimingRow
 from tfloc.errors import ConfigError
+from tfloc.evaluation.timing import reference_of
 from tfloc.io.rundir import RunDir, RunInfo
 
-from .identity import git_state
+from .fingerprint import differences
+from .identity import git_state, tfloc_code
+from .pinning import pinned, rotated
 from .runner import load_average
-from .threads import limit_threads
 from .workspace import load_dataset, load_matcher, problem_of, timed_localize, warm
 
-TIMING_COLUMNS = ["dataset", "scan_id", "group", "matcher", "position", "cpu_ms", "wall_ms"]
 SEED = 20261130
-T = TypeVar("T")
+PER_STRATUM = 4  # scans per dataset × group, by default
+WARMUP = 2       # untimed localize calls per dataset and matcher, by default
+NO_PASS = "no timing pass yet"
+
+
+@dataclass(frozen=True)
+class TimingParams:
+    """What a timing pass is asked for: scans per stratum, the sampling seed, untimed warm-up
+    calls per dataset and matcher, and the reference matcher of the ratios (a label)."""
+
+    per_stratum: int = PER_STRATUM
+    seed: int = SEED
+    warmup: int = WARMUP
+    reference: str = ""
+
+    @classmethod
+    def of(cls, labels: Sequence[str], per_stratum: int | None = None, seed: int | None = None,
+           warmup: int | None = None, reference: str | None = None) -> TimingParams:
+        """The parameters for a run of matchers ``labels``, a default for every ``None`` (the
+        reference: tf-plus if the run has it, else its first matcher); a bad one is a
+        :class:`ConfigError`."""
+        try:
+            ref = reference_of(list(labels), reference)
+        except (ValueError, IndexError) as exc:
+            raise ConfigError(str(exc) or "the run has no matcher") from None
+        p = cls(PER_STRATUM if per_stratum is None else per_stratum, SEED if seed is None else seed,
+                WARMUP if warmup is None else warmup, ref)
+        if p.per_stratum < 1 or p.warmup < 0:
+            raise ConfigError(f"per-stratum sample size must be ≥ 1 and warm-up ≥ 0, got {p.per_stratum} "
+                              f"and {p.warmup}")
+        return p
 
 
 def read_run(run_dir: Path) -> tuple[pd.DataFrame, RunInfo]:
@@ -78,51 +108,52 @@ def sample_scans(df: pd.DataFrame, per_stratum: int, seed: int = SEED) -> pd.Dat
     return pd.concat(parts, ignore_index=True)[cols] if parts else pd.DataFrame(columns=cols)
 
 
-def pin(cores: Sequence[int]) -> list[int]:
-    """Pin this process to ``cores`` (where the OS allows); returns the cores it now runs on."""
-    if hasattr(os, "sched_setaffinity"):
-        try:
-            os.sched_setaffinity(0, set(cores))
-        except OSError as exc:
-            raise ConfigError(f"cannot pin to cores {list(cores)}: {exc}") from None
-        return sorted(os.sched_getaffinity(0))
-    return []
+def timing_fingerprint(run_fingerprint: dict | None, params: TimingParams, sample: pd.DataFrame) -> dict:
+    """What decides a timing pass's rows: the run's fingerprint, the pass's parameters, the
+    sampled scans (SHA-256 of their keys: the run's rows decide the sample) and the code timed
+    (:func:`tfloc.harness.identity.tfloc_code`); JSON-normalised."""
+    keys = "\n".join(f"{d}\t{s}" for d, s in zip(sample["dataset"], sample["scan_id"], strict=True))
+    fp = {"run": run_fingerprint, "tfloc": tfloc_code(), **asdict(params),
+          "sample": hashlib.sha256(keys.encode()).hexdigest()}
+    return json.loads(json.dumps(fp, default=str))
 
 
-@contextmanager
-def pinned(cores: Sequence[int] | None = None) -> Iterator[list[int]]:
-    """The block runs pinned to ``cores`` (default: the last core this process may run on), every
-    library on one thread; yields the cores it runs on, and restores the affinity after."""
-    before = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []
-    try:
-        now = pin(before[-1:] if cores is None else cores)
-        limit_threads(1)
-        yield now
-    finally:
-        if before:
-            os.sched_setaffinity(0, before)
+def stale(rd: RunDir, record: dict | None, fp: dict) -> list[str]:
+    """Why the run's recorded timing pass (``record``: ``run.json``'s ``timing``) is not the one
+    of ``fp``, one phrase each; empty when it is complete, its files are there and it is current.
+    With no record and no ``timing.md``, ``[NO_PASS]``."""
+    if not isinstance(record, dict):
+        return ["timing.md records no fingerprint (made by an older tfloc)" if rd.timing_md.exists() else NO_PASS]
+    old = record.get("fingerprint") if isinstance(record.get("fingerprint"), dict) else {}
+    out = [] if record.get("complete") else ["the last timing pass did not finish"]
+    out += [f"{f}: none" for f in ("timing.csv", "timing.md") if not (rd.path / f).exists()]
+    params = [f"{k} {json.dumps(old.get(k))} → {json.dumps(fp[k])}" for k in asdict(TimingParams()) if old.get(k) != fp[k]]
+    out += params
+    if old.get("run") != fp["run"]:
+        why = differences(old.get("run"), fp["run"]) if isinstance(fp["run"], dict) else []
+        out.append("the run changed" + (f" ({why[0]})" if why else ""))
+    if (old.get("tfloc") or {}).get("source") != fp["tfloc"]["source"]:
+        out.append(f"tfloc's code changed (source {str((old.get('tfloc') or {}).get('source'))[:12]} → "
+                   f"{fp['tfloc']['source'][:12]})")
+    if old.get("sample") != fp["sample"] and old.get("run") == fp["run"] and not params:
+        out.append("the run's rows changed (another sample of scans)")
+    return out
 
 
-def rotated(items: Sequence[T], i: int) -> list[tuple[int, T]]:
-    """Scan ``i``'s order of ``items`` (matchers): rotated by ``i``, each with its position, so
-    that slow drifts of the machine hit every matcher alike."""
-    k = len(items)
-    return [(pos, items[(i + pos) % k]) for pos in range(k)]
-
-
-def run_timing(run_dir: Path, per_stratum: int = 4, seed: int = SEED, cores: Sequence[int] | None = None,
-               warmup: int = 2, progress: Callable[[int, int], None] | None = None,
-               run: tuple[pd.DataFrame, RunInfo] | None = None) -> tuple[pd.DataFrame, dict]:
+def run_timing(run_dir: Path, per_stratum: int = PER_STRATUM, seed: int = SEED, cores: Sequence[int] | None = None,
+               warmup: int = WARMUP, progress: Callable[[int, int], None] | None = None,
+               run: tuple[pd.DataFrame, RunInfo] | None = None,
+               sample: pd.DataFrame | None = None) -> tuple[list[TimingRow], dict]:
     """Re-time a stratified sample of the run in ``run_dir`` (see the module docstring), pinned
     to ``cores`` (default: the last core this process may run on).
 
-    Returns the rows (``TIMING_COLUMNS``; times in ms) and a provenance dict (cores, load
-    averages, sample size, seed). ``run``: the run's rows and ``run.json`` if the caller has
-    already read them (:func:`read_run`)."""
+    Returns the rows (times in ms) and a provenance dict (cores, load averages, sample size,
+    seed). ``run``: the run's rows and ``run.json`` if the caller has already read them
+    (:func:`read_run`); ``sample``: the scans if it has drawn them (:func:`sample_scans`)."""
     df, info_run = read_run(run_dir) if run is None else run
     specs = [m for m in info_run.matchers if m["label"] in set(df["matcher"])]
     paths = info_run.datasets
-    sample = sample_scans(df, per_stratum, seed)
+    sample = sample_scans(df, per_stratum, seed) if sample is None else sample
     if sample.empty:
         raise ConfigError(f"{run_dir}: no scan that every matcher answered")
     started, load_start = time.strftime("%Y-%m-%dT%H:%M:%S%z"), load_average()
@@ -136,7 +167,7 @@ def run_timing(run_dir: Path, per_stratum: int = 4, seed: int = SEED, cores: Seq
 
 
 def _time_sample(sample: pd.DataFrame, specs: list[dict], paths: dict[str, Path], warmup: int,
-                 progress: Callable[[int, int], None] | None) -> pd.DataFrame:
+                 progress: Callable[[int, int], None] | None) -> list[TimingRow]:
     """Warm up, then time every matcher on every sampled scan, interleaved (module docstring)."""
     matchers = [(m["label"], load_matcher(m["name"], json.dumps(m.get("params", {}), sort_keys=True)))
                 for m in specs]
@@ -157,8 +188,8 @@ def _time_sample(sample: pd.DataFrame, specs: list[dict], paths: dict[str, Path]
         scan = scans[r.scan_id]
         for pos, (label, m) in rotated(matchers, i):
             t = timed_localize(m, problem_of(scenario, scan))
-            rows.append({"dataset": r.dataset, "scan_id": r.scan_id, "group": r.group, "matcher": label,
-                         "position": pos, "cpu_ms": 1000.0 * t.cpu_s, "wall_ms": 1000.0 * t.wall_s})
+            rows.append(TimingRow(str(r.dataset), str(r.scan_id), str(r.group), label, pos,
+                                  1000.0 * t.cpu_s, 1000.0 * t.wall_s))
         if progress:
             progress(i + 1, len(sample))
-    return pd.DataFrame(rows, columns=TIMING_COLUMNS)
+    return rows

@@ -1,17 +1,22 @@
 """A run directory: the one owner of ``run.json`` and of where a run's files are.
 
-``tfloc bench`` writes a run directory; ``timing``, ``report``, ``export``, ``real-note`` and the
-guard read it. All of them go through :class:`RunDir`: it knows the paths (``estimates.csv``,
-``run.json``, ``timing.*``, ``report.md``, ``figures/``), reads and checks ``run.json`` once
-(:meth:`RunDir.info`, a :class:`RunInfo`: configuration, matchers, datasets, thresholds, the
-datasets' modes, sessions, fingerprint), and writes it atomically (a kill leaves the old or the
-new file, never half of one). A malformed ``run.json`` is one :class:`ResultsError` naming the
-file and the field.
+``tfloc bench`` writes a run directory, and so does the scaling study (``tfloc scaling``);
+``timing``, ``report``, ``export``, ``real-note`` and the guard read it. All of them go through
+:class:`RunDir`: it knows the paths (``estimates.csv``, ``run.json``, ``timing.*``, ``report.md``,
+``figures/``), reads and checks ``run.json`` once (:meth:`RunDir.info`, a :class:`RunInfo`:
+configuration, matchers, datasets, thresholds, the datasets' modes, sessions, fingerprint), and
+writes it atomically (a kill leaves the old or the new file, never half of one). A malformed
+``run.json`` is one :class:`ResultsError` naming the file and the field.
 
-``run.json`` (written by :mod:`tfloc.harness.runner`) holds ``config`` (the run configuration:
-``name``, ``matchers`` as ``{label, name, params}``, ``success``, ``jobs``, …), ``versions``,
-``git``, ``machine``, ``datasets`` (name → directory), ``sessions`` (one per start: started,
-ended, load averages) and ``fingerprint`` (what decides the rows).
+``run.json`` holds ``config`` (the configuration: ``name``, ``matchers`` as ``{label, name,
+params}``, ``success``, …; ``kind`` ``"scaling"`` with the study's own fields under ``scaling``
+for a scaling study, absent for a benchmark run), ``versions``, ``git``, ``machine``,
+``datasets`` (name → directory; a scaling study's: its tile map), ``sessions`` (one per start:
+started, ended, load averages) and ``fingerprint`` (what decides the rows). A study that runs in
+steps records ``levels`` and the ones ``done``. ``timing`` is the timing pass's record
+(:meth:`RunDir.start_timing`): its ``fingerprint`` (the run's, the pass's parameters), its
+``sessions`` and whether it is ``complete``; :meth:`RunDir.discard` removes it with the pass's
+files.
 """
 
 from __future__ import annotations
@@ -37,7 +42,8 @@ ESTIMATES = "estimates.csv"
 
 #: the run.json fields a reader relies on, and what each must be
 _FIELDS = {"config": dict, "git": dict, "machine": dict, "versions": dict, "datasets": dict, "sessions": list,
-           "declared": dict,
+           "declared": dict, "timing": dict, "levels": list, "done": list,
+           "config.kind": str, "config.scaling": dict, "timing.sessions": list, "timing.complete": bool,
            "config.success": dict, "config.matchers": list, "git.commit": (str, type(None)),
            "git.dirty": (bool, type(None)), "config.name": str}
 
@@ -62,7 +68,9 @@ def check_run_doc(doc: object, path: Path) -> dict:
     ok = all(isinstance(v, str) for v in doc.get("datasets", {}).values())
     ok &= all(isinstance(v, dict) and isinstance(v.get("started", ""), str)
               and all(isinstance(v.get(k) or [0], list) and _finite_list(v.get(k) or [0])
-                      for k in ("loadavg_start", "loadavg_end")) for v in doc.get("sessions", []))
+                      for k in ("loadavg_start", "loadavg_end"))
+              for v in [*doc.get("sessions", []), *doc.get("timing", {}).get("sessions", [])])
+    ok &= all(isinstance(v, str) for v in [*doc.get("levels", []), *doc.get("done", [])])
     ok &= all(isinstance(m, dict) and isinstance(m.get("label"), str) and isinstance(m.get("name"), str)
               and isinstance(m.get("params", {}), dict) for m in doc.get("config", {}).get("matchers", []))
     try:
@@ -71,7 +79,7 @@ def check_run_doc(doc: object, path: Path) -> dict:
     except (TypeError, ValueError, OverflowError):
         ok = False
     if not ok:
-        raise ResultsError(f"{path}: malformed datasets, sessions, config.matchers or config.success")
+        raise ResultsError(f"{path}: malformed datasets, sessions, levels, config.matchers or config.success")
     return doc
 
 
@@ -89,6 +97,11 @@ class RunInfo:
     @property
     def name(self) -> str | None:
         return self.config.get("name")
+
+    @property
+    def kind(self) -> str:
+        """What made the run: ``bench`` (a run configuration), or a study's kind (``scaling``)."""
+        return str(self.config.get("kind", "bench"))
 
     @property
     def matchers(self) -> list[dict]:
@@ -112,6 +125,16 @@ class RunInfo:
     @property
     def fingerprint(self) -> dict | None:
         return self.doc.get("fingerprint")
+
+    @property
+    def done(self) -> list[str]:
+        """The steps (a scaling study's levels) the run has finished, in order."""
+        return list(self.doc.get("done", []))
+
+    @property
+    def timing(self) -> dict | None:
+        """The timing pass's record (``fingerprint``, ``sessions``, ``complete``), None if none."""
+        return self.doc.get("timing")
 
     def declared(self, dataset: str) -> dict:
         """What a dataset of the run declares in its ``scenario.json`` (``mode``,
@@ -204,31 +227,65 @@ class RunDir:
         """Write ``run.json`` atomically (a temporary file, fsynced, renamed)."""
         replace_atomically(self.run_json, lambda fh: fh.write(json.dumps(doc, indent=2) + "\n"))
 
-    def start_session(self, doc: dict[str, Any], n_tasks: int, n_done: int, loadavg: list | None) -> None:
+    def start_session(self, doc: dict[str, Any], n_tasks: int, n_done: int, loadavg: list | None,
+                      **extra: Any) -> None:
         """Write ``run.json`` for a new session: ``doc`` (configuration, environment, datasets,
-        fingerprint) with the sessions so far plus this one."""
+        fingerprint) with the sessions so far plus this one (``n_tasks`` tasks, ``n_done`` of them
+        done before, ``extra`` fields, e.g. the cores it is pinned to); the timing pass's record
+        is kept (its own fingerprint says whether it is still current)."""
         try:
-            previous = self.info().sessions
+            old = self.info().doc
         except ResultsError:
-            previous = []
-        session = {"started": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "tasks": n_tasks,
-                   "already_done": n_done, "loadavg_start": loadavg}
-        self.write({**doc, "sessions": previous + [session]})
+            old = {}
+        session = {"started": _now(), "tasks": n_tasks, "already_done": n_done, "loadavg_start": loadavg,
+                   **extra}
+        kept = {"timing": old["timing"]} if "timing" in old and "timing" not in doc else {}
+        self.write({**doc, **kept, "sessions": list(old.get("sessions", [])) + [session]})
 
-    def close_session(self, loadavg: list | None) -> None:
-        """Record the end time and load average of the last session."""
+    def update(self, fields: dict[str, Any], **session: Any) -> None:
+        """Replace top-level ``fields`` of ``run.json`` (e.g. the steps ``done``) and update the
+        last session with ``session`` (e.g. its CPU seconds so far)."""
+        doc = self.info().doc
+        doc.update(fields)
+        if session and doc.get("sessions"):
+            doc["sessions"][-1].update(session)
+        self.write(doc)
+
+    def close_session(self, loadavg: list | None, **extra: Any) -> None:
+        """Record the end time and load average of the last session (and ``extra`` fields)."""
         try:
             doc = self.info().doc
         except ResultsError:
             return
         if doc.get("sessions"):
-            doc["sessions"][-1].update(ended=time.strftime("%Y-%m-%dT%H:%M:%S%z"), loadavg_end=loadavg)
+            doc["sessions"][-1].update(ended=_now(), loadavg_end=loadavg, **extra)
             self.write(doc)
 
-    def discard(self) -> None:
-        """Remove the run's results and ``run.json`` (``--regenerate``)."""
-        self.estimates.unlink(missing_ok=True)
-        self.run_json.unlink(missing_ok=True)
+    def start_timing(self, fingerprint: dict[str, Any], loadavg: list | None, fresh: bool) -> None:
+        """Record in ``run.json`` that a timing pass of ``fingerprint`` starts (not complete until
+        :meth:`close_timing`): a new session, after the sessions of the same pass unless
+        ``fresh`` (another pass: its record starts over)."""
+        doc = self.info(required=True).doc
+        old = doc.get("timing") or {}
+        previous = [] if fresh or old.get("fingerprint") != fingerprint else list(old.get("sessions", []))
+        session = {"started": _now(), "loadavg_start": loadavg}
+        doc["timing"] = {"fingerprint": fingerprint, "complete": False, "sessions": previous + [session]}
+        self.write(doc)
+
+    def close_timing(self, loadavg: list | None, **extra: Any) -> None:
+        """Record that the timing pass started last is complete (``timing.csv`` and ``timing.md``
+        are written and current), with ``extra`` fields of its session (e.g. its cores)."""
+        doc = self.info(required=True).doc
+        record = doc.get("timing") or {"sessions": [{}]}
+        record["sessions"][-1].update(ended=_now(), loadavg_end=loadavg, **extra)
+        doc["timing"] = {**record, "complete": True}
+        self.write(doc)
+
+    def discard(self, also: tuple[str, ...] = ()) -> None:
+        """Remove the run's results, its timing pass (``timing.csv``, ``timing.md`` and the record
+        in ``run.json``), ``run.json`` and the files named ``also`` (``--regenerate``)."""
+        for f in (self.estimates, self.timing_csv, self.timing_md, *(self.path / n for n in also), self.run_json):
+            f.unlink(missing_ok=True)
 
     def make(self) -> None:
         """Create the directory (a :class:`ResultsError` if it cannot be)."""
@@ -237,3 +294,7 @@ class RunDir:
         except OSError as exc:
             raise ResultsError(f"{self.path}: cannot create the run directory ({exc.strerror or exc})") from None
 
+
+def _now() -> str:
+    """The local time as ``run.json`` records it (ISO 8601 with the offset)."""
+    return time.strftime("%Y-%m-%dT%H:%M:%S%z")

@@ -1,8 +1,10 @@
 """The scaling study's README (tables, slopes, one sentence per matcher) and its figure.
 
-Inputs are the tables of :mod:`tfloc.evaluation.scaling` (levels, slopes, preparation rows);
-:func:`render` derives them from the study's raw rows. The study itself is ``tfloc scaling``
-(:mod:`tfloc.harness.scaling`).
+:func:`render_scaling` draws them from the study's run directory alone: the typed rows
+(``scaling.csv``, ``prep.csv``, ``skips.csv``; :mod:`tfloc.io.timing_rows`) as tables, the
+configuration and how it was made from ``run.json`` (:func:`provenance`). The tables are
+:mod:`tfloc.evaluation.scaling`'s (levels, slopes, preparation rows); the study itself is
+``tfloc scaling`` (:mod:`tfloc.harness.scaling`).
 """
 
 from __future__ import annotations
@@ -14,7 +16,11 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
+from tfloc.core.timing_rows import PrepRow, ScanRow, SkipRow
+from tfloc.errors import ResultsError
 from tfloc.evaluation.scaling import GROWS_SLOPE, level_table, prep_slope_table, slope_table
+from tfloc.io.rundir import RunDir
+from tfloc.io.timing_rows import FILES, read_rows, rows_frame
 
 from .figures import colours
 from .mdtable import num, table
@@ -241,7 +247,7 @@ def write_readme(path: Path, rows: pd.DataFrame, levels: pd.DataFrame, slopes: p
     lines += ["## Files", "", "- `scaling.csv`: one row per (matcher, axis, level, scan): CPU and wall "
               "ms, errors, success.", "- `levels.csv`: medians per level; `slopes.csv`: the fits.",
               "- `prep.csv`: preparation per (matcher, map): CPU and wall s, retained RSS (MB).",
-              "- `study.json`: the configuration, its fingerprint, the code, versions and machine, "
+              "- `run.json`: the configuration, its fingerprint, the code, versions and machine, "
               "the sessions.", ""]
     path.write_text("\n".join(lines))
     return path
@@ -254,11 +260,36 @@ def _code(git: dict | None) -> str:
     return f"code `{git['commit'][:7]}`" + (" with uncommitted changes" if git.get("dirty") else "")
 
 
+def provenance(doc: dict) -> dict:
+    """What the README says of how the study was made, from ``run.json``: the command, cores,
+    machine, code, the first start, load averages, and wall and CPU seconds over its sessions."""
+    sessions = doc.get("sessions") or [{}]
+    total = {k: round(sum(float(s.get(k) or 0.0) for s in sessions), 1) for k in ("wall_s", "cpu_s")}
+    machine = doc.get("machine") or {}
+    return {"command": doc.get("command"), "cores": sessions[-1].get("cores"), "cpu": machine.get("cpu"),
+            "python": machine.get("python"), "git": doc.get("git") or {},
+            "started": sessions[0].get("started"), "loadavg_start": sessions[0].get("loadavg_start"),
+            "loadavg_end": sessions[-1].get("loadavg_end"), "sessions": len(sessions), **total}
+
+
+def render_scaling(run_dir: Path) -> pd.DataFrame:
+    """``levels.csv``, ``slopes.csv``, ``scaling.png`` and ``README.md`` of the scaling study in
+    ``run_dir``, from the directory alone (module notes); returns the slopes. A directory that
+    holds no scaling study's ``run.json`` is a :class:`ResultsError`."""
+    rd = RunDir(run_dir)
+    info = rd.info()
+    if info.kind != "scaling":
+        raise ResultsError(f"{rd.path}: no scaling study here (its run.json is missing or not of kind "
+                           "'scaling'; run 'tfloc scaling' first)")
+    rows, prep, skips = (rows_frame(read_rows(rd.path / FILES[c], c), c) for c in (ScanRow, PrepRow, SkipRow))
+    return render(rd.path, rows, prep, skips, info.config.get("scaling", {}), provenance(info.doc))
+
+
 def render(out: Path, rows: pd.DataFrame, prep: pd.DataFrame, skips: pd.DataFrame, config: dict,
            provenance: dict) -> pd.DataFrame:
     """``levels.csv``, ``slopes.csv``, ``scaling.png`` and ``README.md`` in ``out`` from the
-    study's raw rows (``scaling.csv``, ``prep.csv``, ``skips.csv``), its configuration and how it
-    was made (:func:`tfloc.harness.scaling.provenance`); returns the slopes."""
+    study's tables (of ``scaling.csv``, ``prep.csv``, ``skips.csv``), its configuration and how it
+    was made (:func:`provenance`); returns the slopes."""
     levels = level_table(rows)
     slopes = slope_table(levels)
     levels.to_csv(out / "levels.csv", index=False, float_format="%.6g")

@@ -1,10 +1,16 @@
-"""``RUN/timing.md``: the side-by-side timing pass (:mod:`tfloc.harness.timing`) as a table."""
+"""``RUN/timing.md``: the side-by-side timing pass (:mod:`tfloc.harness.timing`) as a table, and
+its rows as ``RUN/timing.csv`` (:mod:`tfloc.io.timing_rows`)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 import pandas as pd
+
+from tfloc.core.timing_rows import TimingRow
+from tfloc.io.atomic import replace_atomically
+from tfloc.io.rundir import RunDir
+from tfloc.io.timing_rows import write_rows
 
 from .mdtable import num, table
 
@@ -69,10 +75,12 @@ def timing_markdown(run_name: str, summary: pd.DataFrame, reference: str, info: 
         table(headers, rows)])
 
 
-def write_timing(run_dir: Path, rows: pd.DataFrame, summary: pd.DataFrame, reference: str,
+def write_timing(run_dir: Path, rows: list[TimingRow], summary: pd.DataFrame, reference: str,
                  info: dict, name: str) -> tuple[Path, Path]:
-    """Write ``timing.csv`` (one row per scan × matcher) and ``timing.md``; returns both paths."""
-    csv_path, md_path = run_dir / "timing.csv", run_dir / "timing.md"
-    rows.to_csv(csv_path, index=False, float_format="%.4f")
-    md_path.write_text(timing_markdown(name, summary, reference, info))
-    return csv_path, md_path
+    """Write ``timing.csv`` (one row per scan × matcher) and ``timing.md``, each atomically;
+    returns both paths."""
+    rd = RunDir(run_dir)
+    write_rows(rd.timing_csv, rows, TimingRow)
+    text = timing_markdown(name, summary, reference, info)
+    replace_atomically(rd.timing_md, lambda fh: fh.write(text))
+    return rd.timing_csv, rd.timing_md
