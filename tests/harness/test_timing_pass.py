@@ -209,3 +209,24 @@ def test_timing_md_names_the_code_it_timed_against_the_runs():
     assert "`bbbbbbb` with uncommitted changes" in line and "made by `aaaaaaa`" in line
     assert _code_line({}) == "- Code timed: not recorded."
     assert "made by unknown" in _code_line({"git": {"commit": "c" * 40}, "run_git": {}})
+
+
+def test_a_tracking_run_is_timed_step_by_step_side_by_side(tmp_path):
+    """A sequence run's trackers step along the sequence's first scans in turn, each on its own
+    answers: one row per (step, tracker), every position taken in turn, the run's own CPU beside."""
+    from test_track import _copy
+
+    from tfloc.report.timing_pass import timing_pass
+
+    ds = _copy(tmp_path / "q", 30)
+    out = run(cfg(ds, tmp_path / "run", MatcherSpec.make("tf-plus-track"), MatcherSpec.make("odometry"),
+                  jobs=1, timeout_s=60.0), progress=False)
+    timing_pass(out, per_stratum=1, warmup=0, log=lambda s: None)
+    rows = pd.read_csv(out / "timing.csv")
+    assert len(rows) == 30 * 2 and set(rows["matcher"]) == {"tf-plus-track", "odometry"}
+    assert rows["scan_id"].nunique() == 30
+    assert all(sorted(g) == [0, 1] for _, g in rows.groupby("scan_id")["position"])
+    first = rows[rows["position"] == 0]["matcher"].tolist()
+    assert first[:4] == ["tf-plus-track", "odometry", "tf-plus-track", "odometry"]
+    assert (rows.loc[rows["matcher"] == "tf-plus-track", "cpu_ms"] > 0).all()
+    assert "tf-plus-track" in (out / "timing.md").read_text()

@@ -7,7 +7,8 @@ conditions:
 
 * **Sample**: per stratum (dataset × group, e.g. one offset cell) ``per_stratum`` scans drawn
   with a seeded generator from the scans every matcher of the run answered (a scan on which a
-  matcher timed out or raised in the run is left out: it would dominate the pass's time).
+  matcher timed out or raised in the run is left out: it would dominate the pass's time); of a
+  sequence, its first ``per_stratum`` × 100 scans, every tracker stepping along them in turn.
 * **One process pinned to the configured cores**, every library on one thread, the matchers
   interleaved scan by scan in rotated order (:mod:`tfloc.harness.pinning`).
 * **Warm-up**: for each dataset and matcher, :func:`tfloc.harness.workspace.warm` and ``warmup``
@@ -35,19 +36,22 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from tfloc.core.matcher import get_matcher
 from tfloc.core.timing_rows import TimingRow
 from tfloc.errors import ConfigError
 from tfloc.evaluation.timing import reference_of
 from tfloc.io.rundir import RunDir, RunInfo
+from tfloc.io.scenario import SEQUENCE
 
 from .fingerprint import differences
 from .identity import git_state, tfloc_code
 from .pinning import pinned, rotated
 from .runner import load_average
-from .workspace import load_dataset, load_matcher, problem_of, timed_localize, warm
+from .workspace import load_dataset, load_matcher, map_of, problem_of, timed_localize, warm
 
 SEED = 20261130
 PER_STRATUM = 4  # scans per dataset × group, by default
+STEPS = 100      # a sequence's first steps timed per unit of ``per_stratum``
 WARMUP = 2       # untimed localize calls per dataset and matcher, by default
 NO_PASS = "no timing pass yet"
 
@@ -87,11 +91,21 @@ def read_run(run_dir: Path) -> tuple[pd.DataFrame, RunInfo]:
     return rd.results(), info
 
 
-def sample_scans(df: pd.DataFrame, per_stratum: int, seed: int = SEED) -> pd.DataFrame:
-    """``per_stratum`` scans per (dataset, group) that every matcher answered, seeded; columns
-    dataset, scan_id, group, in dataset order, then group, then scan id."""
+def sample_scans(df: pd.DataFrame, per_stratum: int, seed: int = SEED,
+                 sequences: Sequence[str] = ()) -> pd.DataFrame:
+    """``per_stratum`` scans per (dataset, group) that every matcher answered, seeded; of a
+    sequence dataset (``sequences``), its first ``per_stratum`` × :data:`STEPS` scans in order
+    (a tracker's step depends on the steps before it). Columns dataset, scan_id, group, in
+    dataset order, then group, then scan id (a sequence's in its own order)."""
     if per_stratum < 1:
         raise ConfigError(f"per-stratum sample size must be ≥ 1, got {per_stratum}")
+    seq = df[df["dataset"].isin(set(sequences))]
+    heads = [g[["dataset", "scan_id", "group"]].drop_duplicates("scan_id").head(per_stratum * STEPS)
+             for _, g in seq.groupby("dataset", sort=False)]
+    df = df[~df["dataset"].isin(set(sequences))]
+    if df.empty:
+        return (pd.concat(heads, ignore_index=True) if heads
+                else pd.DataFrame(columns=["dataset", "scan_id", "group"]))
     answered = df["status"].fillna("").isin(["ok", "failed"])
     n_matchers = df["matcher"].nunique()
     ok = df[answered].groupby(["dataset", "scan_id"])["matcher"].nunique() == n_matchers
@@ -105,6 +119,7 @@ def sample_scans(df: pd.DataFrame, per_stratum: int, seed: int = SEED) -> pd.Dat
         g = g.sort_values("scan_id")
         parts.append(g.iloc[np.sort(rng.choice(len(g), size=min(per_stratum, len(g)), replace=False))])
     cols = ["dataset", "scan_id", "group"]
+    parts += heads
     return pd.concat(parts, ignore_index=True)[cols] if parts else pd.DataFrame(columns=cols)
 
 
@@ -153,12 +168,16 @@ def run_timing(run_dir: Path, per_stratum: int = PER_STRATUM, seed: int = SEED, 
     df, info_run = read_run(run_dir) if run is None else run
     specs = [m for m in info_run.matchers if m["label"] in set(df["matcher"])]
     paths = info_run.datasets
-    sample = sample_scans(df, per_stratum, seed) if sample is None else sample
+    sequences = sorted(info_run.datasets_in(list(df["dataset"].unique()), SEQUENCE))
+    sample = sample_scans(df, per_stratum, seed, sequences) if sample is None else sample
     if sample.empty:
         raise ConfigError(f"{run_dir}: no scan that every matcher answered")
     started, load_start = time.strftime("%Y-%m-%dT%H:%M:%S%z"), load_average()
     with pinned(cores) as on:
-        rows = _time_sample(sample, specs, paths, warmup, progress)
+        single = sample[~sample["dataset"].isin(sequences)]
+        steps = sample[sample["dataset"].isin(sequences)]
+        rows = _time_sample(single, specs, paths, warmup, progress) if len(single) else []
+        rows += _time_sequences(steps, specs, paths, progress, len(single))
     info = {"cores": on, "per_stratum": per_stratum, "seed": seed, "warmup": warmup,
             "scans": len(sample), "strata": int(sample.groupby(["dataset", "group"]).ngroups),
             "loadavg_start": load_start, "loadavg_end": load_average(), "started": started,
@@ -192,4 +211,35 @@ def _time_sample(sample: pd.DataFrame, specs: list[dict], paths: dict[str, Path]
                                   1000.0 * t.cpu_s, 1000.0 * t.wall_s))
         if progress:
             progress(i + 1, len(sample))
+    return rows
+
+
+def _time_sequences(sample: pd.DataFrame, specs: list[dict], paths: dict[str, Path],
+                    progress: Callable[[int, int], None] | None, done: int = 0) -> list[TimingRow]:
+    """Every tracker of the run along the sampled first steps of each sequence, started and
+    warmed up (untimed) as the tracking loop does, their steps interleaved in rotated order
+    (:func:`tfloc.harness.track.step`: the tracking loop's own step, each tracker on its own
+    answers)."""
+    from tfloc.core.tracker import as_tracker
+
+    from .track import begin, odom_deltas, step
+
+    rows: list[TimingRow] = []
+    total = done + len(sample)
+    for d, g in sample.groupby("dataset", sort=False):
+        scenario, by_id = load_dataset(str(paths[d]))
+        scans = list(by_id.values())[:len(g)]
+        the_map = map_of(scenario, scans[0])
+        trackers = [(m["label"], as_tracker(get_matcher(m["name"], **m.get("params", {})))) for m in specs]
+        for _, t in trackers:
+            begin(t, scenario, scans, the_map)
+        for k, (scan, delta) in enumerate(zip(scans, odom_deltas(scans), strict=True)):
+            for pos, (label, t) in rotated(trackers, k):
+                s = step(t, scenario, scan, delta)
+                if s.cpu_s is not None:
+                    rows.append(TimingRow(str(d), str(scan.scan_id), str(scan.group), label, pos,
+                                          1000.0 * s.cpu_s, 1000.0 * s.wall_s))
+            done += 1
+            if progress:
+                progress(done, total)
     return rows

@@ -20,8 +20,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 
 from tfloc.core.pose import Pose
+from tfloc.core.problem import Estimate
 from tfloc.core.result import ResultRow, Status, StatusKind
 from tfloc.core.thresholds import Thresholds
 from tfloc.core.tracker import DeadReckoning, as_tracker
@@ -63,33 +65,58 @@ def track(scenario: Scenario, scans: Sequence[Scan], matcher, *, label: str | No
     label = label or getattr(tracker, "name", type(matcher).__name__)
     dataset = dataset or scenario.name
     the_map = map if map is not None else map_for(scenario, scans[0], {})
-    start = scans[0].initial
-    warm_tracker(tracker, the_map, scenario.laser, scans[0].ranges, start)
-    tracker.start(the_map, scenario.laser, start)
+    begin(tracker, scenario, scans, the_map)
     rows = []
     for k, (scan, delta) in enumerate(zip(scans, odom_deltas(scans), strict=True)):
-        pred = tracker.predict(delta)
-        where = f"{scenario.scans_path}:{scan.line}"
-        try:
-            t = timed_step(tracker, scan.ranges, delta, scan.stamp, where)
-            est, status, info = t.estimate, status_of(t.estimate), dict(t.estimate.info)
-            pose, wall_s, cpu_s = est.pose, t.wall_s, t.cpu_s
-            if not pose.is_finite():
-                pose = pred
-                tracker.reset(pred)
-        except Exception as exc:  # noqa: BLE001 - a raising tracker is a result; the run goes on
-            est, info, pose, wall_s, cpu_s = None, {}, pred, None, None
-            status = Status.of(StatusKind.ERROR, f"{type(exc).__name__}: {exc}")
-            tracker.reset(pred)
-        row = result_row(dataset, label, scan.scan_id, scan.group, true=scan.true, init=pred, est=pose,
-                         estimate=est, status=status, wall_s=wall_s, cpu_s=cpu_s, info=info)
+        s = step(tracker, scenario, scan, delta)
+        row = result_row(dataset, label, scan.scan_id, scan.group, true=scan.true, init=s.pred, est=s.pose,
+                         estimate=s.estimate, status=s.status, wall_s=s.wall_s, cpu_s=s.cpu_s,
+                         info=dict(s.estimate.info) if s.estimate is not None else {})
         if thresholds is not None and scan.true is not None:
-            row = row.with_(outcome=outcome(status.ok, row.dist_err_m, row.orient_err_rad,
+            row = row.with_(outcome=outcome(s.status.ok, row.dist_err_m, row.orient_err_rad,
                                             math.nan, math.nan, thresholds))
         rows.append(row)
         if progress is not None:
             progress(k)
     return rows
+
+
+def begin(tracker, scenario: Scenario, scans: Sequence[Scan], the_map) -> None:
+    """Warm a tracker up (untimed) and start it at the sequence's first pose."""
+    start = scans[0].initial
+    warm_tracker(tracker, the_map, scenario.laser, scans[0].ranges, start)
+    tracker.start(the_map, scenario.laser, start)
+
+
+@dataclass(frozen=True)
+class Step:
+    """One step of a tracker: its prediction, its answer (the prediction where it declined, gave
+    no finite pose or raised, and it was reset there), the estimate (``None`` if it raised), the
+    status and the step's wall and CPU time (seconds; ``None`` if it raised)."""
+
+    pred: Pose
+    pose: Pose
+    estimate: Estimate | None
+    status: Status
+    wall_s: float | None
+    cpu_s: float | None
+
+
+def step(tracker, scenario: Scenario, scan: Scan, delta: Pose) -> Step:
+    """One scan of the tracking loop: predict, a timed ``step``, reset to the prediction where
+    the answer is no pose or the tracker raised (the loop goes on)."""
+    pred = tracker.predict(delta)
+    where = f"{scenario.scans_path}:{scan.line}"
+    try:
+        t = timed_step(tracker, scan.ranges, delta, scan.stamp, where)
+    except Exception as exc:  # noqa: BLE001 - a raising tracker is a result; the run goes on
+        tracker.reset(pred)
+        return Step(pred, pred, None, Status.of(StatusKind.ERROR, f"{type(exc).__name__}: {exc}"), None, None)
+    pose = t.estimate.pose
+    if not pose.is_finite():
+        pose = pred
+        tracker.reset(pred)
+    return Step(pred, pose, t.estimate, status_of(t.estimate), t.wall_s, t.cpu_s)
 
 
 def dead_reckoning(scenario: Scenario, scans: Sequence[Scan], *, label: str = DeadReckoning.name,

@@ -29,6 +29,7 @@ from tfloc.harness.timing import (
     timing_fingerprint,
 )
 from tfloc.io.rundir import RunDir
+from tfloc.io.scenario import SEQUENCE
 from tfloc.io.timing_rows import rows_frame
 
 from .timing import write_timing
@@ -57,7 +58,8 @@ def timing_pass(run_dir: Path, per_stratum: int | None = None, warmup: int | Non
     rd = RunDir(run_dir)
     df, info = read_run(rd.path)
     params = TimingParams.of([m["label"] for m in info.matchers], per_stratum, seed, warmup, reference)
-    sample = sample_scans(df, params.per_stratum, params.seed)
+    sequences = sorted(info.datasets_in(list(df["dataset"].unique()), SEQUENCE))
+    sample = sample_scans(df, params.per_stratum, params.seed, sequences)
     fp = timing_fingerprint(info.fingerprint, params, sample)
     why = stale(rd, info.timing, fp)
     if not why and not regenerate:
