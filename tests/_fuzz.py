@@ -36,6 +36,10 @@ SETTINGS = settings(max_examples=EXAMPLES, deadline=None, database=None,
                     derandomize=not os.environ.get("TFLOC_FUZZ_RANDOM"),
                     suppress_health_check=list(HealthCheck), print_blob=True)
 
+#: for a reader reached through a whole command that is costly per input (``tfloc report``): an
+#: eighth of the inputs in ``make test``, all of them in ``make fuzz``
+REPORT_SETTINGS = settings(SETTINGS, max_examples=max(1, EXAMPLES // (1 if os.environ.get("TFLOC_FUZZ_RANDOM") else 8)))
+
 #: what a damaged number may become
 NUMBERS = ["nan", "NaN", "inf", "-inf", "Infinity", "1e308", "-1e308", "1e309", "-1", "-0.0", "0",
            "1e-320", "", "x", "0x1p3", "1_000", "9" * 400, "-7.5", "3e5"]

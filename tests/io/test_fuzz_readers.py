@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from _estimates import row, write_run
-from _fuzz import SETTINGS, Tally, damaged, finish, judge, mutated, write_files
+from _fuzz import REPORT_SETTINGS, SETTINGS, Tally, damaged, finish, judge, mutated, write_files
 from _paths import ROOT
 from hypothesis import given
 
@@ -176,26 +176,42 @@ def _small_run(path: Path) -> None:
     write_run(path, rows, {})
 
 
-def test_estimates_through_report(tmp_path_factory) -> None:
-    from tfloc.report.report import write_report
-
-    tally = Tally("estimates.csv via tfloc report")
+def _estimates_cases(tmp_path_factory, what: str, read, settings) -> None:
+    """Damaged ``estimates.csv`` and ``run.json`` of a small run, each read by ``read(run_dir)``."""
+    tally = Tally(what)
     src = tmp_path_factory.mktemp("run-src")
     _small_run(src)
     files = {n: (src / n).read_bytes() for n in ("estimates.csv", "run.json")}
     with tempfile.TemporaryDirectory() as tmp:
         run_dir = Path(tmp) / "run"
 
-        @SETTINGS
+        @settings
         @given(damaged(files, {"estimates.csv": 2}))
         def case(d):
             shutil.rmtree(run_dir, ignore_errors=True)
             run_dir.mkdir()
             write_files(run_dir, d[1])
-            judge(tally, d[0], lambda: write_report(run_dir, with_figures=False), [str(run_dir)])
+            judge(tally, d[0], lambda: read(run_dir), [str(run_dir)])
 
         case()
     finish(tally)
+
+
+def test_estimates_through_the_reader(tmp_path_factory) -> None:
+    """The results reader every command shares (rows and run.json: ``RunDir``)."""
+    from tfloc.io.rundir import RunDir
+
+    _estimates_cases(tmp_path_factory, "estimates.csv via RunDir", lambda d: (RunDir(d).results(), RunDir(d).info()),
+                     SETTINGS)
+
+
+def test_estimates_through_report(tmp_path_factory) -> None:
+    """The same damage through the whole report (a few cases in make test, all in make fuzz: each
+    case writes a report)."""
+    from tfloc.report.report import write_report
+
+    _estimates_cases(tmp_path_factory, "estimates.csv via tfloc report",
+                     lambda d: write_report(d, with_figures=False), REPORT_SETTINGS)
 
 
 def test_the_oracle_bites(tmp_path) -> None:
