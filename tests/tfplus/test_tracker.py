@@ -3,7 +3,6 @@ prediction is searched in its window and widened when the answer does not fit.""
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
@@ -115,12 +114,12 @@ def test_tracks_a_simulated_sequence_like_tf_plus():
     sc, scans = _seq_quick(40)
     b = track(sc, scans, tfloc.get_matcher("tf-plus"))
     a = track(sc, scans, tfloc.get_matcher("tf-plus-track", trusted_window=False))
-    assert [r["est_x"] for r in a] == [r["est_x"] for r in b]
+    assert [r.est_x for r in a] == [r.est_x for r in b]
     w = track(sc, scans, tfloc.get_matcher("tf-plus-track"))
-    assert [json.loads(r["info"])["kept"] for r in w] == ["far"] + ["window"] * 39
-    assert all(r["status"] == "ok" for r in a + w)
+    assert [r.info["kept"] for r in w] == ["far"] + ["window"] * 39
+    assert all(str(r.status) == "ok" for r in a + w)
     for r, q in zip(w, b, strict=True):
-        p, o = Pose(r["est_x"], r["est_y"], r["est_theta"]), Pose(q["est_x"], q["est_y"], q["est_theta"])
+        p, o = Pose(r.est_x, r.est_y, r.est_theta), Pose(q.est_x, q.est_y, q.est_theta)
         d, turn = p.error_to(o)
         assert d < 0.005 and turn < math.radians(0.2)
 
