@@ -23,15 +23,19 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 class Stub:
-    """A matcher answering ``answers[guess's x rounded]`` (pose, cost), cost reported as tf-plus does."""
+    """A matcher answering ``answers(guess)`` = (pose, cost), cost reported as tf-plus does; its
+    ``score`` at a pose is ``fit`` (metres; default: the root of the cost it would answer there)."""
 
-    def __init__(self, answers):
-        self.answers, self.asked = answers, []
+    def __init__(self, answers, fit=None):
+        self.answers, self.asked, self.fit = answers, [], fit
 
     def localize(self, problem):
         self.asked.append(problem.initial)
         pose, cost = self.answers(problem.initial)
         return Estimate(pose, True, info={"status": "ok", "cost": cost})
+
+    def score(self, problem, pose):
+        return self.fit if self.fit is not None else math.sqrt(self.answers(pose)[1])
 
 
 def _tracker(far, near, window=None, **cfg) -> TfPlusTracker:
@@ -76,12 +80,13 @@ def test_an_impossible_increment_is_also_tried_as_no_motion():
 def test_a_trusted_prediction_is_searched_in_its_window_and_widened_when_it_does_not_fit():
     near_answer = lambda g: (Pose(g.x + 0.02, g.y, g.theta), 0.01**2)    # noqa: E731
     t = _tracker(near_answer, near_answer, lambda g: (Pose(g.x + 0.01, g.y, g.theta), 0.03**2))
+    t.window.fit = 0.01                                        # the protocol's window's answers fit
     first = t.step(RANGES, Pose(0.1, 0.0, 0.0), 0.0)          # not trusted yet: the protocol's window
     assert first.info["kept"] == "far" and not t.window.asked and t.trusted
     est = t.step(RANGES, Pose(0.1, 0.0, 0.0), 0.0)            # trusted, and the window's answer fits
     assert est.info["kept"] == "window" and not est.info["widened"] and len(t.matcher.asked) == 1
     assert est.pose.x == pytest.approx(2.23) and est.info["score"] == pytest.approx(0.03)
-    t.window.answers = lambda g: (g, 0.08**2)                  # residual 8 cm > widen_score: no fit
+    t.window.answers = lambda g: (g, 0.05**2)                  # residual 5 cm > widen_score: no fit
     est = t.step(RANGES, Pose(0.1, 0.0, 0.0), 0.0)
     assert est.info["widened"] and est.info["kept"] == "far" and len(t.matcher.asked) == 2
     t.window.answers = lambda g: (Pose(g.x + 0.6, g.y, g.theta), 0.01**2)  # fits, but a jump
@@ -93,7 +98,7 @@ def test_a_trusted_prediction_is_searched_in_its_window_and_widened_when_it_does
 
 
 def test_an_answer_that_does_not_fit_is_no_trusted_prediction():
-    t = _tracker(lambda g: (g, 0.07**2), lambda g: (g, 0.07**2))
+    t = _tracker(lambda g: (g, 0.05**2), lambda g: (g, 0.05**2))
     t.step(RANGES, Pose(0.1, 0.0, 0.0), 0.0)
     t.step(RANGES, Pose(0.1, 0.0, 0.0), 0.0)
     assert not t.trusted and not t.window.asked and len(t.matcher.asked) == 2
@@ -101,6 +106,18 @@ def test_an_answer_that_does_not_fit_is_no_trusted_prediction():
     t.step(RANGES, Pose(0.1, 0.0, 0.0), 0.0)
     t.step(RANGES, Pose(0.1, 0.0, 0.0), 0.0)
     assert not t.window.asked and len(t.matcher.asked) == 2
+
+
+@pytest.mark.parametrize(("fit", "trusted"), [(0.02, True), (0.05, False)])
+def test_the_fit_is_the_point_to_line_residual_not_the_selection_cost(fit, trusted):
+    """The protocol's window's answer is judged by the window's objective (the point-to-line
+    residual), whatever its selection cost with the see-through term: a selection residual of 8 cm
+    with a point-to-line residual of 2 cm fits, one of 5 cm does not."""
+    t = _tracker(lambda g: (g, 0.08**2), lambda g: (g, 0.08**2))
+    t.window.fit = fit
+    est = t.step(RANGES, Pose(0.1, 0.0, 0.0), 0.0)
+    assert est.info["kept"] == "far" and t.trusted == trusted
+    assert est.info["score"] == pytest.approx(fit)
 
 
 def _seq_quick(n: int):
@@ -124,7 +141,7 @@ def test_tracks_a_simulated_sequence_like_tf_plus():
         assert d < 0.005 and turn < math.radians(0.2)
 
 
-@pytest.mark.parametrize(("widen_score", "recovers"), [(0.06, True), (1.0, False)])
+@pytest.mark.parametrize(("widen_score", "recovers"), [(0.04, True), (1.0, False)])
 def test_a_kidnapped_prediction_widens_and_recovers(widen_score, recovers):
     """The robot is carried 1 m sideways while the tracker trusts its prediction: the window's
     answer does not fit, the protocol's window finds the robot (a jump it earns). Never widened
@@ -177,6 +194,7 @@ def test_the_window_is_tf_plus_in_a_smaller_window():
     cfg = TfPlusTracker(window_m=0.25, window_rad=0.1).config
     w = window_config(cfg)
     assert (w.search_radius, w.heading_span, w.tf_seed, w.candidates) == (0.25, 0.1, False, 1)
+    assert not w.beam_check and cfg.local.beam_check      # one candidate: no see-through term
     assert w.refinement.gate_end == cfg.local.refinement.gate_end and w.refinement.iterations == 4
     assert window_config(TfPlusTracker(window_m=9.0, window_rad=3.0).config).search_radius == cfg.local.search_radius
 
@@ -190,3 +208,6 @@ def test_its_residual_is_tf_plus_score():
     problem = problem_of(sc, s)
     est = t.matcher.localize(problem)
     assert t._residual(t.matcher, problem, est) == pytest.approx(t.matcher.score(problem, est.pose), rel=1e-9)
+    window = t.window.localize(problem)                 # the fit: one statistic for both windows
+    assert t._residual(t.window, problem, window) == t._fit(problem, window)
+    assert t._fit(problem, est) <= t._residual(t.matcher, problem, est)   # see-through only adds

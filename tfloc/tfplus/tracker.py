@@ -14,11 +14,13 @@ tracker jumps there. Three rules, each of them the robot's prior knowledge of it
    ``max_step_m`` / ``max_step_rad`` per scan (an encoder that froze and caught up in one
    message) is also tried as no motion, from the last estimate; the better scoring answer wins.
 3. **A trusted prediction is searched in a window of the odometry's noise.** After an answer that
-   fits (residual ≤ ``widen_score``) and for an increment not doubted, ``tf-plus`` searches
-   ±``window_m`` / ±``window_rad`` (:func:`window_config`) instead of the protocol's window; an
-   answer there that does not fit, or lies beyond the jump gate, is searched again as above.
-   The window covers MIT CSAIL's per-scan corrections (99.9th percentile 0.26 m, 15.6°) and
-   ``widen_score`` is the 98th percentile of its answers' residuals (``docs/tracking.md``).
+   fits (its point-to-line residual ≤ ``widen_score``: ``tf-plus``'s selection cost without the
+   see-through term, which only the choice among candidates needs) and for an increment not
+   doubted, ``tf-plus`` searches ±``window_m`` / ±``window_rad`` (:func:`window_config`) instead
+   of the protocol's window; an answer there that does not fit, or lies beyond the jump gate, is
+   searched again as above. The window covers MIT CSAIL's per-scan corrections (99.9th
+   percentile 0.26 m, 15.6°) and ``widen_score`` is the 98th percentile of its answers'
+   point-to-line residuals (``docs/tracking.md``).
 
 A prediction ``tf-plus`` cannot answer (too few returns) is kept, as for every single-scan
 matcher run as a tracker (:class:`~tfloc.core.tracker.LocalTracker`). The true pose is never
@@ -62,7 +64,7 @@ class TfPlusTrackConfig:
     trusted_window: bool = True  #: search a trusted prediction's window first (False: the protocol's, every scan)
     window_m: float = 0.3  #: the trusted window's radius (metres) ...
     window_rad: float = math.radians(15.0)  #: ... and heading span (radians)
-    widen_score: float = 0.06  #: an answer scoring above this (RMS residual, metres) does not fit
+    widen_score: float = 0.04  #: an answer whose point-to-line residual (RMS, metres) is above this does not fit
     local: TfPlusConfig = TfPlusConfig()
 
 
@@ -77,13 +79,16 @@ def window_config(cfg: TfPlusTrackConfig) -> TfPlusConfig:
     (they look for headings far outside the window), one candidate refined from a shortlist of
     :data:`WINDOW_SHORTLIST` (the window holds about a hundred poses, not fifteen thousand) with
     the last :data:`WINDOW_ITERATIONS` gates of the refinement's schedule (the coarse pose is
-    already within a lattice cell of the answer); the rest is ``local``'s."""
+    already within a lattice cell of the answer), and no see-through term in its cost (one
+    candidate needs no selection: its cost is the point-to-line residual the fit is judged by);
+    the rest is ``local``'s."""
     local, r = cfg.local, cfg.local.refinement
     iterations = min(WINDOW_ITERATIONS, r.iterations)
     refinement = dataclasses.replace(r, gate_start=float(_gates(r)[-iterations]), iterations=iterations)
     return dataclasses.replace(local, tf_seed=False, search_radius=min(cfg.window_m, local.search_radius),
                                heading_span=min(cfg.window_rad, local.heading_span), candidates=1,
-                               shortlist=min(WINDOW_SHORTLIST, local.shortlist), refinement=refinement)
+                               shortlist=min(WINDOW_SHORTLIST, local.shortlist), refinement=refinement,
+                               beam_check=False)
 
 
 def _far(a: Pose, b: Pose, metres: float, radians: float) -> bool:
@@ -98,7 +103,8 @@ class TfPlusTracker(LocalTracker):
     ``info`` of each step adds ``widened`` (the trusted window's answer did not fit and the
     protocol's window was searched), ``jump`` (a far answer was considered), ``kept``
     (``"window"``, ``"far"``, ``"near"`` or ``"still"``: which answer was taken; ``"far"`` is the
-    protocol's window's) and ``doubted_odometry``."""
+    protocol's window's), ``doubted_odometry`` and ``score`` (the answer's point-to-line residual,
+    metres: what the fit is judged by)."""
 
     name = "tf-plus-track"
     CONFIG = TfPlusTrackConfig
@@ -127,8 +133,8 @@ class TfPlusTracker(LocalTracker):
             matcher.localize(problem)
 
     def _residual(self, matcher: TurningFunctionPlusMatcher, problem: Problem, est: Estimate) -> float:
-        """The answer's selection objective (RMS residual, metres): the root of the cost
-        ``tf-plus`` reports with it, or scored anew."""
+        """The answer's selection objective under ``matcher`` (RMS residual, metres): the root of
+        the cost ``tf-plus`` reports with it, or scored anew."""
         cost = est.info.get("cost")
         return math.sqrt(cost) if isinstance(cost, float) else matcher.score(problem, est.pose)
 
@@ -139,9 +145,17 @@ class TfPlusTracker(LocalTracker):
             return problem, est, math.inf
         return problem, est, self._residual(self.matcher, problem, est)
 
+    def _fit(self, problem: Problem | None, est: Estimate) -> float:
+        """How well an answer of the protocol's window fits (metres): its point-to-line residual,
+        the trusted window's objective (inf when the guess was kept)."""
+        if problem is None or est.info.get("status") == PREDICTED:
+            return math.inf
+        return self.window.score(problem, est.pose)
+
     def _in_window(self, ranges: np.ndarray, pred: Pose, where: str) -> tuple[Estimate | None, float]:
-        """The trusted window's answer from ``pred`` and its residual, or ``None`` where it does
-        not fit: no answer, a residual above ``widen_score`` or a pose beyond the jump gate."""
+        """The trusted window's answer from ``pred`` and its point-to-line residual, or ``None``
+        where it does not fit: no answer, a residual above ``widen_score`` or a pose beyond the
+        jump gate."""
         cfg = self.config
         try:
             problem = Problem(self._map, self._laser, ranges, pred, where=where)
@@ -150,10 +164,10 @@ class TfPlusTracker(LocalTracker):
         est = self.window.localize(problem)
         if est.declined:
             return None, math.inf
-        score = self._residual(self.window, problem, est)
-        if not score <= cfg.widen_score or _far(est.pose, pred, cfg.jump_gate_m, cfg.jump_gate_rad):
-            return None, score
-        return est, score
+        fit = self._residual(self.window, problem, est)
+        if not fit <= cfg.widen_score or _far(est.pose, pred, cfg.jump_gate_m, cfg.jump_gate_rad):
+            return None, fit
+        return est, fit
 
     def step(self, ranges: np.ndarray, odom_delta: Pose, stamp: float, where: str = "scan") -> Estimate:
         cfg = self.config
@@ -161,7 +175,7 @@ class TfPlusTracker(LocalTracker):
         doubted = _far(Pose(), odom_delta, cfg.max_step_m, cfg.max_step_rad)
         kept, jump, widened, est = "window", False, False, None
         if self.trusted and not doubted:
-            est, score = self._in_window(ranges, pred, where)
+            est, fit = self._in_window(ranges, pred, where)
             widened = est is None
         if est is None:
             kept = "far"
@@ -173,13 +187,13 @@ class TfPlusTracker(LocalTracker):
                     near_score = self._residual(self.near, problem, near)
                     if not near_score > cfg.jump_ratio * score:
                         est, score, kept = near, near_score, "near"
-        if doubted and self.pose is not None:
-            _, still, still_score = self._answer(ranges, self.pose, where)
-            if still_score < score:
-                est, score, kept = still, still_score, "still"
+            if doubted and self.pose is not None:
+                still_problem, still, still_score = self._answer(ranges, self.pose, where)
+                if still_score < score:
+                    problem, est, kept = still_problem, still, "still"
+            fit = self._fit(problem, est)
         self.pose = est.pose
-        self.trusted = cfg.trusted_window and score <= cfg.widen_score
+        self.trusted = cfg.trusted_window and fit <= cfg.widen_score
         return Estimate(est.pose, est.converged, est.iterations, est.evaluations,
                         {**est.info, "widened": widened, "jump": jump, "kept": kept,
-                         "doubted_odometry": doubted,
-                         "score": score if math.isfinite(score) else None})
+                         "doubted_odometry": doubted, "score": fit if math.isfinite(fit) else None})
