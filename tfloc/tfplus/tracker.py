@@ -38,7 +38,7 @@ import numpy as np
 from tfloc.core.laser import LaserSpec
 from tfloc.core.map import Map
 from tfloc.core.params import resolve_params
-from tfloc.core.pose import Pose
+from tfloc.core.pose import Pose, wrap_angle
 from tfloc.core.problem import Estimate, Problem
 from tfloc.core.tracker import PREDICTED, LocalTracker
 from tfloc.errors import InvalidProblemError
@@ -92,10 +92,8 @@ def window_config(cfg: TfPlusTrackConfig) -> TfPlusConfig:
 
 
 def _far(a: Pose, b: Pose, metres: float, radians: float) -> bool:
-    """Whether ``a`` lies more than ``metres`` from ``b`` or is turned more than ``radians``
-    (:func:`~tfloc.core.pose.wrap_angle`'s arithmetic in plain floats: this runs at every scan)."""
-    turn = (a.theta - b.theta + math.pi) % (2.0 * math.pi) - math.pi
-    return a.distance_to(b) > metres or abs(turn) > radians
+    """Whether ``a`` lies more than ``metres`` from ``b`` or is turned more than ``radians``."""
+    return a.distance_to(b) > metres or abs(wrap_angle(a.theta - b.theta)) > radians
 
 
 class TfPlusTracker(LocalTracker):
