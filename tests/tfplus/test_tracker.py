@@ -27,10 +27,11 @@ class Stub:
     ``score`` at a pose is ``fit`` (metres; default: the root of the cost it would answer there)."""
 
     def __init__(self, answers, fit=None):
-        self.answers, self.asked, self.fit = answers, [], fit
+        self.answers, self.asked, self.fit, self.problems = answers, [], fit, []
 
     def localize(self, problem):
         self.asked.append(problem.initial)
+        self.problems.append(problem)
         pose, cost = self.answers(problem.initial)
         return Estimate(pose, True, info={"status": "ok", "cost": cost})
 
@@ -89,6 +90,7 @@ def test_a_trusted_prediction_is_searched_in_its_window_and_widened_when_it_does
     t.window.answers = lambda g: (g, 0.05**2)                  # residual 5 cm > widen_score: no fit
     est = t.step(RANGES, Pose(0.1, 0.0, 0.0), 0.0)
     assert est.info["widened"] and est.info["kept"] == "far" and len(t.matcher.asked) == 2
+    assert t.matcher.problems[-1] is t.window.problems[-1]     # one problem (one check) per step
     t.window.answers = lambda g: (Pose(g.x + 0.6, g.y, g.theta), 0.01**2)  # fits, but a jump
     est = t.step(RANGES, Pose(0.1, 0.0, 0.0), 0.0)
     assert est.info["widened"] and est.info["kept"] == "far" and len(t.matcher.asked) == 3

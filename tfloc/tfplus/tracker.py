@@ -136,9 +136,14 @@ class TfPlusTracker(LocalTracker):
         cost = est.info.get("cost")
         return math.sqrt(cost) if isinstance(cost, float) else matcher.score(problem, est.pose)
 
-    def _answer(self, ranges: np.ndarray, guess: Pose, where: str) -> tuple[Problem | None, Estimate, float]:
-        """``tf-plus``'s answer from ``guess`` and its residual (inf when it kept the guess)."""
-        problem, est = self.answer(ranges, guess, where)
+    def _answer(self, ranges: np.ndarray, guess: Pose, where: str,
+                problem: Problem | None = None) -> tuple[Problem | None, Estimate, float]:
+        """``tf-plus``'s answer from ``guess`` (to ``problem`` where the step already posed it from
+        there) and its residual (inf when it kept the guess)."""
+        if problem is None:
+            problem, est = self.answer(ranges, guess, where)
+        else:
+            est = self.answer_to(problem)
         if problem is None or est.info.get("status") == PREDICTED:
             return problem, est, math.inf
         return problem, est, self._residual(self.matcher, problem, est)
@@ -150,20 +155,16 @@ class TfPlusTracker(LocalTracker):
             return math.inf
         return self.window.score(problem, est.pose)
 
-    def _in_window(self, ranges: np.ndarray, pred: Pose, where: str) -> tuple[Estimate | None, float]:
-        """The trusted window's answer from ``pred`` and its point-to-line residual, or ``None``
-        where it does not fit: no answer, a residual above ``widen_score`` or a pose beyond the
-        jump gate."""
+    def _in_window(self, problem: Problem) -> tuple[Estimate | None, float]:
+        """The trusted window's answer to ``problem`` (posed from the prediction) and its
+        point-to-line residual, or ``None`` where it does not fit: no answer, a residual above
+        ``widen_score`` or a pose beyond the jump gate."""
         cfg = self.config
-        try:
-            problem = Problem(self._map, self._laser, ranges, pred, where=where)
-        except InvalidProblemError:
-            return None, math.inf
         est = self.window.localize(problem)
         if est.declined:
             return None, math.inf
         fit = self._residual(self.window, problem, est)
-        if not fit <= cfg.widen_score or _far(est.pose, pred, cfg.jump_gate_m, cfg.jump_gate_rad):
+        if not fit <= cfg.widen_score or _far(est.pose, problem.initial, cfg.jump_gate_m, cfg.jump_gate_rad):
             return None, fit
         return est, fit
 
@@ -171,13 +172,18 @@ class TfPlusTracker(LocalTracker):
         cfg = self.config
         pred = self.predict(odom_delta)
         doubted = _far(Pose(), odom_delta, cfg.max_step_m, cfg.max_step_rad)
-        kept, jump, widened, est = "window", False, False, None
+        kept, jump, widened, est, problem = "window", False, False, None, None
         if self.trusted and not doubted:
-            est, fit = self._in_window(ranges, pred, where)
+            try:                # the step's one problem: the window's, and the wider search's
+                problem = Problem(self._map, self._laser, ranges, pred, where=where)
+            except InvalidProblemError:
+                pass            # searched again below, which keeps the prediction and says why
+            else:
+                est, fit = self._in_window(problem)
             widened = est is None
         if est is None:
             kept = "far"
-            problem, est, score = self._answer(ranges, pred, where)
+            problem, est, score = self._answer(ranges, pred, where, problem)
             if problem is not None and _far(est.pose, pred, cfg.jump_gate_m, cfg.jump_gate_rad):
                 jump = True
                 near = self.near.localize(problem)
