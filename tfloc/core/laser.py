@@ -106,6 +106,14 @@ class LaserSpec:
         d.setflags(write=False)
         return d
 
+    def every(self, k: int) -> LaserSpec:
+        """The scanner of every ``k``-th beam from the first (``ranges[::k]`` is its scan): the same
+        first angle and range, ``k`` times the resolution."""
+        if k == 1:
+            return self
+        kept = (self.n_beams - 1) // k
+        return LaserSpec(self.max_range, self.resolution * k * kept, self.resolution * k, self.angle_min)
+
     def valid(self, ranges: np.ndarray) -> np.ndarray:
         """Mask of beams with a return: finite, positive and below ``max_range``."""
         r = np.asarray(ranges, dtype=float)

@@ -74,6 +74,18 @@ class Problem:
             raise InvalidProblemError(
                 f"{self.where}: initial pose ({self.initial.x:.3f}, {self.initial.y:.3f}) lies outside the map")
 
+    def every(self, k: int, laser: LaserSpec | None = None) -> Problem:
+        """The same question on every ``k``-th beam of the scan (``laser``: ``self.laser.every(k)``,
+        passed in to share one object across scans). Only the beams kept are checked again (some
+        must return); the guess was checked when this problem was made."""
+        laser = self.laser.every(k) if laser is None else laser
+        ranges = check_ranges(np.ascontiguousarray(self.ranges[::k]), laser, self.where)
+        thinned = object.__new__(Problem)
+        for name, value in (("map", self.map), ("laser", laser), ("ranges", ranges),
+                            ("initial", self.initial), ("where", self.where)):
+            object.__setattr__(thinned, name, value)
+        return thinned
+
     @property
     def points(self) -> np.ndarray:
         """The real scan as points in the sensor frame (Eq. 4), no-return beams dropped."""

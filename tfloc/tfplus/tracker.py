@@ -20,7 +20,8 @@ tracker jumps there. Three rules, each of them the robot's prior knowledge of it
    of the protocol's window; an answer there that does not fit, or lies beyond the jump gate, is
    searched again as above. The window covers MIT CSAIL's per-scan corrections (99.9th
    percentile 0.26 m, 15.6°) and ``widen_score`` is the 98th percentile of its answers'
-   point-to-line residuals (``docs/tracking.md``).
+   point-to-line residuals (``docs/tracking.md``). The window and the fit read beams at least
+   ``window_spacing`` apart (every other beam of a 0.5° scanner), as many as a 1° scanner has.
 
 A prediction ``tf-plus`` cannot answer (too few returns) is kept, as for every single-scan
 matcher run as a tracker (:class:`~tfloc.core.tracker.LocalTracker`). The true pose is never
@@ -53,7 +54,7 @@ class TfPlusTrackConfig:
     """Parameters of ``tf-plus-track`` (metres, radians; ``local``: ``tf-plus``'s own)."""
 
     RULES: ClassVar[dict] = {"> 0": ("jump_gate_m", "jump_gate_rad", "max_step_m", "max_step_rad"),
-                             ">= 0": ("window_m", "window_rad", "widen_score"),
+                             ">= 0": ("window_m", "window_rad", "widen_score", "window_spacing"),
                              ">= 1": ("jump_ratio",)}
 
     jump_gate_m: float = 0.5  #: an answer farther than this from the prediction is a jump (metres) ...
@@ -65,6 +66,7 @@ class TfPlusTrackConfig:
     window_m: float = 0.3  #: the trusted window's radius (metres) ...
     window_rad: float = math.radians(15.0)  #: ... and heading span (radians)
     widen_score: float = 0.04  #: an answer whose point-to-line residual (RMS, metres) is above this does not fit
+    window_spacing: float = math.radians(1.0)  #: the window reads every k-th beam, the most k that keeps them this close (radians)
     local: TfPlusConfig = TfPlusConfig()
 
 
@@ -114,10 +116,18 @@ class TfPlusTracker(LocalTracker):
         self.near = TurningFunctionPlusMatcher(dataclasses.replace(self.config.local, grid=False))
         self.window = TurningFunctionPlusMatcher(window_config(self.config))
         self.trusted = False
+        self.stride, self.window_laser = 1, None     # every beam until a scanner is known
 
     def start(self, map: Map, laser: LaserSpec, pose: Pose) -> None:
         super().start(map, laser, pose)
         self.trusted = False          # the first scan is searched in the protocol's window
+        self._window_beams(laser)
+
+    def _window_beams(self, laser: LaserSpec) -> None:
+        """The beams the window reads: every ``stride``-th, the scanner ``window_laser`` (one
+        object per sequence: ``tf-plus`` caches its plan by it)."""
+        self.stride = max(1, int(self.config.window_spacing / laser.resolution + 1e-9))
+        self.window_laser = laser.every(self.stride)
 
     def reset(self, pose: Pose) -> None:
         super().reset(pose)
@@ -125,10 +135,11 @@ class TfPlusTracker(LocalTracker):
 
     def warm(self, map: Map, laser: LaserSpec, ranges: np.ndarray, pose: Pose) -> None:
         super().warm(map, laser, ranges, pose)
+        self._window_beams(laser)
         problem = Problem(map, laser, ranges, pose)
-        for matcher in (self.near, self.window):
-            matcher.prepare(problem)
-            matcher.localize(problem)
+        for matcher, asked in ((self.near, problem), (self.window, self._thinned(problem))):
+            matcher.prepare(asked)
+            matcher.localize(asked)
 
     def _residual(self, matcher: TurningFunctionPlusMatcher, problem: Problem, est: Estimate) -> float:
         """The answer's selection objective under ``matcher`` (RMS residual, metres): the root of
@@ -148,18 +159,30 @@ class TfPlusTracker(LocalTracker):
             return problem, est, math.inf
         return problem, est, self._residual(self.matcher, problem, est)
 
+    def _thinned(self, problem: Problem) -> Problem:
+        """``problem`` on the beams the window reads (:class:`~tfloc.core.problem.Problem.every`;
+        it raises :class:`~tfloc.errors.InvalidProblemError` if none of them returns)."""
+        return problem if self.stride == 1 else problem.every(self.stride, self.window_laser)
+
     def _fit(self, problem: Problem | None, est: Estimate) -> float:
-        """How well an answer of the protocol's window fits (metres): its point-to-line residual,
-        the trusted window's objective (inf when the guess was kept)."""
+        """How well an answer of the protocol's window fits (metres): its point-to-line residual
+        on the window's beams, the trusted window's objective (inf when the guess was kept)."""
         if problem is None or est.info.get("status") == PREDICTED:
             return math.inf
-        return self.window.score(problem, est.pose)
+        try:
+            return self.window.score(self._thinned(problem), est.pose)
+        except InvalidProblemError:
+            return math.inf
 
     def _in_window(self, problem: Problem) -> tuple[Estimate | None, float]:
         """The trusted window's answer to ``problem`` (posed from the prediction) and its
         point-to-line residual, or ``None`` where it does not fit: no answer, a residual above
         ``widen_score`` or a pose beyond the jump gate."""
         cfg = self.config
+        try:
+            problem = self._thinned(problem)
+        except InvalidProblemError:
+            return None, math.inf
         est = self.window.localize(problem)
         if est.declined:
             return None, math.inf
