@@ -77,4 +77,4 @@ class Pose:
         return self.distance_to(truth), abs(float(angdiff(self.theta, truth.theta)))
 
     def is_finite(self) -> bool:
-        return all(math.isfinite(v) for v in (self.x, self.y, self.theta))
+        return math.isfinite(self.x) and math.isfinite(self.y) and math.isfinite(self.theta)

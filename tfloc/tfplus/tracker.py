@@ -93,6 +93,9 @@ def window_config(cfg: TfPlusTrackConfig) -> TfPlusConfig:
                                beam_check=False)
 
 
+_STILL = Pose()  #: no motion: the odometry increment an increment is doubted against
+
+
 def _far(a: Pose, b: Pose, metres: float, radians: float) -> bool:
     """Whether ``a`` lies more than ``metres`` from ``b`` or is turned more than ``radians``."""
     return a.distance_to(b) > metres or abs(wrap_angle(a.theta - b.theta)) > radians
@@ -194,7 +197,7 @@ class TfPlusTracker(LocalTracker):
     def step(self, ranges: np.ndarray, odom_delta: Pose, stamp: float, where: str = "scan") -> Estimate:
         cfg = self.config
         pred = self.predict(odom_delta)
-        doubted = _far(Pose(), odom_delta, cfg.max_step_m, cfg.max_step_rad)
+        doubted = _far(_STILL, odom_delta, cfg.max_step_m, cfg.max_step_rad)
         kept, jump, widened, est, problem = "window", False, False, None, None
         if self.trusted and not doubted:
             try:                # the step's one problem: the window's, and the wider search's
