@@ -48,6 +48,18 @@ def test_angdiff_is_wrapped_and_consistent(a, b):
     assert abs(math.sin(d) - math.sin(a - b)) < 1e-9 and abs(math.cos(d) - math.cos(a - b)) < 1e-9
 
 
+def test_one_angle_is_wrapped_as_an_array_of_them_bit_for_bit():
+    rng = np.random.default_rng(5)
+    edges = [math.pi, -math.pi, 0.0, -0.0, 2 * math.pi, -3 * math.pi, 1e-320, -1e300,
+             math.inf, -math.inf, math.nan, np.nextafter(math.pi, 4.0), np.nextafter(-math.pi, -4.0)]
+    values = np.concatenate((rng.normal(0.0, 4.0, 20000), rng.uniform(-1e6, 1e6, 2000), edges))
+    with np.errstate(invalid="ignore"):
+        arrays = wrap_angle(values)
+    scalars = np.array([wrap_angle(float(v)) for v in values])
+    assert all(type(wrap_angle(v)) is float for v in (1.0, np.float64(1.0), 7))
+    assert scalars.tobytes() == arrays.tobytes()
+
+
 def test_wrap_angle_examples():
     assert wrap_angle(3 * math.pi / 2) == -math.pi / 2
     assert abs(angdiff(math.radians(179), math.radians(-179)) - math.radians(-2)) < 1e-12

@@ -105,6 +105,39 @@ def test_problem_validation(test_room, lms200):
     Problem(test_room, lms200, np.where(np.arange(181) < 20, np.inf, good), Pose(3, 3.5, 0))
 
 
+def _numpy_range_verdict(r: np.ndarray, laser) -> str:
+    """The range rule in numpy steps (the compiled pass's oracle): the message, or "" if valid."""
+    with np.errstate(invalid="ignore"):
+        neg = np.flatnonzero(r < 0)
+    if neg.size:
+        return f"negative range {r[neg[0]]:g} at beam {neg[0]}"
+    return "" if laser.valid(r).any() else "no return at all"
+
+
+def test_the_compiled_range_check_gives_the_numpy_rule_s_verdicts(lms200):
+    from tfloc.core.problem import check_ranges
+
+    rng = np.random.default_rng(11)
+    specials = np.array([np.nan, np.inf, -np.inf, 0.0, -0.0, -1e-300, lms200.max_range,
+                         np.nextafter(lms200.max_range, 0.0), 1e-300, -2.5])
+    verdicts = set()
+    for k in range(400):
+        r = rng.uniform(0.0, 12.0, 362)
+        r[rng.random(362) < rng.uniform(0.0, 1.0)] = rng.choice(specials)
+        if k % 4 == 0:
+            r[:] = rng.choice(specials[[0, 1, 3, 4, 6]])    # every beam without a return
+        r = r[::2]                                          # a strided view, 181 beams
+        want = _numpy_range_verdict(r, lms200)
+        verdicts.add(want.split(" ")[0])
+        if want:
+            with pytest.raises(InvalidProblemError) as err:
+                check_ranges(r, lms200)
+            assert want in str(err.value)
+        else:
+            assert check_ranges(r, lms200).tobytes() == r.tobytes()
+    assert verdicts == {"", "negative", "no"}
+
+
 def test_unknown_matcher():
     with pytest.raises(tfloc.MatcherError, match="unknown matcher 'nope'"):
         tfloc.get_matcher("nope")

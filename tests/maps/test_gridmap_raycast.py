@@ -134,3 +134,25 @@ def test_grid_from_scans_reproduces_the_room(room) -> None:
     assert both.mean() > 0.9
     assert np.median(np.abs(rv - rg)[both]) < 0.03
     assert grid.is_free(poses[:, :2]).mean() > 0.95  # carved
+
+
+def test_in_bounds_is_the_cells_of_cell_of_inside_the_grid():
+    """The compiled test against the numpy rule it replaced (``cell_of``'s cells within the grid),
+    on random points and on every cell edge, with an origin and a resolution that round."""
+    grid = GridMap(np.zeros((37, 53)), 0.05, origin=(-1.234567, 0.1))
+    rng = np.random.default_rng(2)
+    xmin, ymin, xmax, ymax = grid.bounds
+    edges_x = grid.origin[0] + grid.resolution * np.arange(-1, 55)
+    edges_y = grid.origin[1] + grid.resolution * np.arange(-1, 39)
+    xy = np.concatenate((rng.uniform((xmin - 1, ymin - 1), (xmax + 1, ymax + 1), (20000, 2)),
+                         np.column_stack((edges_x, np.full(edges_x.size, 0.5))),
+                         np.column_stack((np.full(edges_y.size, 0.1), edges_y)),
+                         np.nextafter(np.column_stack((edges_x[:38], edges_y[:38])), -np.inf),
+                         [[np.nan, 0.5], [0.1, np.inf], [-np.inf, 0.5], [1e300, 0.5], [-1e300, 0.5]]))
+    with np.errstate(invalid="ignore"):
+        i, j = grid.cell_of(xy)
+    W, H = grid.shape[1], grid.shape[0]
+    want = (i >= 0) & (i < W) & (j >= 0) & (j < H) & np.isfinite(xy).all(axis=1)
+    got = grid.in_bounds(xy)
+    assert got.dtype == bool and got.shape == (len(xy),) and np.array_equal(got, want)
+    assert got.sum() > 1000 and grid.in_bounds(np.array([0.0, 0.5])).tolist() == [True]

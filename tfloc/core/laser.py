@@ -24,6 +24,21 @@ def _returns_to_points(ranges: np.ndarray, directions: np.ndarray, max_range: fl
 
 
 @njit(cache=True, nogil=True)
+def _scan_faults(ranges: np.ndarray, max_range: float) -> tuple[int, int]:
+    """One pass over a scan for :func:`tfloc.core.problem.check_ranges`: the first beam with a
+    negative range (-1: none) and the number of returns (finite, > 0, < ``max_range``: as
+    :meth:`LaserSpec.valid`)."""
+    first, returns = -1, 0
+    for i in range(ranges.shape[0]):
+        r = ranges[i]
+        if r < 0.0 and first < 0:
+            first = i
+        if np.isfinite(r) and r > 0.0 and r < max_range:
+            returns += 1
+    return first, returns
+
+
+@njit(cache=True, nogil=True)
 def _returns_to_points_into(ranges: np.ndarray, directions: np.ndarray, max_range: float,
                             out: np.ndarray) -> int:
     """:func:`_returns_to_points` into the first rows of ``out`` (``len(ranges)`` rows or as
@@ -90,6 +105,14 @@ class LaserSpec:
         d = np.column_stack((np.cos(self.angles), np.sin(self.angles)))
         d.setflags(write=False)
         return d
+
+    def every(self, k: int) -> LaserSpec:
+        """The scanner of every ``k``-th beam from the first (``ranges[::k]`` is its scan): the same
+        first angle and range, ``k`` times the resolution."""
+        if k == 1:
+            return self
+        kept = (self.n_beams - 1) // k
+        return LaserSpec(self.max_range, self.resolution * k * kept, self.resolution * k, self.angle_min)
 
     def valid(self, ranges: np.ndarray) -> np.ndarray:
         """Mask of beams with a return: finite, positive and below ``max_range``."""

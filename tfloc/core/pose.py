@@ -9,7 +9,10 @@ import numpy as np
 
 
 def wrap_angle(a: float | np.ndarray) -> float | np.ndarray:
-    """Wrap an angle (radians) into [-pi, pi)."""
+    """Wrap an angle (radians) into [-pi, pi). One float is wrapped in plain floats (Python's
+    float ``%`` is numpy's float64 remainder: the same value bit for bit, and much cheaper)."""
+    if isinstance(a, float):
+        return float((a + math.pi) % (2.0 * math.pi) - math.pi)
     w = (np.asarray(a, dtype=float) + np.pi) % (2.0 * np.pi) - np.pi
     return float(w) if w.ndim == 0 else w
 
@@ -74,4 +77,4 @@ class Pose:
         return self.distance_to(truth), abs(float(angdiff(self.theta, truth.theta)))
 
     def is_finite(self) -> bool:
-        return all(math.isfinite(v) for v in (self.x, self.y, self.theta))
+        return math.isfinite(self.x) and math.isfinite(self.y) and math.isfinite(self.theta)

@@ -10,7 +10,7 @@ import numpy as np
 
 from tfloc.errors import InvalidProblemError, TflocError
 
-from .laser import LaserSpec
+from .laser import LaserSpec, _scan_faults
 from .pose import Pose
 
 if TYPE_CHECKING:
@@ -32,11 +32,10 @@ def check_ranges(ranges: Any, laser: LaserSpec, where: str = "scan",
     if r.size != laser.n_beams:
         raise error(f"{where}: {r.size} ranges, expected {laser.n_beams} "
                     f"(laser {math.degrees(laser.fov):g}°/{math.degrees(laser.resolution):g}°)")
-    with np.errstate(invalid="ignore"):
-        neg = np.flatnonzero(r < 0)
-    if neg.size:
-        raise error(f"{where}: negative range {r[neg[0]]:g} at beam {neg[0]}")
-    if not laser.valid(r).any():
+    negative, returns = _scan_faults(r, float(laser.max_range))   # one compiled pass
+    if negative >= 0:
+        raise error(f"{where}: negative range {r[negative]:g} at beam {negative}")
+    if not returns:
         raise error(f"{where}: scan has no return at all (every range inf/nan/≥ max_range)")
     return r
 
@@ -74,6 +73,18 @@ class Problem:
         if not bool(self.map.in_bounds(np.array([[self.initial.x, self.initial.y]]))[0]):
             raise InvalidProblemError(
                 f"{self.where}: initial pose ({self.initial.x:.3f}, {self.initial.y:.3f}) lies outside the map")
+
+    def every(self, k: int, laser: LaserSpec | None = None) -> Problem:
+        """The same question on every ``k``-th beam of the scan (``laser``: ``self.laser.every(k)``,
+        passed in to share one object across scans). Only the beams kept are checked again (some
+        must return); the guess was checked when this problem was made."""
+        laser = self.laser.every(k) if laser is None else laser
+        ranges = check_ranges(np.ascontiguousarray(self.ranges[::k]), laser, self.where)
+        thinned = object.__new__(Problem)
+        for name, value in (("map", self.map), ("laser", laser), ("ranges", ranges),
+                            ("initial", self.initial), ("where", self.where)):
+            object.__setattr__(thinned, name, value)
+        return thinned
 
     @property
     def points(self) -> np.ndarray:

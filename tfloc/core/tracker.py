@@ -122,10 +122,16 @@ class LocalTracker:
             problem = Problem(self._map, self._laser, ranges, guess, where=where)
         except InvalidProblemError as exc:
             return None, Estimate(guess, False, info={"status": PREDICTED, "reason": str(exc)[:200]})
+        return problem, self.answer_to(problem)
+
+    def answer_to(self, problem: Problem) -> Estimate:
+        """The matcher's answer to ``problem`` (posed from a guess), or the guess itself
+        (:data:`PREDICTED`) when the matcher declines."""
         est = self.matcher.localize(problem)
         if est.declined:
-            est = Estimate(guess, False, est.iterations, est.evaluations, {**est.info, "status": PREDICTED})
-        return problem, est
+            est = Estimate(problem.initial, False, est.iterations, est.evaluations,
+                           {**est.info, "status": PREDICTED})
+        return est
 
     def step(self, ranges: np.ndarray, odom_delta: Pose, stamp: float, where: str = "scan") -> Estimate:
         _, est = self.answer(ranges, self.predict(odom_delta), where)

@@ -11,6 +11,20 @@ from numba import njit
 
 
 @njit(cache=True, nogil=True)
+def inside_kernel(xy: np.ndarray, origin_x: float, origin_y: float, resolution: float, W: int,
+                  H: int) -> np.ndarray:
+    """Which ``(N, 2)`` world points (metres) lie in a cell of the ``H × W`` grid whose cell
+    ``[0, 0]`` has its outer corner at the origin: ``0 ≤ (x − origin_x) / resolution < W`` and
+    the same in y, which is ``0 ≤ ⌊(x − origin_x) / resolution⌋ < W`` (false for NaN)."""
+    out = np.empty(xy.shape[0], dtype=np.bool_)
+    for k in range(xy.shape[0]):
+        u = (xy[k, 0] - origin_x) / resolution
+        v = (xy[k, 1] - origin_y) / resolution
+        out[k] = u >= 0.0 and u < W and v >= 0.0 and v < H
+    return out
+
+
+@njit(cache=True, nogil=True)
 def _slab(p0: float, d: float, size: int, t0: float, t1: float) -> tuple[float, float]:
     """``[t0, t1]`` narrowed to the ray parameters with ``0 ≤ p0 + t·d < size`` on one axis
     (empty, ``(inf, -inf)``, when a ray parallel to the axis lies outside)."""

@@ -14,7 +14,7 @@ from tfloc.core.map import as_pose_array
 from tfloc.core.pose import Pose
 from tfloc.errors import MapFormatError
 
-from ._gridcast import raycast_grid
+from ._gridcast import inside_kernel, raycast_grid
 from .fields import edt_metres
 
 
@@ -117,10 +117,11 @@ class GridMap:
         return r[0] if single else r
 
     def in_bounds(self, xy: np.ndarray) -> np.ndarray:
-        """Which ``(N, 2)`` points lie inside the grid's extent."""
-        i, j = self.cell_of(xy)
+        """Which ``(N, 2)`` points lie inside the grid's extent (whose :meth:`cell_of` is a cell of
+        the grid), in one compiled pass: a tracker asks it of one pose every scan."""
+        p = np.ascontiguousarray(np.asarray(xy, dtype=float).reshape(-1, 2))
         H, W = self.shape
-        return (i >= 0) & (i < W) & (j >= 0) & (j < H)
+        return inside_kernel(p, self.origin[0], self.origin[1], self.resolution, W, H)
 
     def is_free(self, xy: np.ndarray, clearance: float = 0.0) -> np.ndarray:
         """Which ``(N, 2)`` points lie in known free cells whose centre is at least
