@@ -4,8 +4,7 @@ steps that make its tables.
 Either name datasets and matchers on the command line, or give study files (benchmarks/*.toml:
 each one run, then the steps it declares, e.g. steps = ["timing", "report"]; a file may extend
 another, extends = "robustness.toml"); options given on the command line override a single
-file. Every matcher is built
-before anything runs: a bad parameter stops the command at once, naming its configuration key.
+file. Every matcher is built before anything runs: a bad parameter stops the command at once.
 Re-running the same command after an interruption (Ctrl-C, kill -9) resumes it. A run directory
 holds one configuration (run.json's fingerprint); another is refused there: use --regenerate or
 another --out. Every task ends in one row: ok, failed, invalid:<reason>, timeout or error:<message>
