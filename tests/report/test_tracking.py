@@ -3,13 +3,15 @@ dead reckoning as the floor, and the figures."""
 
 from __future__ import annotations
 
+import dataclasses
+
 from _paths import ROOT, SCEN
 
 from tfloc.harness.track import dead_reckoning
 from tfloc.io.estimates import result_row, rows_frame
 from tfloc.io.maps import load_map
 from tfloc.io.scenario import read_scans, read_scenario
-from tfloc.report.tracking import sequence_scores, tracking_section
+from tfloc.report.tracking import _own_odometry_rules, sequence_scores, tracking_section
 
 
 def _rows(name: str, n: int, lost_from: int | None = None) -> list:
@@ -60,3 +62,12 @@ def test_a_sequence_with_relations_gets_the_relation_errors_and_a_set_of_buildin
     s = sequence_scores(df, datasets)
     t = tracking_tables(s, datasets)
     assert "**real-native: real-csail-native**" in t and "**real-native**" in t   # two buildings: per log too
+
+
+def test_a_trackers_own_odometry_rule_is_stated_only_where_it_runs():
+    base = _rows("seq-quick", 5)
+    renamed = [dataclasses.replace(r, matcher="tf-plus-track-changed") for r in base if r.matcher == "perfect"]
+    without = _own_odometry_rules(rows_frame(base))
+    with_it = _own_odometry_rules(rows_frame(base + renamed))
+    assert without == []
+    assert len(with_it) == 1 and with_it[0].startswith("`tf-plus-track`'s own feature") and "no motion" in with_it[0]

@@ -283,6 +283,24 @@ def relations_tables(df: pd.DataFrame, datasets: dict[str, Scenario]) -> str:
     return "\n".join(parts)
 
 
+#: trackers with a rule of their own for an odometry increment they doubt (stated in the tables,
+#: since the harness's prediction has none and no peer's package ships one)
+OWN_ODOMETRY_RULES = {
+    "tf-plus-track": "an increment the robot cannot have made between two scans (0.5 m or 30°) is "
+                     "also tried as no motion, from the last estimate, the better answer winning",
+}
+
+
+def _own_odometry_rules(df: pd.DataFrame) -> list[str]:
+    """One line per tracker in ``df`` (or a preset of it, ``name[...]``/``name-...``) that
+    handles a doubted odometry increment itself: its own feature, not the harness's."""
+    names = {str(m) for m in df["matcher"].unique()} if "matcher" in df else set()
+    lines = [f"`{base}`'s own feature: {rule}; no other tracker here has such a rule.\n"
+             for base, rule in OWN_ODOMETRY_RULES.items()
+             if any(n == base or n.startswith((base + "[", base + "-")) for n in names)]
+    return lines
+
+
 def tracking_section(df: pd.DataFrame, datasets: dict[str, Scenario], maps: dict[str, object],
                      out_dir: Path, thresholds: Thresholds = DEFAULT,
                      figures: bool = True) -> str:
@@ -296,7 +314,8 @@ def tracking_section(df: pd.DataFrame, datasets: dict[str, Scenario], maps: dict
             "goes above 0.5 m or 10°; a recovery = back within the thresholds by itself; APE/RPE by "
             "evo with no alignment (map frame), over the scans with truth; a jump = an estimate more "
             "than 1 m from the prediction it started from (every scan); `odometry` = dead reckoning, "
-            "the floor.\n",
+            "the floor. Every tracker gets the same odometry, each increment composed whole.\n",
+            *_own_odometry_rules(df),
             tracking_tables(s, datasets), relations_tables(df, datasets), own_score_table(df, thresholds)]
     ev = kidnap_events(df, datasets, thresholds)
     if len(ev):
