@@ -14,7 +14,8 @@ from .advice import Statement, statements
 from .board import Board, headline_board, unique_dirs
 from .cost import cpu_board, slopes_board
 from .pages import COST, Page, load_pages
-from .rows import RunRows, run_rows
+from .rows import SOURCES, RunRows, run_rows
+from .targets import NATIVE_RUNS, SIMULATED_RUN, targets_markdown
 
 
 @dataclass
@@ -27,6 +28,7 @@ class SiteData:
     runs: dict[str, RunRows]
     boards: dict[str, Board] = field(default_factory=dict)
     statements: list[Statement] = field(default_factory=list)
+    targets: str = ""  #: the tracking targets, checked (Markdown; :mod:`tfloc.site.targets`)
 
 
 def _csv(path: Path) -> pd.DataFrame | None:
@@ -53,7 +55,25 @@ def collect(root: Path, quick: bool = False, pages: list[Page] | None = None) ->
         data.boards[p.key] = headline_board(p, runs)
         data.boards[f"{p.key}-short"] = headline_board(p, runs, short=True)
     data.statements = statements(data.boards)
+    data.targets = _targets(root, runs)
     return data
+
+
+def _reported(root: Path, runs: dict[str, RunRows], name: str) -> RunRows | None:
+    rr = runs.get(name) or run_rows(root, name)
+    return rr if rr.source == SOURCES[0] else None
+
+
+def _targets(root: Path, runs: dict[str, RunRows]) -> str:
+    """The targets block from the first native run with a headline and ``tracking.csv``."""
+    native = None
+    for name in NATIVE_RUNS:
+        rr, tracking = _reported(root, runs, name), _csv(root / name / "tracking.csv")
+        if rr is not None and tracking is not None:
+            native = (name, rr.rows, tracking)
+            break
+    sim = _reported(root, runs, SIMULATED_RUN)
+    return targets_markdown(native, (SIMULATED_RUN, sim.rows) if sim is not None else None)
 
 
 def run_note(rr: RunRows | None, name: str) -> str:

@@ -1,7 +1,7 @@
 """The leaderboards and statements as Markdown, for the README's and docs' generated blocks:
 the text between ``<!-- tfloc:begin NAME -->`` and ``<!-- tfloc:end NAME -->`` is replaced by
 block NAME (a page key: its full board; ``KEY-short``: the README's short table; ``cost``,
-``cost-slopes``; ``advice``: the statements). The cells are the site's: the figure with its
+``cost-slopes``; ``advice``: the statements; ``targets``: the tracking targets, checked). The cells are the site's: the figure with its
 95 % interval (bold where the paired test puts the column's first ahead of the next) and the
 CPU per scan."""
 
@@ -18,6 +18,7 @@ from .pages import COST
 
 BLOCK = re.compile(r"(<!-- tfloc:begin (?P<name>[\w.-]+) -->\n)(?P<body>.*?)(<!-- tfloc:end (?P=name) -->)", re.S)
 ADVICE = "advice"
+TARGETS = "targets"
 #: rows of a README table (``KEY-short``): the first matchers of its first column
 SHORT_ROWS = 5
 
@@ -60,9 +61,11 @@ def block(name: str, data: SiteData) -> str:
     """The Markdown of block ``name``."""
     if name == ADVICE:
         return advice_markdown(data)
+    if name == TARGETS:
+        return data.targets
     if name in data.boards:
         return board_markdown(data.boards[name], data, short=name.endswith("-short"))
-    raise ConfigError(f"unknown generated block {name!r}; known: {', '.join([ADVICE, *data.boards])}")
+    raise ConfigError(f"unknown generated block {name!r}; known: {', '.join([ADVICE, TARGETS, *data.boards])}")
 
 
 def block_names(text: str) -> list[str]:
