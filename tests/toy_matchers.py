@@ -113,3 +113,24 @@ class Flaky(Stay):
         if os.environ.get("TFLOC_TOY_FAIL"):
             raise RuntimeError("toy bug")
         return super().localize(problem)
+
+
+_COMPILED = False  # per process, as numba's kernels are once compiled or loaded
+
+
+class ColdStart(Stay):
+    """:class:`Stay` whose first ``localize`` in a process takes ``first_s`` (a kernel compiled on
+    a loaded machine), every later one nothing."""
+
+    name = "cold-start"
+
+    def __init__(self, first_s: float = 2.0) -> None:
+        super().__init__(0.0)
+        self.first_s = first_s
+
+    def localize(self, problem: Problem) -> Estimate:
+        global _COMPILED
+        if not _COMPILED:
+            time.sleep(self.first_s)
+            _COMPILED = True
+        return super().localize(problem)

@@ -140,3 +140,12 @@ def test_regenerate_reruns_a_complete_run_and_resumes_an_incomplete_one(tmp_path
     run(c, progress=False, regenerate=True)                      # complete: start over
     assert len(json.loads((tmp_path / "run" / "run.json").read_text())["sessions"]) == 1
     assert len(read_estimates(tmp_path / "run")) == 2
+
+
+def test_a_warm_up_longer_than_the_task_limit_does_not_turn_tasks_into_timeouts(tmp_path, test_room, lms200):
+    """The warm-up (kernels compiled before the timed tasks) has its own, longer limit: with the
+    task's 1 s, a 2 s cold start would be killed and the worker's first task time out instead."""
+    ds = make_dataset(tmp_path / "ds", test_room, lms200, n=3)
+    out = run(cfg(ds, tmp_path / "run", MatcherSpec.make("toy_matchers:ColdStart", label="cold"),
+                  jobs=1, timeout_s=1.0), progress=False)
+    assert (read_estimates(out).status == "ok").all()

@@ -21,7 +21,7 @@ from pebble import ProcessPool
 
 from tfloc.core.result import ResultRow, StatusKind
 
-from .runner import WORKER_DIED, _init_worker, collect
+from .runner import WARM_UP_S, WORKER_DIED, _init_worker, collect
 from .task import Task, run_task, warm_up
 
 PLUGIN_NAME = "tfloc-task-pool"
@@ -63,7 +63,7 @@ class TaskPool(WorkerPlugin):
             self.warm.add(key)
         if cold and not task.sequence:  # load data, compile kernels outside the timed, time-limited task
             try:
-                self.pool.schedule(warm_up, args=(task,), timeout=max(60.0, timeout_s)).result()
+                self.pool.schedule(warm_up, args=(task,), timeout=max(WARM_UP_S, timeout_s)).result()
             except Exception:  # noqa: BLE001 - the task itself will report the failure
                 pass
         row = collect(self.pool.schedule(run_task, args=(task,), timeout=timeout_s), task)

@@ -139,6 +139,10 @@ def session_doc(pre: Preflight) -> dict:
             "fingerprint": pre.fingerprint()}
 
 
+#: the time limit of one warm-up (seconds): kernels compiled and cached, map-only data built
+WARM_UP_S = 600.0
+
+
 def execute_local(tasks: list[Task], jobs: int, timeout_s: float,
                   on_row: Callable[[ResultRow | list[ResultRow]], None]) -> None:
     """Run ``tasks`` on a local process pool; every task ends in exactly one ``on_row`` call (a
@@ -150,7 +154,9 @@ def execute_local(tasks: list[Task], jobs: int, timeout_s: float,
             for t in tasks:  # compile kernels and load data outside the timed, time-limited tasks
                 if not t.sequence:  # (a sequence task warms itself up, untimed)
                     warm.setdefault((t.dataset, t.matcher, t.params_json), t)
-            for f in [pool.schedule(warm_up, args=(t,), timeout=timeout_s) for t in warm.values()]:
+            # a warm-up compiles numba kernels (seconds to a minute on a loaded machine): limited
+            # by WARM_UP_S, not the task limit, so a cold cache never turns tasks into timeouts
+            for f in [pool.schedule(warm_up, args=(t,), timeout=max(WARM_UP_S, timeout_s)) for t in warm.values()]:
                 try:
                     f.result()
                 except Exception:  # noqa: BLE001 - the task itself will report the failure

@@ -144,7 +144,8 @@ def run_task(task: Task) -> ResultRow | list[ResultRow]:
 def warm_up(task: Task) -> None:
     """Before a run: load the dataset and matcher of ``task``, :func:`warm` them up and run one
     untimed ``localize``, which compiles every numba kernel the matcher uses into numba's on-disk
-    cache (other workers then only load them). The caller gives it the task's time limit."""
+    cache (other workers then only load them). The caller limits it by runner.WARM_UP_S (or the task's
+    limit, if longer), not the task's limit: a cold cache under load must not become timeouts."""
     try:
         scenario, scan, matcher, problem = _posed(task)
         _warm_once(task, matcher, problem_of(scenario, scan))
