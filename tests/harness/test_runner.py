@@ -149,3 +149,15 @@ def test_a_warm_up_longer_than_the_task_limit_does_not_turn_tasks_into_timeouts(
     out = run(cfg(ds, tmp_path / "run", MatcherSpec.make("toy_matchers:ColdStart", label="cold"),
                   jobs=1, timeout_s=1.0), progress=False)
     assert (read_estimates(out).status == "ok").all()
+
+
+def test_a_run_of_another_configuration_without_rows_leaves_no_sessions_behind(tmp_path, test_room, lms200):
+    """Per-scan rows are not always kept (the native runs' estimates are not committed): a run
+    of another configuration into that directory starts a fresh record, not a 'resumed' one."""
+    ds = make_dataset(tmp_path / "ds", test_room, lms200, n=2)
+    out = tmp_path / "run"
+    run(cfg(ds, out, MatcherSpec.make("toy_matchers:Stay", label="stay"), jobs=1), progress=False)
+    (out / "estimates.csv").unlink()
+    run(cfg(ds, out, MatcherSpec.make("toy_matchers:Stay", label="other"), jobs=1), progress=False, regenerate=True)
+    sessions = json.loads((out / "run.json").read_text())["sessions"]
+    assert len(sessions) == 1 and set(read_estimates(out).matcher) == {"other"}

@@ -239,6 +239,8 @@ def run(config: RunConfig, progress: bool | None = None, executor: Executor = ex
         if diff:
             rd.discard()
             done = set()
+    elif rd.run_json.is_file() and differences(rd.recorded_fingerprint(), fp):
+        rd.discard()  # no rows, but the record of another configuration: its sessions are not this run's
     done = _drop_cut_sequences(rd, tasks, done)
     todo = [t for t in tasks if t.key not in done]
     if regenerate and not todo and tasks:

@@ -39,6 +39,7 @@ from .figures import MANY_MATCHERS
 from .headline import headline_section
 from .landscape import draw_landscapes, landscape_section
 from .mdtable import num
+from .sessions import this_run
 
 CONTENTION = 1.5  # median wall / CPU time above this: other processes competed for the cores
 
@@ -66,7 +67,7 @@ def header(run_dir: Path, run: dict, df: pd.DataFrame, thr: Thresholds, s2s: set
     cfg = run.get("config", {})
     git = run.get("git", {})
     mach = run.get("machine", {})
-    sessions = run.get("sessions", [])
+    sessions = this_run(run.get("sessions", []))
     commit = git.get("commit") or "unknown"
     if git.get("dirty"):
         commit += " (working tree had uncommitted changes)"
