@@ -70,9 +70,12 @@ ablation-real: $(STAMP)
 real-data: $(STAMP)
 	$(BIN)/tfloc real-data --out data
 
-## Unit tests, the accuracy regression guard and a benchmark smoke run (CI), then test-cpu.
+## Unit tests, the accuracy regression guard and a benchmark smoke run (CI), then test-cpu. The
+## tests run in two processes (pytest-xdist); a module whose fixture builds something costly is an
+## xdist_group, run whole by one of them. The smoke run stays in one (two would double its start-up).
+XDIST := -n 2 --dist loadgroup
 test: $(STAMP)
-	$(BIN)/python -m pytest -q tests
+	$(BIN)/python -m pytest -q $(XDIST) tests
 	$(BIN)/python -m pytest -q benchmarks --benchmark-disable
 	$(MAKE) --no-print-directory test-cpu
 
@@ -86,7 +89,7 @@ test-cpu: $(STAMP)
 		coretype="$$($(BIN)/python -c "import sys; sys.path.insert(0, 'tests'); import cpu_levels; print(cpu_levels.OPENBLAS_CORETYPE['$$level'])")" && \
 		echo "test-cpu $$level: NPY_DISABLE_CPU_FEATURES='$$features' OPENBLAS_CORETYPE=$$coretype" && \
 		TFLOC_CPU_LEVEL=$$level NPY_DISABLE_CPU_FEATURES="$$features" OPENBLAS_CORETYPE=$$coretype \
-			$(BIN)/python -m pytest -q -m bitwise tests || exit 1; \
+			$(BIN)/python -m pytest -q $(XDIST) -m bitwise tests || exit 1; \
 	done
 
 ## Every reader against thousands of damaged inputs, and every matcher parameter against bad
