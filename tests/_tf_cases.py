@@ -33,11 +33,12 @@ def cost_cases(room: Map, laser: LaserSpec, grid: bool, n: int = 4):
 
 
 def few_returns_problem(laser: LaserSpec, returns: int) -> Problem:
-    """A scan with only ``returns`` returns (2 m, from beam 90) in a 4 × 3 m room, guess (1, 1, 0)."""
+    """A scan with only ``returns`` returns (2 m, from beam 90) in a 4 × 3 m room, guess (1, 1, 0)
+    in floats, as a dataset's poses are (int coordinates would compile tf-plus's kernels again)."""
     ranges = np.full(laser.n_beams, np.inf)
     ranges[90:90 + returns] = 2.0
     room = VectorMap(outline=box(0, 0, 4, 3))
-    return Problem(room, laser, ranges, Pose(1, 1, 0))
+    return Problem(room, laser, ranges, Pose(1.0, 1.0, 0.0))
 
 
 def corridor_problem(laser: LaserSpec) -> Problem:

@@ -124,6 +124,7 @@ def test_out_of_range_and_no_segments():
 def test_non_uniform_angles_fall_back_to_bruteforce():
     rng = np.random.default_rng(0)
     angles = np.sort(rng.uniform(-np.pi, np.pi, 50))
+    angles.flags.writeable = False  # read-only, as LaserSpec.angles are (no second compilation)
     segs = np.ascontiguousarray(rng.uniform(-5, 5, (30, 4)))
     poses = np.ascontiguousarray(np.column_stack((rng.uniform(-5, 5, (5, 2)), np.zeros(5))))
     np.testing.assert_array_equal(raycast_segments(poses, angles, segs, 10.0, NO_INDEX),

@@ -7,7 +7,7 @@ from __future__ import annotations
 import os
 
 import pytest
-from cpu_levels import OPENBLAS_CORETYPE, PREFIXES, disabled
+from cpu_levels import OPENBLAS_CORETYPE, PREFIXES, disabled, native
 
 LEVEL = os.environ.get("TFLOC_CPU_LEVEL")
 pytestmark = pytest.mark.bitwise
@@ -41,3 +41,18 @@ def test_the_levels_name_targets_of_this_numpy() -> None:
     if platform.machine() not in ("x86_64", "AMD64"):
         pytest.skip("x86-64 levels")
     assert disabled("no-avx512") and set(disabled("no-avx512")) < set(disabled("no-avx2"))
+
+
+@pytest.mark.skipif(LEVEL is not None, reason="asks about the machine, not about a pass")
+def test_a_level_is_skipped_only_where_the_cpu_lacks_what_it_disables() -> None:
+    """``make test-cpu`` skips a level this CPU computes at anyway; never one whose targets it has."""
+    try:
+        from numpy._core._multiarray_umath import __cpu_features__
+    except ImportError:  # numpy < 2
+        from numpy.core._multiarray_umath import __cpu_features__
+
+    for level in PREFIXES:
+        if any(__cpu_features__.get(t, True) for t in disabled(level)):
+            assert not native(level), level
+    if __cpu_features__.get("AVX2"):
+        assert not native("no-avx2")
