@@ -71,9 +71,10 @@ real-data: $(STAMP)
 	$(BIN)/tfloc real-data --out data
 
 ## Unit tests, the accuracy regression guard and a benchmark smoke run (CI), then test-cpu. The
-## tests run in two processes (pytest-xdist); a module whose fixture builds something costly is an
-## xdist_group, run whole by one of them. The smoke run stays in one (two would double its start-up).
-XDIST := -n 2 --dist loadgroup
+## tests run in two processes (pytest-xdist), each test file whole in one of them, so a module
+## fixture is built once (--dist loadgroup would not do: it groups nothing with pytest 9.2's node
+## ids). The smoke run stays in one process (two would double its start-up).
+XDIST := -n 2 --dist loadfile
 test: $(STAMP)
 	$(BIN)/python -m pytest -q $(XDIST) tests
 	$(BIN)/python -m pytest -q benchmarks --benchmark-disable

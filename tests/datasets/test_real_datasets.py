@@ -25,9 +25,6 @@ from tfloc.datasets.relations import build_relations, overlap
 from tfloc.io.carmen import read_carmen
 from tfloc.io.scenario import map_for, read_scans, read_scenario
 
-#: make test's two processes (pytest-xdist) run this module in one: the datasets rebuilt from the logs, once
-pytestmark = pytest.mark.xdist_group("real-datasets")
-
 DATA = ROOT / "data"
 SCEN = DATA / "scenarios"
 

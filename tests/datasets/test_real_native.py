@@ -33,9 +33,6 @@ from tfloc.io.carmen import read_carmen, read_flaser_no_timestamps
 from tfloc.io.relations import Relation, read_relations
 from tfloc.io.scenario import read_scans, read_scenario
 
-#: make test's two processes (pytest-xdist) run this module in one: the native datasets rebuilt from the logs, once
-pytestmark = pytest.mark.xdist_group("real-native")
-
 #: (key, scans in the dataset, truth-bearing scans, raw scans in the log)
 COUNTS = (("intel", 13462, 910, 13631), ("csail", 1927, 406, 1988), ("aces", 7238, 440, 7374))
 

@@ -25,9 +25,6 @@ from tfloc.harness.dask_executor import execute_dask  # noqa: E402
 from tfloc.harness.runner import run  # noqa: E402
 from tfloc.io.estimates import read_estimates  # noqa: E402
 
-#: make test's two processes (pytest-xdist) run this module in one: the loopback cluster, once
-pytestmark = pytest.mark.xdist_group("dask-executor")
-
 TESTS = Path(__file__).resolve().parents[1]
 ENV = {**os.environ, "PYTHONPATH": os.pathsep.join([str(TESTS), str(ROOT)])}
 KEY = ["dataset", "scan_id", "matcher"]

@@ -34,9 +34,6 @@ from tfloc.maps.build import rasterize
 from tfloc.maps.vector import VectorMap
 from tfloc.report.scaling import render_scaling
 
-#: make test's two processes (pytest-xdist) run this module in one: the tiny study, once
-pytestmark = pytest.mark.xdist_group("scaling")
-
 OFFICE = ROOT / "data" / "maps" / "office-1.geojson"
 #: The tiny study: 2 areas × 2 kinds, the 4 lasers, the 3 offset bins; 2 scans each; 2 cheap matchers.
 TINY = ["--matchers", "tf-plus,cv-corners", "--areas", "300,1200", "--scans", "2", "--scans-per-bin", "2",

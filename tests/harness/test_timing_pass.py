@@ -28,9 +28,6 @@ from tfloc.harness.runner import run
 from tfloc.harness.timing import run_timing, sample_scans
 from tfloc.report.timing_pass import timing_pass
 
-#: make test's two processes (pytest-xdist) run this module in one: the small run, once
-pytestmark = pytest.mark.xdist_group("timing-pass")
-
 ENV = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "tests"), str(ROOT)])}
 
 

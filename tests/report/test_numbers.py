@@ -20,9 +20,6 @@ from tfloc.harness.runner import run
 from tfloc.io.estimates import read_estimates
 from tfloc.report.report import write_report
 
-#: make test's two processes (pytest-xdist) run this module in one: the synthetic run's report, once
-pytestmark = pytest.mark.xdist_group("numbers")
-
 
 @pytest.fixture(scope="module")
 def synthetic(tmp_path_factory):

@@ -14,9 +14,6 @@ from tfloc.evaluation.metrics import METRIC_COLUMNS
 from tfloc.evaluation.summary import SUMMARY_KEYS
 from tfloc.report.report import write_report
 
-#: make test's two processes (pytest-xdist) run this module in one: the synthetic run's report, once
-pytestmark = pytest.mark.xdist_group("report")
-
 FIGURES = {"scenario_errors.png", "basin.png", "error_cdf.png", "runtime.png", "outcomes.png"}
 
 

@@ -13,9 +13,6 @@ from _registry import NAMES
 
 from tfloc.harness.runner import _init_worker
 
-#: make test's two processes (pytest-xdist) run this module in one: the probe's worker run, once
-pytestmark = pytest.mark.xdist_group("threads")
-
 MATCHERS = tuple(NAMES)  # every registered matcher
 
 
