@@ -1,6 +1,8 @@
 # tfloc: the commands of the README are `make quick`, `make bench` and `make test`.
 # Each creates .venv on first use and (re)installs when pyproject.toml or requirements.lock changes:
 # the exact versions of requirements.lock (hash-checked), then tfloc itself without dependencies.
+# --no-compile: Python writes the bytecode of a module when it is first imported, not of all 2 GB
+# of packages at install (nearly half of the install's time on this machine).
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
@@ -9,11 +11,11 @@ LOCK   := requirements.lock
 UV_VERSION := 0.13.9
 
 ## The site (tfloc site) is written at the end of make bench (results/site/) and make quick (results/site-quick/).
-.PHONY: install lock browser site quick bench native native-single-scan sequences-single-scan global-full global-offices robustness robustness-full scaling scaling-quick ablation-real test test-cpu test-unit timing lint clean-venv real-data fuzz chaos
+.PHONY: install lock browser site quick bench native native-single-scan sequences-single-scan global-full global-offices robustness robustness-full scaling scaling-quick ablation-real test test-cpu test-sweeps test-unit timing lint clean-venv real-data fuzz chaos
 
 $(STAMP): pyproject.toml $(LOCK)
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install -qq --require-hashes -r $(LOCK)
+	$(BIN)/python -m pip install -qq --no-compile --require-hashes -r $(LOCK)
 	$(BIN)/python -m pip install -qq --no-deps --no-build-isolation -e .
 	@$(BIN)/python -c 'import sys; v = sys.version_info[:2]; v < (3, 12) or print("note: matcher karto left out: karto-scanmatcher has wheels for Python 3.8-3.11 only, this is Python %d.%d" % v)'
 	@touch $(STAMP)
@@ -44,6 +46,7 @@ STUDIES := paper-protocol real-csail-relations real-scan-to-map tf-readings tf-r
 bench: $(STAMP)
 	$(BIN)/tfloc bench $(STUDIES:%=benchmarks/%.toml) --regenerate
 	$(BIN)/tfloc site --readme
+	$(MAKE) --no-print-directory test-sweeps
 
 ## The leaderboards' site from the committed runs → results/site/index.html (opens from disk), and
 ## the README's and docs' generated blocks from the same rows.
@@ -70,15 +73,24 @@ ablation-real: $(STAMP)
 real-data: $(STAMP)
 	$(BIN)/tfloc real-data --out data
 
-## Unit tests, the accuracy regression guard and a benchmark smoke run (CI), then test-cpu. The
-## tests run in two processes (pytest-xdist), each test file whole in one of them, so a module
-## fixture is built once (--dist loadgroup would not do: it groups nothing with pytest 9.2's node
-## ids). The smoke run stays in one process (two would double its start-up).
+## Unit tests, the accuracy regression guard and a benchmark smoke run (CI), then test-cpu. First
+## tests/warm_kernels.py compiles tfloc's kernels into numba's cache, each once, in two processes
+## (else both test processes and the commands the tests run compile them again while the cache
+## is empty). The tests run in two processes (pytest-xdist), a test file whole in one. The
+## longer members of a parametrised check and the full rebuilds (marker sweep) are left to
+## make test-sweeps, which make bench runs. The smoke run stays in one process.
 XDIST := -n 2 --dist loadfile
 test: $(STAMP)
+	$(BIN)/python tests/warm_kernels.py
 	$(BIN)/python -m pytest -q $(XDIST) tests
 	$(BIN)/python -m pytest -q benchmarks --benchmark-disable
 	$(MAKE) --no-print-directory test-cpu
+
+## The sweeps make test leaves out (pytest -m sweep), then those that compare with committed files
+## at the CPU levels of test-cpu.
+test-sweeps: $(STAMP)
+	$(BIN)/python -m pytest -q $(XDIST) -m sweep tests
+	$(MAKE) --no-print-directory test-cpu CPU_MARK="sweep and bitwise"
 
 ## The tests that compare with committed files or pinned values (marker bitwise) again, as a CPU
 ## without AVX-512 computes (numpy's dispatch below X86_V4, OpenBLAS's Haswell kernels), then
@@ -86,6 +98,7 @@ test: $(STAMP)
 ## machine's kind would get, shown on this one (tests/cpu_levels.py names the features). A level
 ## this machine computes at anyway (no AVX-512 on its CPU, OpenBLAS on those kernels) is skipped:
 ## the plain pass of make test is that pass.
+CPU_MARK := bitwise
 test-cpu: $(STAMP)
 	@for level in no-avx512 no-avx2; do \
 		if $(BIN)/python tests/cpu_levels.py --native $$level; then \
@@ -94,7 +107,7 @@ test-cpu: $(STAMP)
 		coretype="$$($(BIN)/python -c "import sys; sys.path.insert(0, 'tests'); import cpu_levels; print(cpu_levels.OPENBLAS_CORETYPE['$$level'])")" && \
 		echo "test-cpu $$level: NPY_DISABLE_CPU_FEATURES='$$features' OPENBLAS_CORETYPE=$$coretype" && \
 		TFLOC_CPU_LEVEL=$$level NPY_DISABLE_CPU_FEATURES="$$features" OPENBLAS_CORETYPE=$$coretype \
-			$(BIN)/python -m pytest -q $(XDIST) -m bitwise tests || exit 1; \
+			$(BIN)/python -m pytest -q $(XDIST) -m "$(CPU_MARK)" tests || exit 1; \
 	done
 
 ## Every reader against thousands of damaged inputs, and every matcher parameter against bad

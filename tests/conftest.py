@@ -42,11 +42,20 @@ def map_yaml(tmp_path_factory) -> Path:
     return write_ros_map(room_grid(), tmp_path_factory.mktemp("maps") / "room.yaml")
 
 
+#: markers whose tests run only when ``-m`` names them: ``slow`` (``make chaos``, ``make fuzz``)
+#: and ``sweep`` (the longer members of a parametrised check and full rebuilds, ``make test-sweeps``,
+#: which ``make bench`` runs)
+ON_REQUEST = {"slow": "slow: run with -m slow (make chaos)",
+              "sweep": "sweep: run with -m sweep (make test-sweeps, part of make bench)"}
+
+
 def pytest_collection_modifyitems(config, items) -> None:
-    """Tests marked ``slow`` run only when asked for (``-m slow``, e.g. ``make chaos``)."""
-    if "slow" in (config.getoption("-m") or ""):
-        return
-    skip = pytest.mark.skip(reason="slow: run with -m slow (make chaos)")
-    for item in items:
-        if "slow" in item.keywords:
-            item.add_marker(skip)
+    """Tests marked ``slow`` or ``sweep`` run only when ``-m`` asks for them."""
+    asked = config.getoption("-m") or ""
+    for marker, reason in ON_REQUEST.items():
+        if marker in asked:
+            continue
+        skip = pytest.mark.skip(reason=reason)
+        for item in items:
+            if marker in item.keywords:
+                item.add_marker(skip)

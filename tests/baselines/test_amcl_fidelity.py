@@ -123,7 +123,8 @@ def report(name: str, n: int | None, seeds: range, result: dict) -> None:
               "{:.3f} [{:.3f}, {:.3f}], APE RMSE {:.4f} [{:.4f}, {:.4f}] m".format(*r["tracked"], *r["ape_m"]))
 
 
-@pytest.mark.parametrize(("name", "n"), [("seq-quick", None), ("seq-easy-a", 200)])
+@pytest.mark.parametrize(("name", "n"), [("seq-quick", None),
+                                         pytest.param("seq-easy-a", 200, marks=pytest.mark.sweep)])
 def test_port_and_wheel_track_alike(name, n) -> None:
     seeds = range(10)
     result = compare(name, n, seeds)

@@ -31,7 +31,10 @@ KEY = ["dataset", "scan_id", "matcher"]
 
 
 def bench(*args, env=None) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "tfloc.cli", "bench", *map(str, args), "--no-progress"],
+    """``tfloc bench ARGS`` in one worker process unless ARGS say otherwise (what these tests check
+    does not depend on the pool's size; a second worker costs its start-up, seconds of CPU)."""
+    jobs = [] if "--jobs" in map(str, args) else ["--jobs", "1"]
+    return subprocess.run([sys.executable, "-m", "tfloc.cli", "bench", *map(str, args), *jobs, "--no-progress"],
                           cwd=ROOT, env=env or ENV, capture_output=True, text=True, timeout=600)
 
 
