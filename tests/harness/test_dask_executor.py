@@ -43,18 +43,33 @@ def sorted_rows(df: pd.DataFrame) -> pd.DataFrame:
     return df.drop(columns=["runtime_s", "cpu_s"]).sort_values(KEY).reset_index(drop=True)
 
 
-def test_local_cluster_gives_the_local_runners_estimates(tmp_path):
+#: a small bench through the CLI: the local pool's rows are what every cluster must give
+BENCH = ["data/scenarios/detail-1", "--limit-per-group", "1", "--no-progress", "--allow-import",
+         "--matchers", "csm-corr,toy_matchers:ThreadsInfo,toy_matchers:TwoMinima"]
+
+
+def bench(out: Path, *extra: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "tfloc.cli", "bench", *BENCH, "--out", str(out), *extra],
+                          cwd=ROOT, env=ENV, capture_output=True, text=True, timeout=300)
+
+
+@pytest.fixture(scope="module")
+def local_rows(tmp_path_factory) -> pd.DataFrame:
+    """:data:`BENCH` on the local process pool (made once for the tests that compare with it)."""
+    out = tmp_path_factory.mktemp("local") / "run"
+    r = bench(out)
+    assert r.returncode == 0, r.stderr
+    return read_estimates(out)
+
+
+def test_local_cluster_gives_the_local_runners_estimates(tmp_path, local_rows):
     """CLI --scheduler local:2 vs the local process pool: identical rows but for runtime_s, cpu_s."""
-    args = ["data/scenarios/detail-1", "--limit-per-group", "1", "--no-progress",
-            "--allow-import", "--matchers", "csm-corr,toy_matchers:ThreadsInfo,toy_matchers:TwoMinima"]
-    for out, extra in ((tmp_path / "local", []), (tmp_path / "dask", ["--scheduler", "local:2"])):
-        r = subprocess.run([sys.executable, "-m", "tfloc.cli", "bench", *args, "--out", str(out),
-                            *extra], cwd=ROOT, env=ENV, capture_output=True, text=True, timeout=300)
-        assert r.returncode == 0, r.stderr
-    local, dask_ = read_estimates(tmp_path / "local"), read_estimates(tmp_path / "dask")
+    r = bench(tmp_path / "dask", "--scheduler", "local:2")
+    assert r.returncode == 0, r.stderr
+    dask_ = read_estimates(tmp_path / "dask")
     assert len(dask_) == 27 and not dask_.duplicated(KEY).any()
     assert (dask_.status == "ok").all() and set(dask_.outcome) >= {"success"}
-    pd.testing.assert_frame_equal(sorted_rows(dask_), sorted_rows(local))
+    pd.testing.assert_frame_equal(sorted_rows(dask_), sorted_rows(local_rows))
     assert dask_[dask_.matcher == "toy_matchers:ThreadsInfo"]["info"].str.contains('"omp_threads":"').all()
 
 
@@ -146,7 +161,7 @@ def test_workers_without_the_data_are_named(tmp_path, cluster):
         run(cfg, progress=False, executor=elsewhere)
 
 
-def test_a_tls_cluster_gives_the_local_pools_rows(tmp_path):
+def test_a_tls_cluster_gives_the_local_pools_rows(tmp_path, local_rows):
     """A LocalCluster that speaks only TLS (throw-away certificates), reached like a remote one by
     its tls:// address with --tls-* certificate files: the same rows as the local process pool."""
     pytest.importorskip("cryptography")
@@ -156,23 +171,16 @@ def test_a_tls_cluster_gives_the_local_pools_rows(tmp_path):
     pem = {"ca.pem": sec.tls_ca_file, "client.pem": sec.tls_client_cert, "client.key": sec.tls_client_key}
     for name, text in pem.items():
         (tmp_path / name).write_text(text)
-    args = ["data/scenarios/detail-1", "--limit-per-group", "1", "--no-progress", "--allow-import",
-            "--matchers", "csm-corr,toy_matchers:TwoMinima"]
     with dask.config.set({"distributed.worker.daemon": False}), \
             distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                                      protocol="tls://", security=sec, dashboard_address=None) as c:
         assert c.scheduler_address.startswith("tls://127.0.0.1:")
-        tls = ["--scheduler", c.scheduler_address, "--tls-ca-file", str(tmp_path / "ca.pem"),
-               "--tls-cert", str(tmp_path / "client.pem"), "--tls-key", str(tmp_path / "client.key")]
-        for out, extra in ((tmp_path / "local", []), (tmp_path / "tls", tls)):
-            r = subprocess.run([sys.executable, "-m", "tfloc.cli", "bench", *args, "--out", str(out), *extra],
-                               cwd=ROOT, env=ENV, capture_output=True, text=True, timeout=300)
-            assert r.returncode == 0, r.stderr
-        r = subprocess.run([sys.executable, "-m", "tfloc.cli", "bench", *args, "--out", str(tmp_path / "no"),
-                            "--scheduler", c.scheduler_address], cwd=ROOT, env=ENV, capture_output=True,
-                           text=True, timeout=300)
+        r = bench(tmp_path / "tls", "--scheduler", c.scheduler_address, "--tls-ca-file", str(tmp_path / "ca.pem"),
+                  "--tls-cert", str(tmp_path / "client.pem"), "--tls-key", str(tmp_path / "client.key"))
+        assert r.returncode == 0, r.stderr
+        r = bench(tmp_path / "no", "--scheduler", c.scheduler_address)
         assert r.returncode == 2 and "TLS needs a CA file and a client certificate" in r.stderr
         assert not (tmp_path / "no").exists()
-    local, tls_ = read_estimates(tmp_path / "local"), read_estimates(tmp_path / "tls")
-    assert len(tls_) == 18 and (tls_.status == "ok").all()
-    pd.testing.assert_frame_equal(sorted_rows(tls_), sorted_rows(local))
+    tls_ = read_estimates(tmp_path / "tls")
+    assert len(tls_) == 27 and (tls_.status == "ok").all()
+    pd.testing.assert_frame_equal(sorted_rows(tls_), sorted_rows(local_rows))
