@@ -20,7 +20,7 @@ BLOCK = re.compile(r"(<!-- tfloc:begin (?P<name>[\w.-]+) -->\n)(?P<body>.*?)(<!-
 ADVICE = "advice"
 TARGETS = "targets"
 #: rows of a README table (``KEY-short``): the first matchers of its first column
-SHORT_ROWS = 5
+SHORT_ROWS = 4
 
 
 def _cell(c: Cell | None) -> str:
