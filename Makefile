@@ -1,8 +1,6 @@
 # tfloc: the commands of the README are `make quick`, `make bench` and `make test`.
 # Each creates .venv on first use and (re)installs when pyproject.toml or requirements.lock changes:
 # the exact versions of requirements.lock (hash-checked), then tfloc itself without dependencies.
-# --no-compile: Python writes the bytecode of a module when it is first imported, not of all 2 GB
-# of packages at install (nearly half of the install's time on this machine).
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
@@ -15,7 +13,7 @@ UV_VERSION := 0.13.9
 
 $(STAMP): pyproject.toml $(LOCK)
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install -qq --no-compile --require-hashes -r $(LOCK)
+	$(BIN)/python -m pip install -qq --require-hashes -r $(LOCK)
 	$(BIN)/python -m pip install -qq --no-deps --no-build-isolation -e .
 	@$(BIN)/python -c 'import sys; v = sys.version_info[:2]; v < (3, 12) or print("note: matcher karto left out: karto-scanmatcher has wheels for Python 3.8-3.11 only, this is Python %d.%d" % v)'
 	@touch $(STAMP)
