@@ -199,6 +199,18 @@ def test_quick_is_a_stratified_subset_into_its_own_directory():
     assert c.limit_per_group == 5 and c.out == Path("x")
 
 
+def test_make_quicks_runs_land_where_the_quick_site_reads_them():
+    """make quick runs paper-protocol.toml and sequences-quick.toml with --quick; each run lands in
+    a directory the site's --only-quick reads (a quick study keeps its name: not *-quick-quick)."""
+    from tfloc.site.pages import load_pages
+
+    read = {r.dir for page in load_pages(quick=True) for r in page.runs}
+    for study, out in (("paper-protocol", "paper-protocol-quick"), ("sequences-quick", "sequences-quick")):
+        c = config_from_args(build_parser().parse_args(
+            ["bench", str(ROOT / "benchmarks" / f"{study}.toml"), "--quick"]))
+        assert c.out == Path("results") / out and c.name == out and out in read
+
+
 def test_timing_md_names_the_code_it_timed_against_the_runs():
     from tfloc.report.timing import _code_line
 

@@ -87,7 +87,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--tls-key", metavar="PEM", help="TLS: this client's private key (if not in --tls-cert)")
     p.add_argument("--quick", action="store_true",
                    help=f"a quick first run: the first {QUICK_PER_GROUP} scans of each group (unless "
-                   "--limit-per-group says otherwise), into OUT-quick (unless --out is given)")
+                   "--limit-per-group says otherwise), into OUT-quick (unless --out is given, or OUT ends in -quick)")
     p.add_argument("--regenerate", action="store_true",
                    help="if OUT holds a complete run, or a run of another configuration, discard it and "
                         "run again (an interrupted run of the same configuration is still resumed); make "
@@ -122,6 +122,13 @@ def _overridden(args: argparse.Namespace) -> list[str]:
                            ("--name", args.name)) if v]
 
 
+def quick_name(name: str) -> str:
+    """The quick variant of a run's name or directory: ``NAME-quick``; a study that is already a
+    quick one (``sequences-quick``, make quick's tracking look) keeps its name, so that the site's
+    ``--only-quick`` finds it where it finds every quick run."""
+    return name if name.endswith("-quick") else f"{name}-quick"
+
+
 def config_from_args(args: argparse.Namespace, study: Study | None = None) -> RunConfig:
     """The run of one study file (``study``) or of the dataset directories given, with the
     command line's options on top."""
@@ -147,7 +154,7 @@ def config_from_args(args: argparse.Namespace, study: Study | None = None) -> Ru
                         datasets=tuple(Path(d) for d in args.inputs),
                         matchers=parse_matchers(names, {}, "--matchers"), steps=())
     if args.quick:
-        cfg = cfg.with_overrides(name=f"{cfg.name}-quick", out=cfg.out.with_name(f"{cfg.out.name}-quick"),
+        cfg = cfg.with_overrides(name=quick_name(cfg.name), out=cfg.out.with_name(quick_name(cfg.out.name)),
                                  limit_per_group=QUICK_PER_GROUP)
     return cfg.with_overrides(
         name=args.name, out=args.out, jobs=args.jobs, timeout_s=args.timeout,
