@@ -46,9 +46,10 @@ def warm(half: int) -> list[str]:
     truth = Pose(3.1, 2.4, 0.3)
     ranges = room.raycast(truth, laser)
     guess = Pose(truth.x + 0.12, truth.y - 0.09, truth.theta + float(np.radians(3.0)))
+    maps = (room, rasterize(room, 0.05))
     failed = []
     for name in _names()[half]:
-        for map_ in (room, rasterize(room, 0.05)):
+        for map_ in maps:
             try:
                 m = tfloc.get_matcher(name)
                 if hasattr(m, "localize"):
