@@ -29,9 +29,10 @@ lock:
 
 install: $(STAMP)
 
-## A quick first run (about 4 minutes on 2 cores from a fresh clone, 2.5 after the install): every single-scan matcher on the first 3 scans of every group
-## of the paper protocol with its quick timing pass and report, every tracker along one short
-## sequence, and their site → results/site-quick/index.html
+## A quick first run (about 4 minutes on 2 cores from a fresh clone, 2.5 after the install):
+## every single-scan matcher on the first 3 scans of every group of the paper protocol with its
+## quick timing pass and report, every tracker along one short sequence, and their site →
+## results/site-quick/index.html
 quick: $(STAMP)
 	$(BIN)/tfloc bench benchmarks/paper-protocol.toml benchmarks/sequences-quick.toml --quick --regenerate
 	$(BIN)/tfloc site --only-quick

@@ -1,9 +1,9 @@
 """The leaderboards and statements as Markdown, for the README's and docs' generated blocks:
 the text between ``<!-- tfloc:begin NAME -->`` and ``<!-- tfloc:end NAME -->`` is replaced by
 block NAME (a page key: its full board; ``KEY-short``: the README's short table; ``cost``,
-``cost-slopes``; ``advice``: the statements; ``targets``: the tracking targets, checked). The cells are the site's: the figure with its
-95 % interval (bold where the paired test puts the column's first ahead of the next) and the
-CPU per scan."""
+``cost-slopes``; ``advice``: the statements; ``targets``: the tracking targets, checked). The
+cells are the site's: the figure with its 95 % interval (bold where the paired test puts the
+column's first ahead of the next) and the CPU per scan."""
 
 from __future__ import annotations
 
