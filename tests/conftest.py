@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import multiprocessing
 import shutil
 from pathlib import Path
 
@@ -10,6 +11,36 @@ import pytest
 import tfloc
 
 ROOT = Path(__file__).resolve().parents[1]
+
+
+class _ForkserverWorkers:
+    """``multiprocessing`` as the local runner sees it in this test process, but for the start
+    method: its pool's workers come from a forkserver that has imported tfloc's task code (and
+    the toy matchers) once, instead of each spawned worker importing numpy, scipy, pandas and
+    numba anew (2-3 s of CPU each, paid by every in-process ``run``). A forkserver's worker is a
+    fresh process like a spawned one: no state of this process, tasks pickled, the pool's
+    initializer run. The commands the tests start (``tfloc bench`` in a subprocess) spawn their
+    workers exactly as a user's run does."""
+
+    def __init__(self) -> None:
+        self._ctx = multiprocessing.get_context("forkserver")
+        self._ctx.set_forkserver_preload(["tfloc.harness.task", "toy_matchers"])
+
+    def get_context(self, method: str | None = None):
+        return self._ctx
+
+    def __getattr__(self, name: str):
+        return getattr(multiprocessing, name)
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _workers_from_a_forkserver():
+    from tfloc.harness import runner
+
+    mp = pytest.MonkeyPatch()
+    mp.setattr(runner, "multiprocessing", _ForkserverWorkers())
+    yield
+    mp.undo()
 
 
 @pytest.fixture(scope="session")

@@ -3,11 +3,8 @@
 from __future__ import annotations
 
 import json
-import os
-import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import pandas as pd
@@ -70,37 +67,6 @@ def test_success_outcome(tmp_path, test_room, lms200):
     df = read_estimates(run(cfg(ds, tmp_path / "run", MatcherSpec.make("toy_matchers:Stay", label="stay"),
                                 jobs=1), progress=False))
     assert (df.outcome == "success").all() and df.dist_err_m.round(6).eq(0.05).all()
-
-
-def test_resume_after_sigkill_has_every_task_exactly_once(tmp_path, test_room, lms200):
-    ds = make_dataset(tmp_path / "ds", test_room, lms200, n=12)
-    out = tmp_path / "run"
-    cmd = [sys.executable, "-m", "tfloc.cli", "bench", str(ds), "--out", str(out), "--jobs", "2",
-           "--allow-import", "--matchers", "toy_matchers:SlowStay,toy_matchers:TwoMinima", "--no-progress", "--timeout", "30"]
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(TESTS), str(ROOT)])}
-    proc = subprocess.Popen(cmd, env=env, start_new_session=True, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE)
-    est = out / "estimates.csv"
-    deadline = time.time() + 120
-    while time.time() < deadline:
-        if est.exists() and est.read_text().count("\n") >= 4:
-            break
-        time.sleep(0.05)
-    os.killpg(proc.pid, signal.SIGKILL)
-    proc.wait()
-    n_before = est.read_text().count("\n") - 1
-    # a torn last line, as a kill in the middle of a write leaves it
-    with est.open("a") as fh:
-        fh.write("ds,s99,g0,toy_matchers:SlowStay,3.0,3.5")
-    r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
-    assert r.returncode == 0, r.stderr
-    df = read_estimates(out)
-    keys = df[["dataset", "scan_id", "matcher"]]
-    assert len(df) == 24 and not keys.duplicated().any()
-    assert set(df.scan_id) == {f"s{i}" for i in range(12)}
-    assert n_before < 24
-    run_json = json.loads((out / "run.json").read_text())
-    assert len(run_json["sessions"]) == 2 and run_json["sessions"][1]["already_done"] >= n_before
 
 
 def test_malformed_row_is_rejected_with_file_and_line(tmp_path, test_room, lms200):
