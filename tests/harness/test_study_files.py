@@ -1,5 +1,5 @@
 """Study files: every benchmarks/*.toml loads, none restates a default, the file it extends or a
-preset's parameters; ``extends`` merges tables key by key and never inherits the name; a study's
+preset's parameters, every matcher label is a name a verb accepts for the configuration it labels; ``extends`` merges tables key by key and never inherits the name; a study's
 steps run after its run (``index`` before it) and make its tables."""
 
 from __future__ import annotations
@@ -28,6 +28,22 @@ def test_every_study_file_loads(path: Path) -> None:
     study = load_study(path)
     assert study.name and study.steps is not None
     assert (study.run is not None) == (study.kind == "bench")
+
+
+@pytest.mark.parametrize("path", FILES, ids=lambda p: p.relative_to(ROOT / "benchmarks").as_posix())
+def test_every_label_is_a_name_for_the_configuration_it_labels(path: Path) -> None:
+    study = load_study(path)
+    if study.run is None:
+        return
+    wrong = []
+    for m in study.run.matchers:
+        try:
+            named = resolve(m.label, {})
+        except Exception as exc:  # noqa: BLE001 - every failure is listed
+            named = (str(exc), {})
+        if named != resolve(m.name, m.params):
+            wrong.append(f"{m.label!r} reads as {named}, runs {resolve(m.name, m.params)}")
+    assert not wrong, f"{path.name}: labels no verb reads as their configuration:\n" + "\n".join(wrong)
 
 
 def _inherited(path: Path) -> dict:

@@ -15,7 +15,7 @@ from tfloc.errors import ConfigError
 from tfloc.evaluation.headline import HeadlineRow
 from tfloc.site.advice import statements
 from tfloc.site.board import headline_board
-from tfloc.site.collect import SiteData
+from tfloc.site.collect import SiteData, run_note
 from tfloc.site.families import family
 from tfloc.site.markdown import refresh
 from tfloc.site.pages import Page, RunRef, load_pages
@@ -53,6 +53,14 @@ def test_provisional_rows_from_tracking_csv(tmp_path: Path) -> None:
     pooled = a[("all", "tf-plus-track")]
     assert pooled.value_pct == pytest.approx(100 * 89 / 90) and math.isnan(pooled.cpu_ms)
     assert not run_rows(tmp_path, "missing").exists
+
+
+def test_a_scaling_run_is_noted_by_the_file_its_board_reads(tmp_path: Path) -> None:
+    (tmp_path / "scaling").mkdir()
+    rr = run_rows(tmp_path, "scaling")
+    assert run_note(rr, "scaling").startswith("`results/scaling/`: no headline yet")
+    assert run_note(rr, "scaling", "slopes.csv") == "`results/scaling/`: `slopes.csv`"
+    assert run_note(run_rows(tmp_path, "missing"), "missing", "slopes.csv").endswith("not yet run")
 
 
 def test_the_best_is_marked_only_where_the_paired_test_separates_it() -> None:

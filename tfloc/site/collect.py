@@ -12,7 +12,7 @@ import pandas as pd
 
 from .advice import Statement, statements
 from .board import Board, headline_board, unique_dirs
-from .cost import cpu_board, slopes_board
+from .cost import SLOPES_CSV, cpu_board, slopes_board
 from .pages import COST, Page, load_pages
 from .rows import SOURCES, RunRows, run_rows
 from .targets import NATIVE_RUNS, SIMULATED_RUN, targets_markdown
@@ -49,7 +49,7 @@ def collect(root: Path, quick: bool = False, pages: list[Page] | None = None) ->
     for p in pages:
         if p.key == COST:
             data.boards[COST] = cpu_board(pages, runs, timing)
-            slopes = {r.dir: s for r in p.runs if (s := _csv(root / r.dir / "slopes.csv")) is not None}
+            slopes = {r.dir: s for r in p.runs if (s := _csv(root / r.dir / SLOPES_CSV)) is not None}
             data.boards[f"{COST}-slopes"] = slopes_board(slopes)
             continue
         data.boards[p.key] = headline_board(p, runs)
@@ -76,10 +76,13 @@ def _targets(root: Path, runs: dict[str, RunRows]) -> str:
     return targets_markdown(native, (SIMULATED_RUN, sim.rows) if sim is not None else None)
 
 
-def run_note(rr: RunRows | None, name: str) -> str:
-    """Where a run's figures come from, or why it has none (Markdown inline)."""
+def run_note(rr: RunRows | None, name: str, table: str | None = None) -> str:
+    """Where a run's figures come from, or why it has none (Markdown inline); ``table``: the file
+    a board reads instead of the headline (the scaling study's ``slopes.csv``)."""
     if rr is None or not rr.exists:
         return f"`results/{name}/`: not yet run"
+    if table is not None:
+        return f"`results/{name}/`: `{table}`"
     if not rr.source:
         return f"`results/{name}/`: no headline yet (run `tfloc report results/{name}`)"
     if rr.provisional:

@@ -16,6 +16,9 @@ from .board import Board, Cell, Column, order
 from .pages import COST, Page
 from .rows import RunRows
 
+SLOPES = "slopes"  #: the slopes board's key
+SLOPES_CSV = "slopes.csv"  #: the scaling study's file that board reads
+
 QUIET = "re-timing"
 #: a run without a pooled CPU figure (provisional rows) shows each dataset's if it has at most this many
 MAX_SPLIT = 3
@@ -83,5 +86,5 @@ def slopes_board(slopes: dict[str, pd.DataFrame]) -> Board:
                          f"levels; {'grows' if str(r['grows']) == 'True' else 'does not grow'} by the study's rule")
                 cells[(str(r["matcher"]), col.key)] = Cell(v, f"{v:.2f}", sub, title, False, run)
                 first.setdefault(str(r["matcher"]), (len(columns) - 1, 0))
-    return Board("slopes", "How CPU per scan grows (log–log slope)", columns, order(first), cells,
+    return Board(SLOPES, "How CPU per scan grows (log–log slope)", columns, order(first), cells,
                  higher=False, unit="")

@@ -15,6 +15,7 @@ from markdown_it import MarkdownIt
 from .advice import Statement
 from .board import Board, Cell
 from .collect import SiteData, run_note
+from .cost import SLOPES_CSV
 from .families import BASELINE, OWN, Family
 from .pages import COST
 
@@ -102,8 +103,9 @@ def statements_html(items: list[Statement]) -> str:
             f'<ul class="advice">{lis}</ul></section>')
 
 
-def _notes(data: SiteData, dirs: list[str]) -> str:
-    items = "".join(f"<li>{inline(run_note(data.runs.get(d), d))}"
+def _notes(data: SiteData, dirs: list[str], slopes: frozenset[str] = frozenset()) -> str:
+    """The runs a section reads and their state; ``slopes``: those read for their ``slopes.csv``."""
+    items = "".join(f"<li>{inline(run_note(data.runs.get(d), d, SLOPES_CSV if d in slopes else None))}"
                     + (f' — <a href="runs/{d}/index.html">report</a>'
                        if data.runs.get(d) and data.runs[d].exists else "") + "</li>" for d in dirs)
     return f'<ul class="note">{items}</ul>'
@@ -135,7 +137,8 @@ def index_html(data: SiteData, families: dict[str, Family], results_label: str) 
             sec.append(f'<div class="targets"><h3>The tracking targets</h3>{markdown().render(data.targets)}</div>')
         dirs = [r.dir for r in p.runs] if p.key != COST else list(dict.fromkeys(
             c.run for k in (COST, f"{COST}-slopes") for c in data.boards[k].columns))
-        sec.append(_notes(data, dirs) + "</section>")
+        slopes = frozenset(c.run for c in data.boards[f"{COST}-slopes"].columns) if p.key == COST else frozenset()
+        sec.append(_notes(data, dirs, slopes) + "</section>")
         parts.append("".join(sec))
     parts.append(f'<footer class="muted">Written by <code>tfloc site</code> from {html.escape(results_label)}; '
                  f"the page → run mapping is <code>tfloc/site/pages.toml</code>.</footer>")

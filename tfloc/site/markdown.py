@@ -14,6 +14,7 @@ from tfloc.report.mdtable import table
 
 from .board import Board, Cell
 from .collect import SiteData, run_note
+from .cost import SLOPES, SLOPES_CSV
 from .pages import COST
 
 BLOCK = re.compile(r"(<!-- tfloc:begin (?P<name>[\w.-]+) -->\n)(?P<body>.*?)(<!-- tfloc:end (?P=name) -->)", re.S)
@@ -32,7 +33,8 @@ def _cell(c: Cell | None) -> str:
 
 def board_markdown(board: Board, data: SiteData, short: bool = False) -> str:
     """One board as a Markdown table, with the runs it reads (and their state) below it."""
-    notes = [run_note(data.runs.get(r), r) for r in dict.fromkeys(c.run for c in board.columns)]
+    reads = SLOPES_CSV if board.key == SLOPES else None
+    notes = [run_note(data.runs.get(r), r, reads) for r in dict.fromkeys(c.run for c in board.columns)]
     page = next((p for p in data.pages if p.key == board.key.removesuffix("-short")), None)
     if page is not None and page.key != COST:
         have = {c.run for c in board.columns}
