@@ -1,7 +1,7 @@
 """Every committed run directory was made by a verb of the package from a clean tree: its
 run.json records the code that answered (tfloc's answering source) and no uncommitted change to
 it; every report opens with its headline table beside its headline.csv; the names its tables
-use are matchers or presets a user can pass to any verb."""
+use are matchers or presets a user can pass to any verb, each for the configuration it labels."""
 
 from __future__ import annotations
 
@@ -13,6 +13,7 @@ import pytest
 from _paths import RESULTS
 
 from tfloc.core.matcher import factory_of
+from tfloc.core.presets import resolve
 
 RUNS = sorted(p.parent for p in RESULTS.rglob("run.json") if "site" not in p.parts)
 
@@ -50,3 +51,18 @@ def test_every_name_a_headline_uses_is_a_matcher_or_preset() -> None:
         except Exception as exc:  # noqa: BLE001 - every failure is listed
             bad.append(f"{name}: {exc}")
     assert not bad, "names no verb accepts:\n" + "\n".join(bad)
+
+
+def test_every_label_a_committed_run_used_names_its_configuration() -> None:
+    wrong = []
+    for run in RUNS:
+        for m in json.loads((run / "run.json").read_text())["config"].get("matchers", []):
+            if not isinstance(m, dict):
+                continue
+            try:
+                named = resolve(m["label"], {})
+            except Exception as exc:  # noqa: BLE001 - every failure is listed
+                named = (str(exc), {})
+            if named != resolve(m["name"], m.get("params") or {}):
+                wrong.append(f"{run.relative_to(RESULTS)}: {m['label']!r} reads as {named}")
+    assert not wrong, "labels a user cannot pass for what they ran:\n" + "\n".join(wrong)
