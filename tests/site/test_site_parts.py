@@ -33,6 +33,9 @@ def test_every_page_names_its_runs_once() -> None:
     keys = [p.key for p in pages]
     assert keys[:5] == ["single-scan", "tracking", "global", "kidnap", "robustness"] and "cost" in keys
     assert all(r.dir.endswith("-quick") for p in load_pages(quick=True) for r in p.runs)
+    for p in load_pages(quick=True):  # a run already quick (make bench's scaling-quick) is not renamed
+        dirs = [r.dir for r in p.runs]
+        assert len(set(dirs)) == len(dirs) and not any(d.endswith("-quick-quick") for d in dirs), dirs
 
 
 def test_a_bad_pages_file_is_one_line(tmp_path: Path) -> None:

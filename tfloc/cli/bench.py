@@ -49,6 +49,7 @@ from tfloc.harness.config import (
     parse_matchers,
 )
 from tfloc.io.scenario import read_scenario
+from tfloc.site.pages import quick_name
 
 from ._options import add_progress
 
@@ -120,13 +121,6 @@ def _overridden(args: argparse.Namespace) -> list[str]:
     """The options that change one run's configuration (they apply to one study file only)."""
     return [o for o, v in (("--matchers", args.matchers), ("--datasets", args.datasets), ("--out", args.out),
                            ("--name", args.name)) if v]
-
-
-def quick_name(name: str) -> str:
-    """The quick variant of a run's name or directory: ``NAME-quick``; a study that is already a
-    quick one (``sequences-quick``, make quick's tracking look) keeps its name, so that the site's
-    ``--only-quick`` finds it where it finds every quick run."""
-    return name if name.endswith("-quick") else f"{name}-quick"
 
 
 def config_from_args(args: argparse.Namespace, study: Study | None = None) -> RunConfig:

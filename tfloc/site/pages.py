@@ -16,6 +16,14 @@ COST = "cost"
 QUICK_SUFFIX = "-quick"
 
 
+def quick_name(name: str) -> str:
+    """The quick variant of a run's name or directory: ``NAME-quick``; a study that is already a
+    quick one (``sequences-quick``, ``scaling-quick``) keeps its name, so that ``tfloc bench
+    --quick`` writes it where ``tfloc site --only-quick`` reads every quick run. The one copy of
+    the rule: the bench verb and the site both call it."""
+    return name if name.endswith(QUICK_SUFFIX) else f"{name}{QUICK_SUFFIX}"
+
+
 @dataclass(frozen=True)
 class RunRef:
     """One run directory of a page: ``dir`` under the results root, the headline ``modes`` it
@@ -58,8 +66,13 @@ def load_pages(path: Path = PAGES_FILE, quick: bool = False) -> list[Page]:
         if missing:
             raise ConfigError(f"{path}: a [[page]] without {', '.join(missing)}")
         runs = [_run(r, str(path)) for r in body.get("run", [])]
-        if quick:
-            runs = [RunRef(r.dir + QUICK_SUFFIX, r.label, r.modes, r.short) for r in runs]
+        if quick:  # each quick run once: the cost page reads scaling and scaling-quick, both scaling-quick
+            named: dict[str, RunRef] = {}
+            for r in runs:
+                d = quick_name(r.dir)
+                if d not in named or r.dir == d:  # the entry naming the quick run itself keeps its label
+                    named[d] = RunRef(d, r.label, r.modes, r.short)
+            runs = list(named.values())
         out.append(Page(str(body["key"]), str(body["title"]), str(body.get("about", "")),
                         str(body.get("doc", "")), tuple(runs)))
     keys = [p.key for p in out]
