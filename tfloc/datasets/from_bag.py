@@ -1,22 +1,23 @@
 """A scenario dataset from a ROS bag: scans, reference poses at the scan stamps, a map, and
 initial poses (perturbed in the paper's bins from a seed, or from a second pose topic); or, given
-an odometry topic, a *sequence* (tracking): the scans in time order with the robot's odometry
-pose at each, the start = the reference at the first scan."""
+an odometry topic, a *sequence* (tracking, :mod:`tfloc.datasets.bag_sequence`): the scans in time
+order with the robot's odometry pose at each, with reference poses or without (a robot owner's
+recording: the start from ``--initial-pose``, ``--initial-topic`` or a global matcher)."""
 
 from __future__ import annotations
 
-import shutil
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-import yaml
 
 from tfloc.core.pose import Pose
 from tfloc.errors import BagError, ConfigError, DatasetError
 from tfloc.io.scenario import Scan, write_scenario
 
+from .bag_files import ImportSummary, save_map, source_record, span
 from .interpolate import interpolate_poses
 
 if TYPE_CHECKING:
@@ -29,7 +30,8 @@ class BagImport:
 
     Attributes:
         bag: a ROS 1 ``.bag`` file, or a ROS 2 bag directory / ``.db3`` / ``.mcap`` file.
-        pose_topic: the reference poses (PoseStamped, PoseWithCovarianceStamped, Odometry or tf).
+        pose_topic: the reference poses (PoseStamped, PoseWithCovarianceStamped, Odometry or tf);
+            None: no truth, a sequence (``odom_topic`` needed) whose ``true_*`` are empty.
         map_file: a map_server YAML (or GeoJSON) copied into the dataset, or
         map_topic: a ``nav_msgs/OccupancyGrid`` topic saved as ``map.yaml`` + ``map.pgm``.
         initial_topic: take initial poses from this pose topic instead of perturbing;
@@ -39,13 +41,17 @@ class BagImport:
         seed, clearance_m: the perturbation (paper's 3 × 3 offset bins) when no initial topic.
         odom_topic: write a sequence dataset: the robot's odometry (nav_msgs/Odometry, a pose
             topic, or tf with ``odom_frames``, e.g. ``odom base_link``) interpolated to the scan
-            stamps; excludes ``initial_topic`` and the perturbation. ``odom_frames``: its frame
-            pair if it is a tf topic.
+            stamps; excludes the perturbation, and with reference poses ``initial_topic`` (the
+            start is the reference). ``odom_frames``: its frame pair if it is a tf topic.
+        initial_pose: without reference poses, the robot's pose at the first scan (map frame);
+            else ``initial_topic`` at the first scan it covers; else ``initial_matcher`` (a
+            registered global matcher) run on the first ``initial_scans`` scans
+            (:mod:`tfloc.datasets.first_pose`).
     """
 
     bag: Path
     scan_topic: str  #: a sensor_msgs/LaserScan topic
-    pose_topic: str
+    pose_topic: str | None
     out: Path  #: the dataset directory to write
     map_file: Path | None = None
     map_topic: str | None = None
@@ -62,6 +68,9 @@ class BagImport:
     laser_offset: Pose = field(default_factory=Pose)  #: laser pose, reference frame (m, rad)
     odom_topic: str | None = None
     odom_frames: tuple[str, str] | None = None
+    initial_pose: Pose | None = None
+    initial_matcher: str = "tf-global"
+    initial_scans: int = 3
 
     def __post_init__(self) -> None:
         """Argument errors (one type, :class:`ConfigError`, whoever builds the import)."""
@@ -75,25 +84,26 @@ class BagImport:
             raise ConfigError("--align-initial needs --initial-topic")
         if self.odom_frames and not self.odom_topic:
             raise ConfigError("--odom-frames needs --odom-topic")
-        if self.odom_topic and (self.initial_topic or self.seed is not None):
+        if not self.pose_topic and not self.odom_topic:
+            raise ConfigError("a single-scan dataset needs reference poses (--pose-topic); without them give "
+                              "--odom-topic for a sequence, which starts at --initial-pose X Y YAW, "
+                              "--initial-topic or where --initial-matcher finds it")
+        if self.odom_topic and self.pose_topic and (self.initial_topic or self.seed is not None
+                                                    or self.initial_pose is not None):
             raise ConfigError("--odom-topic writes a sequence (the start is the reference at the first scan): "
-                              "it takes no --initial-topic or --seed")
+                              "with --pose-topic it takes no --initial-topic, --initial-pose or --seed")
+        if not self.pose_topic and (self.align_initial or self.seed is not None):
+            raise ConfigError("--align-initial and --seed need reference poses (--pose-topic)")
+        if self.initial_pose is not None and (self.pose_topic or self.initial_topic):
+            raise ConfigError("--initial-pose is the start of a sequence without reference poses: it takes "
+                              "no --pose-topic or --initial-topic")
+        if self.initial_pose is not None and not self.initial_pose.is_finite():
+            raise ConfigError(f"--initial-pose must be finite, got {self.initial_pose}")
+        if self.initial_scans < 1:
+            raise ConfigError(f"--initial-scans must be ≥ 1, got {self.initial_scans}")
         if not (self.clearance_m >= 0 and self.max_pose_gap_s > 0 and self.laser_offset.is_finite()):
             raise ConfigError(f"--clearance must be ≥ 0 m, --max-pose-gap > 0 s and --laser-offset finite, got "
                               f"{self.clearance_m}, {self.max_pose_gap_s} and {self.laser_offset}")
-
-
-@dataclass(frozen=True)
-class ImportSummary:
-    """What an import kept and skipped (counts of scan messages)."""
-
-    path: Path
-    messages: int
-    kept: int
-    outside_poses: int
-    outside_initial: int
-    no_return: int
-    outside_odom: int = 0
 
 
 def import_bag(cfg: BagImport) -> ImportSummary:
@@ -107,29 +117,29 @@ def import_bag(cfg: BagImport) -> ImportSummary:
         raise DatasetError(f"{out}: a dataset exists there already; choose another --out or remove it")
     with Bag(cfg.bag) as bag:
         scans = bag.scans(cfg.scan_topic)
-        ref = bag.poses(cfg.pose_topic, cfg.pose_frames)
+        ref = bag.poses(cfg.pose_topic, cfg.pose_frames) if cfg.pose_topic else None
         init = bag.poses(cfg.initial_topic, cfg.initial_frames) if cfg.initial_topic else None
         odom = bag.poses(cfg.odom_topic, cfg.odom_frames) if cfg.odom_topic else None
         grid = bag.grid(cfg.map_topic) if cfg.map_topic else None
 
     pick = np.flatnonzero(scans.index % cfg.every == 0)
     t = scans.stamps[pick]
-    truth, covered = interpolate_poses(ref.stamps, ref.poses, t, cfg.max_pose_gap_s)
+    if ref is None:
+        truth, covered = np.full((t.size, 3), math.nan), np.ones(t.size, dtype=bool)
+    else:
+        truth, covered = interpolate_poses(ref.stamps, ref.poses, t, cfg.max_pose_gap_s)
     if not covered.any():
         raise BagError(f"{cfg.bag}: {cfg.pose_topic} covers none of the {t.size} scans on {cfg.scan_topic} "
                        f"(scan message {scans.index[pick[0]]} at t={t[0]:.3f} s; poses span "
-                       f"{_span(ref.stamps)}, max gap {cfg.max_pose_gap_s:g} s)")
+                       f"{span(ref.stamps)}, max gap {cfg.max_pose_gap_s:g} s)")
+    if odom is not None:
+        from .bag_sequence import import_sequence
+
+        return import_sequence(cfg, scans, pick, t, truth, covered, init, odom, grid, ref)
     keep = covered.copy()
     outside_init = 0
     if init is not None:
         start, outside_init, keep = _also_covered(cfg, init, cfg.initial_topic, t, keep)
-    outside_odom = 0
-    if odom is not None:
-        odom_p, outside_odom, keep = _also_covered(cfg, odom, cfg.odom_topic, t, keep)
-        # a sequence's stamps increase strictly: a scan not later than every earlier one is dropped
-        late = t > np.maximum.accumulate(np.concatenate([[-np.inf], t[:-1]]))
-        outside_odom += int(np.count_nonzero(keep & ~late))
-        keep &= late
     no_return = scans.laser.valid(scans.ranges[pick]).sum(axis=1) == 0
     n_empty = int(np.count_nonzero(keep & no_return))
     keep &= ~no_return
@@ -147,9 +157,6 @@ def import_bag(cfg: BagImport) -> ImportSummary:
     if not the_map.in_bounds(true_p[:, :2]).any():
         raise BagError(f"{cfg.bag}: none of the {cfg.pose_topic} poses at the scans lies inside the map "
                        f"(bounds {tuple(round(b, 2) for b in the_map.bounds)} m); are they in the map frame?")
-    if odom is not None:
-        return _write_sequence(cfg, scans, pick, rows, t, true_p, odom_p, grid, ref, out,
-                               int(np.count_nonzero(~covered)), outside_odom, n_empty)
     if init is not None:
         ip = start[rows]
         if cfg.align_initial:  # express the initial stream in the reference frame at the first scan
@@ -172,17 +179,9 @@ def import_bag(cfg: BagImport) -> ImportSummary:
                 for k, g, ip_, tp in zip(rows, groups, init_p, true_p, strict=True)]
     las = scans.laser
     out.mkdir(parents=True, exist_ok=True)
-    map_path = _save_map(cfg, grid, out)
-    source = {"bag": str(cfg.bag), "scan_topic": cfg.scan_topic, "pose_topic": cfg.pose_topic,
-              "pose_frames": list(cfg.pose_frames) if cfg.pose_frames else None,
-              "map_topic": cfg.map_topic, "laser_frame": scans.frame_id, "pose_frame": ref.frame_id,
-              "laser_offset": [off.x, off.y, off.theta],
-              "angle_min": las.angle_min, "angle_increment": las.resolution, "range_min": scans.range_min,
-              "range_max": las.max_range, "n_beams": las.n_beams, "every": cfg.every,
-              "max_pose_gap_s": cfg.max_pose_gap_s, **how,
-              "scan_messages": int(scans.index.size), "imported": int(rows.size),
-              "skipped": {"outside_poses": int(np.count_nonzero(~covered)),
-                          "outside_initial": outside_init, "no_return": n_empty}}
+    map_path = save_map(cfg, grid, out)
+    source = source_record(cfg, scans, ref, rows, {"how": how, "skipped": {
+        "outside_poses": int(np.count_nonzero(~covered)), "outside_initial": outside_init, "no_return": n_empty}})
     name = cfg.name or out.name
     write_scenario(out, name, map_path, las, rows_out,
                    description=(f"Imported from ROS bag {Path(cfg.bag).name}: {cfg.scan_topic} scans, "
@@ -202,60 +201,5 @@ def _also_covered(cfg: BagImport, stream: PoseStream, topic: str, t: np.ndarray,
     keep = keep & cov
     if not keep.any():
         raise BagError(f"{cfg.bag}: {topic} covers none of the scans on {cfg.scan_topic} "
-                       f"that {cfg.pose_topic} covers (poses span {_span(stream.stamps)})")
+                       f"that {cfg.pose_topic} covers (poses span {span(stream.stamps)})")
     return poses, outside, keep
-
-
-def _write_sequence(cfg: BagImport, scans, pick, rows, t, true_p, odom_p, grid, ref, out: Path,
-                    outside_poses: int, outside_odom: int, n_empty: int) -> ImportSummary:
-    """Write the sequence dataset: scans in time order, odometry of the laser (the robot's
-    odometry composed with the laser offset), the start = the reference at the first scan."""
-    from tfloc.io.scenario import SEQUENCE
-
-    off = cfg.laser_offset
-    odom_l = [Pose.from_array(odom_p[k]).compose(off) for k in rows]
-    rows_out = [Scan(f"s{scans.index[pick[k]]:05d}", "sequence", scans.ranges[pick[k]],
-                     Pose.from_array(tp) if i == 0 else None, Pose.from_array(tp), stamp=float(t[k]), odom=o)
-                for i, (k, tp, o) in enumerate(zip(rows, true_p, odom_l, strict=True))]
-    las = scans.laser
-    out.mkdir(parents=True, exist_ok=True)
-    map_path = _save_map(cfg, grid, out)
-    source = {"bag": str(cfg.bag), "scan_topic": cfg.scan_topic, "pose_topic": cfg.pose_topic,
-              "pose_frames": list(cfg.pose_frames) if cfg.pose_frames else None,
-              "odom_topic": cfg.odom_topic, "odom_frames": list(cfg.odom_frames) if cfg.odom_frames else None,
-              "map_topic": cfg.map_topic, "laser_frame": scans.frame_id, "pose_frame": ref.frame_id,
-              "laser_offset": [off.x, off.y, off.theta],
-              "angle_min": las.angle_min, "angle_increment": las.resolution, "range_min": scans.range_min,
-              "range_max": las.max_range, "n_beams": las.n_beams, "every": cfg.every,
-              "max_pose_gap_s": cfg.max_pose_gap_s,
-              "scan_messages": int(scans.index.size), "imported": int(rows.size),
-              "skipped": {"outside_poses": outside_poses, "outside_odom": outside_odom, "no_return": n_empty}}
-    write_scenario(out, cfg.name or out.name, map_path, las, rows_out,
-                   description=(f"Imported from ROS bag {Path(cfg.bag).name} as a sequence: {cfg.scan_topic} "
-                                f"scans in time order, odometry from {cfg.odom_topic} and reference poses "
-                                f"from {cfg.pose_topic}, both interpolated to the scan stamps; the robot "
-                                "starts at the reference pose of the first scan."),
-                   mode=SEQUENCE, condition={"name": "bag"}, source=source)
-    return ImportSummary(out, int(scans.index.size), int(rows.size), outside_poses, 0, n_empty, outside_odom)
-
-
-def _span(stamps: np.ndarray) -> str:
-    return f"t={stamps[0]:.3f}…{stamps[-1]:.3f} s ({stamps.size} poses)"
-
-
-def _save_map(cfg: BagImport, grid, out: Path) -> Path:
-    """Put the map into the dataset directory; return its path."""
-    if grid is not None:
-        from tfloc.io.rosmap import write_ros_map
-
-        return write_ros_map(grid, out / "map.yaml")
-    src = Path(cfg.map_file)
-    if src.suffix.lower() not in (".yaml", ".yml"):
-        return Path(shutil.copyfile(src, out / src.name))
-    doc = yaml.safe_load(src.read_text())
-    img = src.parent / doc["image"]
-    shutil.copyfile(img, out / img.name)
-    doc["image"] = img.name
-    dst = out / src.name
-    dst.write_text(f"# copied from {src} by tfloc import-bag\n" + yaml.safe_dump(doc, sort_keys=False))
-    return dst

@@ -33,7 +33,15 @@ from tfloc.core.tracker import has_single_scan_mode
 from tfloc.errors import ConfigError, ResultsError
 from tfloc.io.estimates import ResultWriter, done_keys, drop_rows
 from tfloc.io.rundir import RunDir
-from tfloc.io.scenario import SEQUENCE, Scenario, iter_scans, read_scans, read_scenario
+from tfloc.io.scenario import (
+    SEQUENCE,
+    Scenario,
+    check_usable,
+    iter_scans,
+    map_for,
+    read_scans,
+    read_scenario,
+)
 
 from .config import RunConfig
 from .fingerprint import differences
@@ -60,6 +68,7 @@ def make_tasks(config: RunConfig, log: Callable[[str], None] | None = None,
         scenario = (scenarios or {}).get(Path(d)) or read_scenario(d)
         if scenario.mode == SEQUENCE:
             scans = read_scans(scenario)
+            check_usable(scenario, scans, map_for(scenario, scans[0]))
             tasks += [Task(str(d), scenario.name, scans[-1].scan_id, m.label, m.name, m.params_json,
                            config.success, sequence=True, timeout_s=config.sequence_timeout_s)
                       for m in config.matchers]

@@ -30,18 +30,20 @@ from tfloc.core.tracker import DeadReckoning, as_tracker
 from tfloc.errors import DatasetError
 from tfloc.evaluation.outcome import outcome
 from tfloc.io.estimates import result_row
-from tfloc.io.scenario import SEQUENCE, Scan, Scenario, map_for
+from tfloc.io.scenario import SEQUENCE, Scan, Scenario, check_usable, map_for
 
 from .workspace import status_of, timed_step, warm_tracker
 
 
-def check_sequence(scenario: Scenario, scans: Sequence[Scan]) -> None:
-    """Raise :class:`DatasetError` unless ``scans`` are a sequence the loop can run."""
+def check_sequence(scenario: Scenario, scans: Sequence[Scan], the_map=None) -> None:
+    """Raise :class:`DatasetError` unless ``scans`` are a sequence the loop can run (and, given
+    ``the_map``, one that starts inside it: :func:`tfloc.io.scenario.check_usable`)."""
     if scenario.mode != SEQUENCE:
         raise DatasetError(f"{scenario.root}: not a sequence dataset (mode {scenario.mode!r}); "
                            "tracking needs \"mode\": \"sequence\" in scenario.json")
     if not scans or scans[0].initial is None:
         raise DatasetError(f"{scenario.scans_path}: a sequence needs a first row with init_x/y/theta")
+    check_usable(scenario, scans, the_map)
 
 
 def odom_deltas(scans: Sequence[Scan]) -> list[Pose]:
@@ -65,6 +67,7 @@ def track(scenario: Scenario, scans: Sequence[Scan], matcher, *, label: str | No
     label = label or getattr(tracker, "name", type(matcher).__name__)
     dataset = dataset or scenario.name
     the_map = map if map is not None else map_for(scenario, scans[0], {})
+    check_sequence(scenario, scans, the_map)
     begin(tracker, scenario, scans, the_map)
     rows = []
     for k, (scan, delta) in enumerate(zip(scans, odom_deltas(scans), strict=True)):

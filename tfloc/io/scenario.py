@@ -15,6 +15,11 @@ scans pose:
 * ``sequence``: the rows are one trajectory in time order: ``stamp`` strictly increasing,
   ``odom_*`` on every row, ``init_*`` on the first row only (where the robot starts);
 * ``global``: no row has an initial guess: each pose is searched over the whole map.
+
+``scenario.json`` ``"truth": false`` declares a dataset without truth (every ``true_*`` empty,
+e.g. a user's recording imported without reference poses): :attr:`Scenario.has_truth`, read from
+the rows where it is not declared. :func:`check_usable` holds the rules for a sequence that cannot
+be tracked at all.
 """
 
 from __future__ import annotations
@@ -23,8 +28,9 @@ import csv
 import json
 import math
 import os
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -80,6 +86,17 @@ class Scenario:
         if self.extra.get("scan_to_scan"):
             return SCAN_TO_SCAN
         return str(self.extra.get("mode", SINGLE))
+
+    @cached_property
+    def has_truth(self) -> bool:
+        """Whether any row holds a true pose: ``scenario.json``'s ``"truth"`` where declared,
+        else read from ``scans.csv`` (its ``true_x`` column only)."""
+        if "truth" in self.extra:
+            return bool(self.extra["truth"])
+        if not self.scans_path.is_file():
+            return False
+        _, rows = csv_rows(self.scans_path, DatasetError, "scans.csv file", COLUMNS)
+        return any((row.get("true_x") or "").strip() for _, row in rows)
 
     @property
     def paper_scenarios(self) -> tuple[str, ...]:
@@ -148,6 +165,8 @@ def read_scenario(root: str | Path) -> Scenario:
         raise DatasetError(f"{path}: laser resolution_deg is too fine: more than {MAX_BEAMS} beams")
     extra = {k: v for k, v in doc.items() if k not in ("name", "map", "laser", "description")}
     paper_scenarios_of(extra, str(path))
+    if not isinstance(extra.get("truth", False), bool):
+        raise DatasetError(f"{path}: field 'truth' must be true or false, got {extra['truth']!r:.40}")
     if extra.get("mode", SINGLE) not in MODES:
         raise DatasetError(f"{path}: field 'mode' must be one of {', '.join(MODES)}, got {extra['mode']!r:.40}")
     try:
@@ -209,6 +228,7 @@ def iter_scans(scenario: Scenario) -> Iterator[Scan]:
             raise DatasetError(f"{path}: a sequence needs the column(s) {', '.join(missing)}")
     seen: set[str] = set()
     last_stamp: float | None = None
+    no_truth = scenario.extra.get("truth") is False
     for n, (line, row) in enumerate(rows):
         if None in row or any(row[c] is None for c in COLUMNS):
             raise DatasetError(f"{path}:{line}: wrong number of fields (expected {len(COLUMNS)})")
@@ -236,9 +256,13 @@ def iter_scans(scenario: Scenario) -> Iterator[Scan]:
             last_stamp = stamp
         elif mode == GLOBAL and initial is not None:
             raise DatasetError(f"{path}:{line}: a global dataset has no initial pose (init_* must be empty)")
+        true = _pose(row, "true", path, line, optional=True)
+        if no_truth and true is not None:
+            raise DatasetError(f"{path}:{line}: a true pose in a dataset whose scenario.json says "
+                               "\"truth\": false")
         yield Scan(sid, row["group"].strip(),
                    parse_ranges(row["ranges"], scenario.laser, path, line),
-                   initial, _pose(row, "true", path, line, optional=True), line,
+                   initial, true, line,
                    parse_ranges(ref, scenario.laser, path, line) if ref else None,
                    stamp, odom)
     if mode == SEQUENCE and not seen:
@@ -250,6 +274,36 @@ def _stamp(text: str, path: Path, line: int) -> float:
     if not math.isfinite(t):
         raise DatasetError(f"{path}:{line}: stamp is not finite: {text!r}")
     return t
+
+
+def check_usable(scenario: Scenario, scans: Sequence[Scan], the_map=None) -> None:
+    """Raise a one-line :class:`DatasetError` where a sequence dataset cannot be tracked at all
+    (:func:`usable_sequence`'s rules); other modes pass."""
+    if scenario.mode == SEQUENCE:
+        usable_sequence(scans, scenario.laser, the_map, str(scenario.scans_path))
+
+
+def usable_sequence(scans: Sequence[Scan], laser: LaserSpec, the_map=None, where: str = "scans.csv",
+                    error: type[Exception] = DatasetError) -> None:
+    """The rules for a sequence that cannot be tracked at all, one line naming ``where`` (the
+    file, and the row): fewer than 2 scans, every scan without a return, or (given ``the_map``)
+    a start pose outside the map's known area (:func:`tfloc.maps.known.in_known_area`). Rows
+    without odometry or a start pose are refused by :func:`iter_scans`; a recording that is
+    usable but flawed is flagged, not refused (:mod:`tfloc.evaluation.recording`)."""
+    if len(scans) < 2:
+        raise error(f"{where}: a sequence needs at least 2 scans to track, found {len(scans)}")
+    if not any(laser.valid(s.ranges).any() for s in scans):
+        raise error(f"{where}: none of the {len(scans)} scans has a return (below max_range "
+                    f"{laser.max_range:g} m): nothing to localize with")
+    start = scans[0].initial
+    if the_map is not None and start is not None:
+        from tfloc.maps.known import in_known_area
+
+        if not in_known_area(the_map, np.array([[start.x, start.y]]))[0]:
+            row = f":{scans[0].line}" if scans[0].line else ""
+            b = ", ".join(f"{v:.2f}" for v in the_map.bounds)
+            raise error(f"{where}{row}: the start pose of {scans[0].scan_id} ({start.x:.3f}, {start.y:.3f} m) "
+                        f"lies outside the map's known area (bounds {b} m)")
 
 
 def map_for(scenario: Scenario, scan: Scan, cache: dict | None = None):
