@@ -141,3 +141,27 @@ def test_rows_are_read_back_by_the_results_reader(tmp_path):
         w.writerows(to_record(r) for r in rows)
     df = read_estimates(tmp_path)
     assert len(df) == 6 and set(df["status"]) <= {"ok", "failed", "error:RuntimeError: boom"}
+
+
+@pytest.mark.parametrize("fault", ["one scan", "no return", "start outside the map"])
+def test_unusable_sequences_are_one_line_errors_for_track_and_bench(tmp_path, capsys, fault):
+    """Where a recording cannot be tracked at all, `tfloc track` and `tfloc bench` stop before
+    running, with one line naming the file (and row)."""
+    sc = read_scenario(QUICK)
+    scans = read_scans(sc)[:6]
+    if fault == "one scan":
+        scans, want = scans[:1], "scans.csv: a sequence needs at least 2 scans to track, found 1"
+    elif fault == "no return":
+        scans = [Scan(s.scan_id, s.group, np.full_like(s.ranges, np.inf), s.initial, s.true, stamp=s.stamp,
+                      odom=s.odom) for s in scans]
+        want = "scans.csv:2: scan has no return at all"  # the one range rule, at the first row
+    else:
+        s = scans[0]
+        scans[0] = Scan(s.scan_id, s.group, s.ranges, Pose(500.0, 0.0, 0.0), s.true, stamp=s.stamp, odom=s.odom)
+        want = f"scans.csv:2: the start pose of {s.scan_id} (500.000, 0.000 m) lies outside the map's known area"
+    root = write_scenario(tmp_path / "bad", "bad", sc.map_path, sc.laser, scans, mode="sequence")
+    for argv in (["track", "--dataset", str(root), "--matcher", "odometry", "--out", str(tmp_path / "e.csv")],
+                 ["bench", str(root), "--matchers", "odometry", "--out", str(tmp_path / "run")]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip()
+        assert want in err and len(err.splitlines()) == 1, err

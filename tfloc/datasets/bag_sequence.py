@@ -8,7 +8,7 @@ pose, map frame), ``--initial-topic`` (e.g. AMCL's ``/amcl_pose``, at the first 
 or found by a global matcher (:mod:`tfloc.datasets.first_pose`); ``generator.start`` says which,
 with the matcher's score and whether another place scored about as well. Scans the odometry does
 not cover (a gap longer than ``--max-pose-gap``) are skipped and their stretches recorded in
-``generator.odometry_gaps``.
+``generator.odometry_gaps``; so are scans without a return (``generator.scans_without_return``).
 """
 
 from __future__ import annotations
@@ -56,6 +56,7 @@ def import_sequence(cfg, scans, pick: np.ndarray, t: np.ndarray, truth: np.ndarr
     las = scans.laser
     no_return = las.valid(scans.ranges[pick]).sum(axis=1) == 0
     n_empty = int(np.count_nonzero(keep & no_return))
+    empty = stretches(keep & no_return, t, scans.index[pick])
     keep &= ~no_return
     rows = np.flatnonzero(keep)
     if cfg.limit:
@@ -77,7 +78,7 @@ def import_sequence(cfg, scans, pick: np.ndarray, t: np.ndarray, truth: np.ndarr
     seq = [Scan(f"s{scans.index[pick[k]]:05d}", "sequence", scans.ranges[pick[k]], start.pose if i == 0 else None,
                 tp, stamp=float(t[k]), odom=o)
            for i, (k, tp, o) in enumerate(zip(rows, true_p, odom_l, strict=True))]
-    usable_sequence(seq, las, the_map, str(cfg.bag), BagError)
+    usable_sequence(seq, the_map, str(cfg.bag), BagError)
     out.mkdir(parents=True, exist_ok=True)
     map_path = save_map(cfg, grid, out)
     skipped = {"outside_poses": int(np.count_nonzero(~covered)), "outside_odom": outside_odom, "no_return": n_empty}
@@ -85,7 +86,8 @@ def import_sequence(cfg, scans, pick: np.ndarray, t: np.ndarray, truth: np.ndarr
         skipped["before_initial"] = outside_init
     how = {"initial_topic": cfg.initial_topic} if init is not None else {}
     source = source_record(cfg, scans, ref, rows, {"how": how, "skipped": skipped})
-    generator = {"command": "tfloc import-bag", "start": start.record(), "odometry_gaps": list(gaps)}
+    generator = {"command": "tfloc import-bag", "start": start.record(), "odometry_gaps": list(gaps),
+                 "scans_without_return": list(empty)}
     truth_text = (f"reference poses from {cfg.pose_topic}" if ref is not None else
                   "no reference poses (true_* empty: tracked, not scored)")
     write_scenario(out, cfg.name or out.name, map_path, las, seq,

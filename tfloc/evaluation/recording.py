@@ -11,9 +11,11 @@ Each rule's threshold is relative to the recording's own statistics, with a stat
 * ``odometry-stall``: ``stall_steps`` or more consecutive increments below ``still_m`` and
   ``still_rad`` (the odometry reports no motion) while the scans change: the median |Δr| between
   the stretch's first and last scans (over the beams with a return in both) exceeds
-  ``max(change_factor × noise, change_floor_m)``, noise being the 5th percentile of the non-zero
-  changes between consecutive scans over the recording. First to last, not step by step: a
-  moving robot's change adds up, a standing one's flicker (noise, a passer-by) does not.
+  ``max(change_factor × noise, change_floor_m)``, noise being the 1st percentile of the non-zero
+  changes between consecutive scans over the recording (a standing robot's scans differ by the
+  sensor's noise; a recording that never stands still gives a larger, more cautious value).
+  First to last, not step by step: a moving robot's change adds up, a standing one's flicker
+  (noise, a passer-by) does not.
 * ``odometry-jump``: an increment (per median period: one over a longer step counts pro rata)
   beyond ``jump_factor`` × the recording's 99th percentile (translation or rotation, at least
   ``jump_floor_m`` / ``jump_floor_rad``), or implying more than ``max_speed`` / ``max_turn``
@@ -209,7 +211,7 @@ def _odometry(scans: Sequence[Scan], laser: LaserSpec, R: np.ndarray, has_odom: 
     p99_m, p99_rad = np.percentile(dd_n[both], 99), np.percentile(da_n[both], 99)
     change = scan_change(R[:-1], R[1:], laser)
     moved = change[change > 0]
-    noise = float(np.percentile(moved, 5)) if moved.size else 0.0
+    noise = float(np.percentile(moved, 1)) if moved.size else 0.0
     tau = max(rules.change_factor * noise, rules.change_floor_m)
     with np.errstate(invalid="ignore"):
         still = both & (dd < rules.still_m) & (da < rules.still_rad)

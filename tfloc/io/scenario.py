@@ -280,21 +280,19 @@ def check_usable(scenario: Scenario, scans: Sequence[Scan], the_map=None) -> Non
     """Raise a one-line :class:`DatasetError` where a sequence dataset cannot be tracked at all
     (:func:`usable_sequence`'s rules); other modes pass."""
     if scenario.mode == SEQUENCE:
-        usable_sequence(scans, scenario.laser, the_map, str(scenario.scans_path))
+        usable_sequence(scans, the_map, str(scenario.scans_path))
 
 
-def usable_sequence(scans: Sequence[Scan], laser: LaserSpec, the_map=None, where: str = "scans.csv",
+def usable_sequence(scans: Sequence[Scan], the_map=None, where: str = "scans.csv",
                     error: type[Exception] = DatasetError) -> None:
     """The rules for a sequence that cannot be tracked at all, one line naming ``where`` (the
-    file, and the row): fewer than 2 scans, every scan without a return, or (given ``the_map``)
-    a start pose outside the map's known area (:func:`tfloc.maps.known.in_known_area`). Rows
-    without odometry or a start pose are refused by :func:`iter_scans`; a recording that is
-    usable but flawed is flagged, not refused (:mod:`tfloc.evaluation.recording`)."""
+    file, and the row): fewer than 2 scans, or (given ``the_map``) a start pose outside the
+    map's known area (:func:`tfloc.maps.known.in_known_area`). Rows without odometry or a start
+    pose are refused by :func:`iter_scans`, a scan without a return by the one range rule
+    (:func:`tfloc.core.problem.check_ranges`); a recording that is usable but flawed is flagged,
+    not refused (:mod:`tfloc.evaluation.recording`)."""
     if len(scans) < 2:
         raise error(f"{where}: a sequence needs at least 2 scans to track, found {len(scans)}")
-    if not any(laser.valid(s.ranges).any() for s in scans):
-        raise error(f"{where}: none of the {len(scans)} scans has a return (below max_range "
-                    f"{laser.max_range:g} m): nothing to localize with")
     start = scans[0].initial
     if the_map is not None and start is not None:
         from tfloc.maps.known import in_known_area
