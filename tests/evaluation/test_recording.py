@@ -163,3 +163,30 @@ def test_unusable_sequences_are_one_line_errors(room, tmp_path) -> None:
         with err as e:
             check_usable(sc, away, room)
         assert "\n" not in str(e.value)
+
+
+def test_the_check_recording_verb(room, tmp_path, capsys) -> None:
+    """One line per flag and a summary, exit 0 on a usable recording; --poses flags coverage
+    for a tracker's answers (a CSV like tfloc track's); a bad file is one line."""
+    from tfloc.cli import main
+    from tfloc.io.scenario import write_scenario
+
+    scans = sequence(room, route())
+    for k in range(31, 35):
+        scans[k] = dataclasses.replace(scans[k], odom=scans[30].odom)
+    root = write_scenario(tmp_path / "d", "made-up", ROOM, LASER, scans, mode=SEQUENCE)
+    assert main(["check-recording", str(root)]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("odometry-stall   k030…k034") and out[1].startswith("odometry-jump    k034…k035")
+    assert out[-1] == f"made-up: {N} scans over 5.9 s (period 0.100 s): 1 odometry-stall, 1 odometry-jump; usable"
+    est = tmp_path / "est.csv"
+    est.write_text("scan_id,est_x,est_y,est_theta\n" + "".join(f"{s.scan_id},{s.true.x + (40 if k >= 50 else 0)},"
+                                                                 f"{s.true.y},{s.true.theta}\n"
+                                                                 for k, s in enumerate(scans)))
+    assert main(["check-recording", str(root), "--poses", str(est)]) == 0
+    out = capsys.readouterr().out
+    assert "outside-map      k050…k059" in out and "1 coverage flag(s)" in out
+    est.write_text("scan_id,est_x,est_y,est_theta\nnope,1,2,3\n")
+    assert main(["check-recording", str(root), "--poses", str(est)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.endswith("est.csv:2: scan_id 'nope' is not a scan of the dataset") and "\n" not in err
