@@ -47,6 +47,7 @@ from tfloc.core.map import Map
 from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose, wrap_angle
 from tfloc.core.problem import Estimate
+from tfloc.core.traits import Confidence
 from tfloc.errors import InvalidProblemError, ParameterError
 from tfloc.maps.cache import cached
 from tfloc.maps.grid import GridMap
@@ -146,6 +147,8 @@ class AmclWheelTracker:
     single-scan mode (no ``localize``). See the module docstring and ``docs/baselines/amcl-wheel.md``."""
 
     name = "amcl-wheel"
+    METHOD = "nav2-amcl"  # (tfloc.core.traits)
+    CONFIDENCE = Confidence("sigma_xy_m", False, "the filter's position standard deviation (metres)")
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
         self.config = resolve_params(Config, config, overrides)

@@ -36,6 +36,7 @@ from scipy.optimize import least_squares
 from tfloc.core.params import Configured
 from tfloc.core.pose import Pose, wrap_angle
 from tfloc.core.problem import Estimate, Problem
+from tfloc.core.traits import Confidence
 
 from .likelihood import LikelihoodField, likelihood_field
 
@@ -75,6 +76,7 @@ class CorrelativeMatcher(Configured):
     """Olson's real-time correlative scan matcher over the protocol's window (see the module docstring)."""
 
     name = "csm-corr"
+    CONFIDENCE = Confidence("grid_mean_likelihood", True, "the best pose's mean likelihood per point")
     CONFIG = Config
 
     def _field(self, problem: Problem) -> LikelihoodField:

@@ -36,6 +36,7 @@ import numpy as np
 from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose, angdiff, wrap_angle
 from tfloc.core.problem import Estimate, Problem
+from tfloc.core.traits import Confidence
 from tfloc.paper.shape import ShapeConfig, scan_corners
 
 from ._corner_match import mutual_inliers, search_hypotheses
@@ -85,6 +86,7 @@ class CvCornersMatcher:
     """Corner matching with fair rigid hypotheses, refined by OpenCV (see the module docstring)."""
 
     name = "cv-corners"
+    CONFIDENCE = Confidence("inliers", True, "the number of corner pairs its transform explains")
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
         self.config = resolve_params(Config, config, overrides)

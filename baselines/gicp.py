@@ -40,6 +40,7 @@ import numpy as np
 from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
+from tfloc.core.traits import Confidence
 from tfloc.errors import ParameterError
 from tfloc.maps.cache import cached, map_geometry
 
@@ -118,6 +119,7 @@ class GicpMatcher:
     """small_gicp GICP on layered 2D points with a coarse-to-fine gate schedule (see the module docstring)."""
 
     name = "gicp"
+    CONFIDENCE = Confidence("inlier_fraction", True, "small_gicp's share of inlier points")
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
         self.config = resolve_params(Config, config, overrides)

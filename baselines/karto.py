@@ -39,6 +39,7 @@ from tfloc.core.laser import LaserSpec
 from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose, wrap_angle
 from tfloc.core.problem import Estimate, Problem
+from tfloc.core.traits import Confidence
 from tfloc.errors import ParameterError
 from tfloc.maps.cache import cached
 
@@ -116,6 +117,7 @@ class KartoMatcher:
     """OpenKarto's correlative matcher, coarse then fine, against virtual scans of the map (see the module docstring)."""
 
     name = "karto"
+    CONFIDENCE = Confidence("response", True, "Karto's correlation response")
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
         self.config = resolve_params(Config, config, overrides)

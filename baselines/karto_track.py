@@ -32,6 +32,7 @@ from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate
 from tfloc.core.tracker import LocalTracker
+from tfloc.core.traits import Confidence
 
 from .karto import Config as KartoConfig
 from .karto import KartoMatcher
@@ -57,6 +58,8 @@ class KartoGatedTracker(LocalTracker):
     of each step: ``matched`` (whether Karto ran) and ``travel_m`` (odometry since the last match)."""
 
     name = "karto-gated"
+    METHOD = "karto"  # (tfloc.core.traits)
+    CONFIDENCE = Confidence("response", True, "Karto's correlation response (the last matched scan's between matches)")
     CONFIG = Config
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:

@@ -34,6 +34,7 @@ from kiss_icp.registration import Registration
 from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
+from tfloc.core.traits import Confidence
 from tfloc.maps.cache import cached, map_geometry
 
 from ._geometry import embed_z0, matrix_to_pose, pose_to_matrix
@@ -75,6 +76,7 @@ class KissIcpMatcher:
     """KISS-ICP registration to the map with a voxel schedule (see the module docstring)."""
 
     name = "kiss-icp"
+    CONFIDENCE = Confidence("inlier_fraction", True, "the share of points within the last gate")
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
         self.config = resolve_params(Config, config, overrides)

@@ -29,6 +29,7 @@ from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
 from tfloc.core.tracker import LocalTracker
+from tfloc.core.traits import Confidence
 
 from ._geometry import embed_z0, matrix_to_pose, pose_to_matrix
 from .kiss_icp import _voxel_map
@@ -92,6 +93,8 @@ class KissIcpAdaptiveTracker(LocalTracker):
     """KISS-ICP with its adaptive threshold along a sequence (see the module docstring)."""
 
     name = "kiss-icp-adaptive"
+    METHOD = "kiss-icp"  # (tfloc.core.traits)
+    CONFIDENCE = Confidence("sigma", False, "its adaptive threshold's sigma (metres)")
     CONFIG = Config
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:

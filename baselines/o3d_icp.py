@@ -32,6 +32,7 @@ import numpy as np
 from tfloc.core.params import Configured
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
+from tfloc.core.traits import Confidence
 from tfloc.maps.cache import map_geometry, point_to_line_residuals
 
 from ._geometry import embed_z0, matrix_to_pose, pose_to_matrix
@@ -64,6 +65,7 @@ class Open3dIcpMatcher(Configured):
     """open3d point-to-line ICP with a coarse-to-fine gate schedule (see the module docstring)."""
 
     name = "o3d-icp"
+    CONFIDENCE = Confidence("fitness", True, "open3d's ICP fitness (share of points with a correspondence)")
     CONFIG = Config
 
     def prepare(self, problem: Problem) -> None:

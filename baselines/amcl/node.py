@@ -39,6 +39,7 @@ from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate
 from tfloc.core.tracker import GLOBAL_START, START_KEY
+from tfloc.core.traits import Confidence
 from tfloc.errors import InvalidProblemError
 from tfloc.maps.cache import cached
 
@@ -115,6 +116,8 @@ class AmclTracker:
     ``"global"`` (the start pose the harness passed was ignored)."""
 
     name = "amcl"
+    METHOD = "nav2-amcl"  # (tfloc.core.traits)
+    CONFIDENCE = Confidence("sigma_xy_m", False, "the particles' position spread (metres)")
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
         self.config = resolve_params(Config, config, overrides)

@@ -39,6 +39,7 @@ from scipy.optimize import least_squares
 from tfloc.core.params import Configured
 from tfloc.core.pose import Pose, wrap_angle
 from tfloc.core.problem import NO_ANSWER, Estimate, Problem
+from tfloc.core.traits import Confidence
 
 from . import _csm
 from ._filters import matched_points
@@ -81,6 +82,8 @@ class CartographerLocalMatcher(Configured):
     """Cartographer's local scan matching against the map (see the module docstring)."""
 
     name = "cartographer-local"
+    METHOD = "cartographer"  # (tfloc.core.traits)
+    CONFIDENCE = Confidence("final_cost", False, "the Ceres scan matcher's final cost")
     kind = "tracker"  # (core.matcher.TRACKER: it pulls towards its guess; meant for sequences)
     CONFIG = Config
 

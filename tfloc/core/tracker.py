@@ -161,6 +161,7 @@ class DeadReckoning(Configured):
 
     CONFIG = NoParameters
     name = "odometry"
+    METHOD = None  # (tfloc.core.traits)
     kind = "tracker"  # (core.matcher.TRACKER: meant for sequences)
 
     def localize(self, problem: Problem) -> Estimate:

@@ -42,7 +42,7 @@ ESTIMATES = "estimates.csv"
 
 #: the run.json fields a reader relies on, and what each must be
 _FIELDS = {"config": dict, "git": dict, "machine": dict, "versions": dict, "datasets": dict, "sessions": list,
-           "declared": dict, "timing": dict, "levels": list, "done": list,
+           "declared": dict, "timing": dict, "verdict": dict, "levels": list, "done": list,
            "config.kind": str, "config.scaling": dict, "timing.sessions": list, "timing.complete": bool,
            "config.success": dict, "config.matchers": list, "git.commit": (str, type(None)),
            "git.dirty": (bool, type(None)), "config.name": str}
@@ -183,6 +183,14 @@ class RunDir:
     timing_md = property(lambda self: self.path / "timing.md", doc="the timing pass's summary")
     report = property(lambda self: self.path / "report.md", doc="the report")
     figures = property(lambda self: self.path / "figures", doc="the report's figures")
+    verdict = property(lambda self: self.path / "verdict.csv", doc="the truth-free verdict per tracker")
+    verdict_scans = property(lambda self: self.path / "verdict_scans.csv.gz",
+                             doc="the truth-free verdict's per-scan signals and beliefs")
+    verdict_checks = property(lambda self: self.path / "verdict_checks.csv",
+                              doc="the verdict against the truth, per tracker (recordings with truth)")
+    verdict_agreement = property(lambda self: self.path / "verdict_agreement.csv",
+                                 doc="the verdict's ranking against the truth's, per recording")
+    VERDICT_FILES = ("verdict.csv", "verdict_scans.csv.gz", "verdict_checks.csv", "verdict_agreement.csv")
 
     def has_rows(self) -> bool:
         """Whether the run has an ``estimates.csv`` with anything in it."""
@@ -283,8 +291,10 @@ class RunDir:
 
     def discard(self, also: tuple[str, ...] = ()) -> None:
         """Remove the run's results, its timing pass (``timing.csv``, ``timing.md`` and the record
-        in ``run.json``), ``run.json`` and the files named ``also`` (``--regenerate``)."""
-        for f in (self.estimates, self.timing_csv, self.timing_md, *(self.path / n for n in also), self.run_json):
+        in ``run.json``), its truth-free verdict, ``run.json`` and the files named ``also``
+        (``--regenerate``)."""
+        for f in (self.estimates, self.timing_csv, self.timing_md, *(self.path / n for n in self.VERDICT_FILES),
+                  *(self.path / n for n in also), self.run_json):
             f.unlink(missing_ok=True)
 
     def make(self) -> None:

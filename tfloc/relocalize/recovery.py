@@ -21,6 +21,7 @@ from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
 from tfloc.core.tracker import LocalTracker
+from tfloc.core.traits import Confidence
 from tfloc.tfplus.matcher import TfPlusConfig, TurningFunctionPlusMatcher
 
 from .matcher import TfGlobalConfig, TurningFunctionGlobalMatcher
@@ -119,6 +120,8 @@ class TfPlusRecoverTracker(RecoveringTracker):
     ``seq-kidnap-dev`` (``docs/kidnap.md``). A tracker only: no single-scan ``localize``."""
 
     name = "tf-plus-recover"
+    METHOD = "tf-plus"  # (tfloc.core.traits)
+    CONFIDENCE = Confidence("score", False, "its answer's point-to-line residual (RMS, metres), its lost test's input")
     CONFIG = TfPlusRecoverConfig
 
     def __init__(self, config: TfPlusRecoverConfig | None = None, **overrides) -> None:

@@ -42,6 +42,7 @@ from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose, wrap_angle
 from tfloc.core.problem import Estimate, Problem
 from tfloc.core.tracker import PREDICTED, LocalTracker
+from tfloc.core.traits import Confidence
 from tfloc.errors import InvalidProblemError
 
 from .config import TfPlusConfig
@@ -110,6 +111,8 @@ class TfPlusTracker(LocalTracker):
     metres: what the fit is judged by)."""
 
     name = "tf-plus-track"
+    METHOD = "tf-plus"  # (tfloc.core.traits)
+    CONFIDENCE = Confidence("score", False, "its answer's point-to-line residual (RMS, metres)")
     CONFIG = TfPlusTrackConfig
 
     def __init__(self, config: TfPlusTrackConfig | None = None, **overrides) -> None:

@@ -1,0 +1,40 @@
+"""Judge a run's trackers without the truth: RUN/verdict.csv and the per-scan signals beside it.
+
+For every sequence dataset of the run, each tracker's answers are judged from what a robot owner
+has: the scans, the map, the odometry and the other trackers' answers, never the truth. Signals
+per scan: the share of returns that land on the map, agreement with the pose independent other
+trackers agree on, corrections beyond the odometry's measured noise (jumps), and restarts from
+perturbed poses that come back to the tracker's own trajectory. The verdict is the share of
+scans each tracker is believed tracked, with a 95 % interval (docs/truth-free.md).
+Where a dataset has truth, the verdict is then checked against it (verdict_agreement.csv:
+rank correlation, top tracker, the scans judged wrongly). tfloc report opens with the verdict
+for datasets without truth; tfloc bench on such a dataset runs this step itself.
+
+Examples:
+  tfloc verdict results/my-robot
+  tfloc verdict results/native --no-restarts   # the signals from the rows alone (no tracker runs)
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+HELP = "judge a run's trackers without ground truth (the truth-free verdict: verdict.csv)"
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("run", type=Path, metavar="RUN", help="run directory (estimates.csv, run.json)")
+    p.add_argument("--no-restarts", action="store_true",
+                   help="skip the re-convergence restarts (they run every tracker again on a few stretches)")
+
+
+def run(args: argparse.Namespace) -> int:
+    from tfloc.report.verdict import write_verdict
+
+    v = write_verdict(args.run, restarts=not args.no_restarts)
+    print(f"verdict: {args.run / 'verdict.csv'} ({len(v.rows)} rows)")
+    for a in v.agreements:
+        print(f"{a.dataset}: against the truth rho {a.rho:.2f}, top {a.verdict_top} ({a.top}; truth's "
+              f"{a.truth_top}){'' if a.agrees else ': DISAGREES'}")
+    return 0

@@ -1,0 +1,32 @@
+"""The per-scan judgement the verdict counts: is a tracker's answer *believed tracked*?
+
+Where the others agree on a pose (:mod:`.consensus`), the tracker is believed tracked exactly
+when it agrees with them. Where they do not, the scan and the map decide: its answer's fit share
+(:mod:`.mapfit`) must be within ``fit_margin`` of the best share any tracker reached on that scan
+(an unmapped object hides the same returns from every answer), and its correction must not
+disagree with the odometry (:mod:`.odometry`). Each scan's belief says which signal decided it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: which signal decided a scan's belief
+BY_CONSENSUS, BY_FIT = "consensus", "fit"
+
+
+def best_fit(fits: np.ndarray) -> np.ndarray:
+    """``(N,)`` the best fit share any tracker reached at each scan (NaN where none has one)."""
+    with np.errstate(invalid="ignore"):
+        ok = np.isfinite(fits).any(axis=0)
+        return np.where(ok, np.nanmax(np.where(np.isfinite(fits), fits, -np.inf), axis=0), np.nan)
+
+
+def believed(agree: np.ndarray, known: np.ndarray, fits: np.ndarray, odometry_disagrees: np.ndarray,
+             fit_margin: float) -> np.ndarray:
+    """``(M, N)`` believed tracked: the consensus where ``known``, else a fit share within
+    ``fit_margin`` of the scan's best and no disagreement with the odometry (module notes)."""
+    best = best_fit(fits)[None, :]
+    with np.errstate(invalid="ignore"):
+        fit_ok = np.isfinite(fits) & (fits >= best - fit_margin)
+    return np.where(known, agree, fit_ok & ~odometry_disagrees)

@@ -1,0 +1,241 @@
+"""``tfloc verdict RUN``: the truth-free verdict of a run's sequence datasets, written beside it.
+
+For every sequence dataset of the run, the trackers' answers (``estimates.csv``), the dataset's
+scans, odometry and map are judged without the truth (:mod:`tfloc.evaluation.truthfree`), the
+re-convergence restarts are run (:mod:`tfloc.harness.restarts`), and four files are written:
+
+* ``verdict.csv``: per (dataset, tracker) and pooled (``all``), the verdict and every signal
+  (:class:`~tfloc.evaluation.truthfree.judge.VerdictRow`);
+* ``verdict_scans.csv.gz``: per scan and tracker, the signals and the belief;
+* ``verdict_checks.csv`` and ``verdict_agreement.csv`` (datasets with truth only): the verdict
+  against the truth, per tracker and per recording (:mod:`tfloc.evaluation.truthfree.agreement`).
+
+The truth is read only after the verdict is made, to check it. ``run.json`` records the
+verdict's configuration and the hash of the rows it judged (``verdict``), so a report can tell
+a verdict of other rows.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from tfloc.core.traits import method_of
+from tfloc.evaluation.trajectory import pooled_share
+from tfloc.evaluation.truthfree import reconverge as R
+from tfloc.evaluation.truthfree.agreement import Agreement, TrackerCheck, agreement, tracker_checks
+from tfloc.evaluation.truthfree.config import TruthFreeConfig
+from tfloc.evaluation.truthfree.judge import Judgement, VerdictRow, judge, verdict_rows
+from tfloc.evaluation.truthfree.mapfit import fit_shares, scan_points
+from tfloc.harness.restarts import restart_ends
+from tfloc.harness.workspace import load_dataset, load_matcher, map_of
+from tfloc.io.rundir import RunDir, RunInfo
+from tfloc.io.scenario import SEQUENCE
+from tfloc.maps.fields import distance_field
+
+POOLED = "all"
+DEFAULT = TruthFreeConfig()
+
+
+@dataclass(frozen=True)
+class Recording:
+    """One sequence dataset of a run, ready to judge: its trackers (run order) and ``(M, N, 3)``
+    answers and predictions, its scans in order, whether each has truth and which trackers were
+    tracked there (``(M, N)``, False without truth)."""
+
+    name: str
+    matchers: list[str]
+    est: np.ndarray
+    init: np.ndarray
+    scan_ids: list[str]
+    has_truth: np.ndarray
+    tracked: np.ndarray
+
+
+def _poses(g: pd.DataFrame, prefix: str) -> np.ndarray:
+    return g[[f"{prefix}_x", f"{prefix}_y", f"{prefix}_theta"]].apply(pd.to_numeric, errors="coerce").to_numpy(float)
+
+
+def recording(df: pd.DataFrame, name: str, order: list[str], scan_ids: list[str], thr) -> Recording:
+    """The :class:`Recording` of dataset ``name`` from a run's rows (trackers without a row for
+    every scan are left out: an interrupted sequence is not judged)."""
+    d = df[df["dataset"] == name]
+    labels, est, init, tracked = [], [], [], []
+    truth = None
+    for m in order:
+        g = d[d["matcher"] == m].set_index("scan_id")
+        if len(g) != len(scan_ids) or not g.index.isin(scan_ids).all():
+            continue
+        g = g.loc[scan_ids]
+        labels.append(m)
+        est.append(_poses(g, "est"))
+        init.append(_poses(g, "init"))
+        dist = pd.to_numeric(g["dist_err_m"], errors="coerce").to_numpy(float)
+        turn = pd.to_numeric(g["orient_err_rad"], errors="coerce").to_numpy(float)
+        tracked.append(thr.success(dist, turn) & np.isfinite(dist))
+        if truth is None:
+            truth = pd.to_numeric(g["true_x"], errors="coerce").notna().to_numpy(bool)
+    n = len(scan_ids)
+    shape = (len(labels), n)
+    return Recording(name, labels, np.array(est).reshape(*shape, 3), np.array(init).reshape(*shape, 3),
+                     scan_ids, truth if truth is not None else np.zeros(n, bool),
+                     np.array(tracked, dtype=bool).reshape(shape))
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """What :func:`judge_run` found: the verdict rows (per dataset and pooled), the per-scan
+    table, and against the truth the per-tracker checks and per-recording agreements."""
+
+    rows: list[VerdictRow]
+    scans: pd.DataFrame
+    checks: list[TrackerCheck]
+    agreements: list[Agreement]
+
+
+def rows_hash(path: Path) -> str:
+    """SHA-256 of the rows file a verdict judged."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def _order(info: RunInfo, df: pd.DataFrame) -> list[str]:
+    labels = [m.get("label", m.get("name")) for m in info.matchers]
+    present = set(df["matcher"])
+    return [m for m in labels if m in present] or sorted(present)
+
+
+def _restarts(scenario, scans, rec: Recording, specs: dict[str, dict], the_map, cfg: TruthFreeConfig,
+              log: Callable[[str], None]) -> dict[str, np.ndarray]:
+    """Per tracker, whether each of its restarts returned (:mod:`~tfloc.evaluation.truthfree.reconverge`)."""
+    plan = R.plan(len(scans), cfg.restarts, cfg.restart_scans, cfg.restart_offset_m, cfg.restart_offset_rad,
+                  cfg.seed)
+    out: dict[str, np.ndarray] = {}
+    if not plan:
+        return out
+    last = np.array([r.last for r in plan])
+    for i, m in enumerate(rec.matchers):
+        spec = specs.get(m, {"name": m, "params": {}})
+        try:
+            matcher = load_matcher(spec["name"], json.dumps(spec.get("params") or {}, sort_keys=True))
+        except Exception as exc:  # noqa: BLE001 - a tracker that cannot be built is reported, not fatal
+            log(f"{rec.name}: {m}: no restarts ({type(exc).__name__}: {exc})")
+            continue
+        ends = restart_ends(scenario, scans, matcher, rec.est[i], plan, the_map)
+        out[m] = R.returned(ends, rec.est[i][last], cfg.agree_m, cfg.agree_rad)
+    return out
+
+
+def _scan_table(rec: Recording, j: Judgement) -> pd.DataFrame:
+    m, n = j.believed.shape
+    state = np.where(j.known, np.where(j.agree, "agree", "disagree"), "none")
+    return pd.DataFrame({
+        "dataset": rec.name, "scan_id": np.tile(rec.scan_ids, m), "matcher": np.repeat(rec.matchers, n),
+        "fit": j.fit.ravel(), "best_fit": np.tile(j.best_fit, m), "consensus": state.ravel(),
+        "support": j.support.ravel(), "correction_m": j.dist.ravel(), "correction_rad": j.turn.ravel(),
+        "odometry_disagrees": j.odometry_disagrees.ravel().astype(int), "believed": j.believed.ravel().astype(int)})
+
+
+def pooled_rows(rows: list[VerdictRow], beliefs: dict[tuple[str, str], np.ndarray]) -> list[VerdictRow]:
+    """Each tracker's verdict pooled over the run's recordings (the share over every scan, its
+    interval a bootstrap over recordings, :func:`~tfloc.evaluation.trajectory.pooled_share`;
+    the other signals weighted by scans); only with more than one recording."""
+    if len({r.dataset for r in rows}) < 2:
+        return []
+    out = []
+    for m in dict.fromkeys(r.matcher for r in rows):
+        mine = [r for r in rows if r.matcher == m]
+        k = [float(beliefs[(r.dataset, m)].sum()) for r in mine]
+        n = [r.scans for r in mine]
+        s, lo, hi = pooled_share(k, n)
+        w = np.array(n, dtype=float)
+
+        def avg(field: str, rows_=mine, w=w) -> float:
+            v = np.array([getattr(r, field) for r in rows_], dtype=float)
+            ok = np.isfinite(v)
+            return float(np.average(v[ok], weights=w[ok])) if ok.any() else math.nan
+
+        restarts = sum(r.restarts for r in mine)
+        back = sum(r.reconverged_pct / 100 * r.restarts for r in mine if r.restarts)
+        out.append(VerdictRow(POOLED, m, 100 * s, 100 * lo, 100 * hi, int(sum(n)), avg("consensus_pct"),
+                              avg("agree_pct"), avg("fit_pct"), avg("odometry_pct"), sum(r.jumps for r in mine),
+                              100 * back / restarts if restarts else math.nan, restarts))
+    return out
+
+
+def judge_run(run_dir: str | Path, cfg: TruthFreeConfig = DEFAULT, restarts: bool = True,
+              log: Callable[[str], None] = print) -> Verdict:
+    """The truth-free verdict of every sequence dataset of the run in ``run_dir`` (module notes)."""
+    rd = RunDir(Path(run_dir))
+    df, info = rd.results(), rd.info()
+    names = [n for n in df["dataset"].unique() if n in info.datasets_in(list(df["dataset"].unique()), SEQUENCE)]
+    order, thr = _order(info, df), info.thresholds
+    specs = {m.get("label", m.get("name")): m for m in info.matchers}
+    rows, tables, checks, agreements, beliefs = [], [], [], [], {}
+    for name in names:
+        scenario, by_id = load_dataset(str(info.datasets[name]))
+        scans = list(by_id.values())
+        rec = recording(df, name, order, [s.scan_id for s in scans], thr)
+        if not rec.matchers:
+            log(f"{name}: no tracker has a row for every scan: not judged")
+            continue
+        the_map = map_of(scenario, scans[0])
+        field = distance_field(the_map, cfg.field_resolution_m, cap=4 * cfg.fit_tol_m, pad=1.0)
+        points = scan_points(np.stack([s.ranges for s in scans]), scenario.laser)
+        fit = np.stack([fit_shares(points, rec.est[i], field, cfg.fit_tol_m) for i in range(len(rec.matchers))])
+        j = judge(rec.est, rec.init, fit, [method_of(m) for m in rec.matchers], cfg)
+        back = _restarts(scenario, scans, rec, specs, the_map, cfg, log) if restarts else {}
+        mine = verdict_rows(name, rec.matchers, j, cfg, back)
+        rows += mine
+        beliefs.update({(name, m): j.believed[i] for i, m in enumerate(rec.matchers)})
+        tables.append(_scan_table(rec, j))
+        if rec.has_truth.any():
+            c = tracker_checks(name, rec.matchers, [r.score_pct for r in mine], j.believed, rec.tracked,
+                               rec.has_truth)
+            checks += c
+            agreements.append(agreement(name, c, rec.tracked, rec.has_truth))
+        log(f"{name}: judged {len(rec.matchers)} trackers over {len(scans)} scans")
+    rows += pooled_rows(rows, beliefs)
+    scans_df = pd.concat(tables, ignore_index=True) if tables else pd.DataFrame()
+    return Verdict(rows, scans_df, checks, agreements)
+
+
+def _frame(items: list) -> pd.DataFrame:
+    return pd.DataFrame([asdict(x) for x in items])
+
+
+def write_verdict(run_dir: str | Path, cfg: TruthFreeConfig = DEFAULT, restarts: bool = True,
+                  log: Callable[[str], None] = print) -> Verdict:
+    """:func:`judge_run`, then its files and ``run.json``'s ``verdict`` record (module notes)."""
+    rd = RunDir(Path(run_dir))
+    v = judge_run(run_dir, cfg, restarts, log)
+    _frame(v.rows).to_csv(rd.verdict, index=False, float_format="%.6g")
+    v.scans.to_csv(rd.verdict_scans, index=False, float_format="%.5g")
+    for path, items in ((rd.verdict_checks, v.checks), (rd.verdict_agreement, v.agreements)):
+        if items:
+            _frame(items).to_csv(path, index=False, float_format="%.6g")
+        else:
+            path.unlink(missing_ok=True)
+    rd.update({"verdict": {"config": asdict(cfg), "restarts": restarts, "rows_sha256": rows_hash(rd.estimates)}})
+    return v
+
+
+def read_verdict(run_dir: str | Path) -> tuple[pd.DataFrame | None, str]:
+    """A run's ``verdict.csv`` and a note: ``""`` when it judged the run's current rows, else why
+    it is missing or stale (``None`` when there is no verdict)."""
+    rd = RunDir(Path(run_dir))
+    if not rd.verdict.is_file():
+        return None, "no truth-free verdict yet (tfloc verdict RUN)"
+    record = (rd.info().doc.get("verdict") or {})
+    stale = rd.estimates.is_file() and record.get("rows_sha256") not in (None, rows_hash(rd.estimates))
+    return pd.read_csv(rd.verdict), ("the verdict judged other rows than the run's (tfloc verdict RUN)" if stale else "")
