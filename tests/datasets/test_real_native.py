@@ -271,3 +271,25 @@ def test_a_bad_relations_field_is_one_line(tmp_path) -> None:
     sc = Scenario("x", tmp_path / "m.yaml", LaserSpec.lms200(), root=tmp_path, extra={"relations": 5})
     with pytest.raises(DatasetError, match=r"scenario.json: field 'relations' must be a path"):
         relations_path(sc)
+
+
+@pytest.mark.bitwise
+def test_committed_no_truth_dataset_regenerates(rebuilt: Path) -> None:
+    """The bundled recording without truth is `tfloc real-data`'s too."""
+    rel = Path("scenarios") / "real-csail-native-no-truth"
+    assert_same_file(rebuilt / rel / "scans.csv", SCEN.parent / rel / "scans.csv")
+
+
+def test_no_truth_dataset_is_the_native_recording_without_its_truth(datasets) -> None:
+    """Same scans, stamps, odometry and start as real-csail-native; no true pose anywhere, and
+    declared so (a robot owner's recording)."""
+    sc = read_scenario(SCEN / "real-csail-native-no-truth")
+    blind = read_scans(sc)
+    _, native = datasets["csail"]
+    assert sc.extra["truth"] is False and not sc.has_truth and sc.mode == "sequence"
+    assert [s.scan_id for s in blind] == [s.scan_id for s in native]
+    assert all(s.true is None for s in blind)
+    assert blind[0].initial == native[0].true
+    for a, b in zip(blind, native, strict=True):
+        assert a.stamp == b.stamp and a.odom == b.odom
+        np.testing.assert_array_equal(a.ranges, b.ranges)

@@ -3,7 +3,7 @@ that make its tables, run as their commands would) and the scaling study.
 
 A step is a verb of this command line applied to the run: ``index`` (tf-global's place index of
 every global dataset's map, before the run), ``timing`` (the side-by-side timing pass; one scan
-per stratum with ``--quick``), ``report``, ``robustness``, ``real-note``. Each is the verb itself
+per stratum with ``--quick``), ``verdict`` (the truth-free verdict of its sequences), ``report``, ``robustness``, ``real-note``. Each is the verb itself
 (``tfloc STEP RUN``), so a table made by ``make bench`` is the table a user gets by hand.
 """
 

@@ -18,6 +18,10 @@ the `error:` rows; --retry-errors runs them again).
 Matchers named `module:Class` (not registered ones) are imported: that runs the module's code.
 Run only configurations you trust; such matchers are refused without --allow-import.
 
+A sequence dataset without ground truth (scenario.json "truth": false, e.g. tfloc import-bag
+without --pose-topic) named directly is then judged without it (tfloc verdict) and reported: its
+report.md opens with the truth-free ranking, headline.csv's truth_free_score column holds it.
+
 --quick runs the first 3 scans of every group of every dataset into RUN-quick (make quick).
 
 Examples:
@@ -165,7 +169,11 @@ def run(args: argparse.Namespace) -> int:
     if len(tomls) > 1 and _overridden(args):
         raise ConfigError(f"{', '.join(_overridden(args))}: apply to one study file, not {len(tomls)}")
     if not tomls:
-        return run_one(args, config_from_args(args))
+        cfg = config_from_args(args)
+        code = run_one(args, cfg)
+        if not args.no_steps and code in (0, 3) and _without_truth(cfg):
+            run_steps(cfg, ["verdict", "report"], args.quick)
+        return code
     studies = [load_study(t) for t in tomls]  # every file checked before any runs
     code = 0
     for study in studies:
@@ -179,6 +187,14 @@ def run(args: argparse.Namespace) -> int:
         if not args.no_steps:
             run_steps(cfg, [s for s in cfg.steps if s not in STEPS_BEFORE], args.quick)
     return code
+
+
+def _without_truth(cfg: RunConfig) -> bool:
+    """Whether a run has a sequence dataset without truth: then ``tfloc bench DATASET …`` judges
+    it (``tfloc verdict``) and writes its report, which opens with the truth-free ranking."""
+    from tfloc.io.scenario import SEQUENCE
+
+    return any((sc := read_scenario(d)).mode == SEQUENCE and not sc.has_truth for d in cfg.datasets)
 
 
 def run_one(args: argparse.Namespace, cfg: RunConfig) -> int:

@@ -19,7 +19,7 @@ corrected scans' logger times (:func:`interpolated_stamps`).
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -232,4 +232,27 @@ def build_native(real: Path, out: Path) -> list[Path]:
             description=_description(log, summary), mode=SEQUENCE, condition=dict(CONDITION), **extra,
             generator={"command": "tfloc real-data", **summary},
             source={"files": [f"data/real/{f}" for f in files], "provenance": "data/real/*/PROVENANCE.md"}))
+        if log.key == NO_TRUTH:
+            made.append(_without_truth(root, name, out, laser, rows, summary, files))
     return made
+
+
+#: the log also bundled with its truth removed: a user's recording as a robot owner has it
+NO_TRUTH = "csail"
+
+
+def _without_truth(root: Path, name: str, out: Path, laser: LaserSpec, rows: list[Scan], summary: dict,
+                   files: list[str]) -> Path:
+    """``real-<log>-native-no-truth``: the same scans, stamps and odometry with every true pose
+    removed (``"truth": false``), the start (first row's ``init_*``) kept as the pose a user would
+    give (``import-bag --initial-pose``). What the truth-free verdict is shown on end to end."""
+    blind = [replace(r, true=None) for r in rows]
+    target = root.parent / f"{name}-no-truth"
+    return write_scenario(
+        target, target.name, out / "maps" / f"real-{NO_TRUTH}.yaml", laser, blind,
+        description=(f"{name} with its truth removed: the same {len(blind)} scans, stamps and raw odometry, "
+                     "no true pose (a robot owner's recording: the truth-free verdict ranks its trackers). "
+                     f"start = the first corrected pose, as a user would give it. Truth: {name}."),
+        mode=SEQUENCE, condition={**CONDITION, "name": "real-native-no-truth", "label": "every raw scan, raw odometry, no truth"}, truth=False,
+        generator={"command": "tfloc real-data", "from": name, "scans": len(blind)},
+        source={"files": [f"data/real/{f}" for f in files], "provenance": "data/real/*/PROVENANCE.md"})

@@ -10,6 +10,13 @@ a percentile bootstrap over sequences (scans of one sequence are not independent
 the median distance error (cm), for tracking the APE RMSE (cm). The verdict compares each matcher
 with the next one down on the scans both answered: an exact McNemar test on success, p-values
 Holm-adjusted within the table; ``ahead`` where adjusted p < 0.05, else ``tied``.
+
+A sequence dataset without truth is ranked by the truth-free verdict instead (measure
+*truth-free*: the share of scans each tracker is believed tracked, :mod:`tfloc.evaluation.
+truthfree`, its per-scan beliefs taking the place of the truth in the interval and the paired
+test; no error). Every tracking row also carries ``truth_free_score`` (the verdict on that scope,
+made with the truth hidden: where there is truth, to compare) and ``self_auc`` (the tracker's own
+confidence as a lost-detector, :mod:`tfloc.evaluation.selfassess`); NaN where not computed.
 :func:`headline_frame` is what ``report.md``, ``headline.csv``, the site and the README read.
 """
 
@@ -29,6 +36,8 @@ from .trajectory import pooled_share
 
 #: a run's dataset modes (``tfloc.io.scenario``) → the measure its headline ranks by
 MEASURES = {"single": "success", "scan-to-scan": "success", "sequence": "tracked", "global": "top-1"}
+#: the measure of a sequence dataset without truth
+TRUTH_FREE = "truth-free"
 POOLED = "all"
 
 
@@ -51,14 +60,26 @@ class HeadlineRow:
     verdict: str
     next_matcher: str
     p_holm: float
+    truth_free_score: float = math.nan
+    self_auc: float = math.nan
 
+
+#: per (scope, matcher): a figure a headline row carries beside its measure
+Extras = dict[tuple[str, str], float]
+#: per (scope, matcher): the truth-free verdict's share and its interval (%), (score, lo, hi)
+Verdicts = dict[tuple[str, str], tuple[float, float, float]]
 
 HEADLINE_COLUMNS = [f.name for f in fields(HeadlineRow)]
+#: columns a ``headline.csv`` written before they existed may lack (read as NaN)
+OPTIONAL = ("truth_free_score", "self_auc")
 
 
 def _hits(g: pd.DataFrame, mode: str, thr: Thresholds) -> pd.Series:
     """Per scan with truth: answered within the thresholds (a tracker's kept prediction counts as
-    its estimate, as in the tracking tables; elsewhere the outcome rule decides)."""
+    its estimate, as in the tracking tables; elsewhere the outcome rule decides). Truth-free: per
+    scan, believed tracked."""
+    if mode == TRUTH_FREE:
+        return g["believed"].astype(bool)
     t = g[g["truth"]]
     if mode == "sequence":
         d = pd.to_numeric(t["dist_err_m"], errors="coerce")
@@ -77,21 +98,26 @@ def _median(s: pd.Series) -> float:
     return float(v.median()) if len(v) else math.nan
 
 
-def _table(p: pd.DataFrame, mode: str, scope: str, thr: Thresholds) -> list[HeadlineRow]:
-    """The ranked rows of one table (``p``: prepared rows of one mode, one scope)."""
+def _table(p: pd.DataFrame, mode: str, scope: str, thr: Thresholds, free: Verdicts,
+           auc: Extras) -> list[HeadlineRow]:
+    """The ranked rows of one table (``p``: prepared rows of one mode, one scope; ``mode``
+    :data:`TRUTH_FREE` for sequences without truth, ``p`` with a ``believed`` column)."""
     stats, hits = [], {}
     for m, g in p.groupby("matcher", sort=False):
         h = _hits(g, mode, thr)
         key = g.loc[h.index, "dataset"].astype(str) + "/" + g.loc[h.index, "scan_id"].astype(str)
         hits[m] = pd.Series(h.to_numpy(bool), index=key.to_numpy())
         k, n = int(h.sum()), int(len(h))
-        if mode == "sequence" and g["dataset"].nunique() > 1:
+        if mode == TRUTH_FREE and scope != POOLED and (scope, m) in free:  # the verdict's own (block bootstrap)
+            share, lo, hi = (x / 100 for x in free[(scope, m)])
+        elif mode in ("sequence", TRUTH_FREE) and g["dataset"].nunique() > 1:
             per = [(int(x.sum()), len(x)) for _, x in h.groupby(g.loc[h.index, "dataset"])]
             share, lo, hi = pooled_share([a for a, _ in per], [b for _, b in per])
         else:
             share = k / n if n else math.nan
             lo, hi = wilson(k, n)
-        err = _ape_cm(g) if mode == "sequence" else _median(g.loc[g["truth"], "dist_err_cm"])
+        err = math.nan if mode == TRUTH_FREE else _ape_cm(g) if mode == "sequence" else \
+            _median(g.loc[g["truth"], "dist_err_cm"])
         stats.append((m, 100 * share, 100 * lo, 100 * hi, n, err, _median(g["cpu_ms"])))
     stats.sort(key=lambda s: (-np.nan_to_num(s[1], nan=-1.0), np.nan_to_num(s[5], nan=np.inf),
                               np.nan_to_num(s[6], nan=np.inf), s[0]))
@@ -106,24 +132,44 @@ def _table(p: pd.DataFrame, mode: str, scope: str, thr: Thresholds) -> list[Head
         nxt = stats[i + 1][0] if i + 1 < len(stats) else ""
         p_adj = float(adj[i]) if i < len(adj) else math.nan
         verdict = "" if not nxt or math.isnan(p_adj) else "ahead" if p_adj < ALPHA else "tied"
-        out.append(HeadlineRow(mode, scope, i + 1, m, MEASURES.get(mode, "success"), v, lo, hi, n, err,
-                               "APE RMSE" if mode == "sequence" else "median error", cpu, verdict, nxt, p_adj))
+        measure = TRUTH_FREE if mode == TRUTH_FREE else MEASURES.get(mode, "success")
+        error = "" if mode == TRUTH_FREE else "APE RMSE" if mode == "sequence" else "median error"
+        out.append(HeadlineRow("sequence" if mode == TRUTH_FREE else mode, scope, i + 1, m, measure, v, lo, hi,
+                               n, err, error, cpu, verdict, nxt, p_adj,
+                               v if mode == TRUTH_FREE else free.get((scope, m), (math.nan,))[0],
+                               auc.get((scope, m), math.nan)))
     return out
 
 
-def headline(p: pd.DataFrame, modes: dict[str, str], thr: Thresholds) -> list[HeadlineRow]:
+def headline(p: pd.DataFrame, modes: dict[str, str], thr: Thresholds, beliefs: pd.DataFrame | None = None,
+             free: Verdicts | None = None, auc: Extras | None = None) -> list[HeadlineRow]:
     """Every headline table of prepared rows ``p`` (:func:`tfloc.evaluation.metrics.prepare`);
-    ``modes``: dataset → mode. Datasets without truth are left out."""
+    ``modes``: dataset → mode. A sequence dataset without truth is ranked by the truth-free
+    verdict where ``beliefs`` (``dataset, scan_id, matcher, believed``) has it; other datasets
+    without truth are left out. ``free``: the verdict (score, lo, hi) by (scope, matcher), the
+    tracking rows' ``truth_free_score`` (and the truth-free tables' interval); ``auc``: their
+    ``self_auc``."""
+    free, auc = free or {}, auc or {}
     out: list[HeadlineRow] = []
-    p = p[p["truth"]]
+    with_truth = set(p.loc[p["truth"], "dataset"])
+    t = p[p["truth"]]
     for mode in MEASURES:
-        names = [d for d in p["dataset"].unique() if modes.get(d, "single") == mode]
+        names = [d for d in t["dataset"].unique() if modes.get(d, "single") == mode]
         if not names:
             continue
         if len(names) > 1:
-            out += _table(p[p["dataset"].isin(names)], mode, POOLED, thr)
+            out += _table(t[t["dataset"].isin(names)], mode, POOLED, thr, free, auc)
         for d in names:
-            out += _table(p[p["dataset"] == d], mode, d, thr)
+            out += _table(t[t["dataset"] == d], mode, d, thr, free, auc)
+    blind = [d for d in p["dataset"].unique() if modes.get(d) == "sequence" and d not in with_truth]
+    if beliefs is not None and blind:
+        b = p[p["dataset"].isin(blind)].merge(beliefs[["dataset", "scan_id", "matcher", "believed"]],
+                                             on=["dataset", "scan_id", "matcher"], how="inner")
+        names = [d for d in blind if d in set(b["dataset"])]
+        if len(names) > 1:
+            out += _table(b, TRUTH_FREE, POOLED, thr, free, auc)
+        for d in names:
+            out += _table(b[b["dataset"] == d], TRUTH_FREE, d, thr, free, auc)
     return out
 
 
@@ -135,14 +181,15 @@ def headline_frame(rows: list[HeadlineRow]) -> pd.DataFrame:
 def read_headline(path) -> list[HeadlineRow]:
     """The rows of a ``headline.csv`` (as :func:`headline_frame` wrote them)."""
     df = pd.read_csv(path, keep_default_na=False, na_values=[""])
-    missing = [c for c in HEADLINE_COLUMNS if c not in df.columns]
+    missing = [c for c in HEADLINE_COLUMNS if c not in df.columns and c not in OPTIONAL]
     if missing:
         from tfloc.errors import ResultsError
 
         raise ResultsError(f"{path}: not a headline table (no column(s) {', '.join(missing)})")
     out = []
     for r in df.to_dict("records"):
-        out.append(HeadlineRow(**{f.name: _cast(f.type, r[f.name]) for f in fields(HeadlineRow)}))
+        out.append(HeadlineRow(**{f.name: _cast(f.type, r[f.name]) for f in fields(HeadlineRow)
+                                  if f.name in r}))
     return out
 
 

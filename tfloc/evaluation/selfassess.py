@@ -24,7 +24,7 @@ import numpy as np
 import pandas as pd
 from scipy.stats import rankdata
 
-from tfloc.core.traits import Confidence
+from tfloc.core.traits import Confidence, confidence_of
 
 #: the false-alarm rate of the "caught" figure
 FALSE_ALARM = 0.01
@@ -77,3 +77,44 @@ def assess(scope: str, matcher: str, conf: Confidence, lostness: np.ndarray,
     ok = np.isfinite(lostness)
     x, y = lostness[ok], lost[ok]
     return SelfAssessment(scope, matcher, conf.key, int(ok.sum()), int(y.sum()), auc(x, y), caught(x, y))
+
+
+POOLED = "all"
+
+
+def _scan_order(g: pd.DataFrame) -> pd.DataFrame:
+    """A tracker's rows of one dataset in scan order (by stamp where there is one)."""
+    if "stamp" in g.columns and pd.to_numeric(g["stamp"], errors="coerce").notna().all():
+        return g.assign(_t=pd.to_numeric(g["stamp"])).sort_values("_t", kind="stable")
+    return g
+
+
+def self_assessments(p: pd.DataFrame, sequences: list[str], thr, confidence=None) -> list[SelfAssessment]:
+    """Every tracker's lost-detector on each sequence dataset with truth of prepared rows ``p``
+    and pooled over them (``all``, one threshold across recordings, as a robot would use it);
+    ``confidence``: label → :class:`Confidence` (default :func:`tfloc.core.traits.confidence_of`).
+    Trackers without a confidence are left out."""
+    conf_of = confidence or confidence_of
+    out: list[SelfAssessment] = []
+    pooled: dict[str, tuple[Confidence, list[np.ndarray], list[np.ndarray]]] = {}
+    for m in dict.fromkeys(p["matcher"]):
+        conf = conf_of(m)
+        if conf is None or "info" not in p.columns:
+            continue
+        for d in sequences:
+            g = _scan_order(p[(p["matcher"] == m) & (p["dataset"] == d)])
+            if not len(g) or not g["truth"].any():
+                continue
+            x = values(g["info"], conf)
+            t = g["truth"].to_numpy(bool)
+            dist = pd.to_numeric(g["dist_err_m"], errors="coerce").to_numpy(float)
+            turn = pd.to_numeric(g["orient_err_rad"], errors="coerce").to_numpy(float)
+            lost = ~(thr.success(dist, turn) & np.isfinite(dist))
+            out.append(assess(d, m, conf, x[t], lost[t]))
+            c, xs, ls = pooled.setdefault(m, (conf, [], []))
+            xs.append(x[t])
+            ls.append(lost[t])
+    if len({a.scope for a in out}) > 1:
+        for m, (c, xs, ls) in pooled.items():
+            out.append(assess(POOLED, m, c, np.concatenate(xs), np.concatenate(ls)))
+    return out

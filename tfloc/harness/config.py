@@ -45,7 +45,7 @@ from tfloc.io.text import parse_text
 #: steps a study file may declare: ``index`` (tf-global's place index of every dataset's map)
 #: runs before the run, the others after it in the order written
 STEPS_BEFORE = ("index",)
-STEPS_AFTER = ("timing", "report", "robustness", "real-note")
+STEPS_AFTER = ("timing", "verdict", "report", "robustness", "real-note")
 STEPS = (*STEPS_BEFORE, *STEPS_AFTER)
 DEFAULT_STEPS = ("report",)
 KINDS = ("bench", "scaling")

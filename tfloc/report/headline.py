@@ -10,13 +10,14 @@ from pathlib import Path
 import pandas as pd
 
 from tfloc.core.thresholds import Thresholds
-from tfloc.evaluation.headline import POOLED, HeadlineRow, headline, headline_frame
+from tfloc.evaluation.headline import POOLED, TRUTH_FREE, HeadlineRow, headline, headline_frame
 
 from .mdtable import num, table
 
 #: how a mode's table is titled
 TITLES = {"single": "A single scan from a rough guess", "scan-to-scan": "Scan to scan",
-          "sequence": "Tracking along a sequence", "global": "A single scan without a guess (global)"}
+          "sequence": "Tracking along a sequence", "global": "A single scan without a guess (global)",
+          TRUTH_FREE: "Tracking without ground truth: the truth-free verdict"}
 
 
 def interval(r: HeadlineRow) -> str:
@@ -39,36 +40,54 @@ def headline_table(rows: list[HeadlineRow]) -> str:
         return ""
     first = rows[0]
     unit = "CPU ms/step" if first.mode == "sequence" else "CPU ms/scan"
+    if first.measure == TRUTH_FREE:  # no truth: no error column, no truth-based figure
+        body = [[r.rank, f"`{r.matcher}`", interval(r), num(r.cpu_ms, 2), r.n, verdict(r)] for r in rows]
+        return table(["#", "tracker", "believed tracked % [95 % CI]", f"{unit} (median)", "scans",
+                      "against the next"], body, "rlrrrl")
     body = [[r.rank, f"`{r.matcher}`", interval(r), num(r.error_cm, 2), num(r.cpu_ms, 2), r.n, verdict(r)]
             for r in rows]
     return table(["#", "matcher", f"{first.measure} % [95 % CI]", f"{first.error} (cm)",
                   f"{unit} (median)", "scans", "against the next"], body, "rlrrrrl")
 
 
-def top_scope(rows: list[HeadlineRow], mode: str) -> str:
-    """The scope a report shows for ``mode``: the pooled table, else its one dataset."""
-    scopes = [r.scope for r in rows if r.mode == mode]
+def top_scope(rows: list[HeadlineRow], mode: str, measure: str | None = None) -> str:
+    """The scope a report shows for ``mode`` (and ``measure``): the pooled table, else its first
+    dataset."""
+    scopes = [r.scope for r in rows if r.mode == mode and measure in (None, r.measure)]
     return POOLED if POOLED in scopes else scopes[0]
 
 
-def headline_section(p: pd.DataFrame, modes: dict[str, str], thr: Thresholds, run_dir: Path) -> str:
+def _table_key(r: HeadlineRow) -> str:
+    return TRUTH_FREE if r.measure == TRUTH_FREE else r.mode
+
+
+def headline_section(p: pd.DataFrame, modes: dict[str, str], thr: Thresholds, run_dir: Path,
+                     tf=None) -> str:
     """The report's opening section; writes ``run_dir/headline.csv`` (every table: each dataset,
-    and each mode pooled)."""
-    rows = headline(p, modes, thr)
+    and each mode pooled). ``tf``: the run's truth-free parts (:class:`tfloc.report.truthfree.
+    TruthFree`): datasets without truth are ranked by the verdict, and that ranking comes first."""
+    rows = headline(p, modes, thr, *((tf.beliefs, tf.free, tf.auc) if tf is not None else ()))
     headline_frame(rows).to_csv(run_dir / "headline.csv", index=False, float_format="%.6g")
     if not rows:
-        return "## Headline\n\n_No scan of this run has ground truth: nothing to rank._\n"
+        why = f" ({tf.note})" if tf is not None and tf.note else ""
+        return f"## Headline\n\n_No scan of this run has ground truth: nothing to rank{why}._\n"
     out = ["## Headline\n"]
-    for mode in dict.fromkeys(r.mode for r in rows):
-        scope = top_scope(rows, mode)
-        mine = [r for r in rows if r.mode == mode and r.scope == scope]
-        names = sorted({d for d, m in modes.items() if m == mode and d in set(p["dataset"])})
+    keys = sorted(dict.fromkeys(_table_key(r) for r in rows), key=lambda k: k != TRUTH_FREE)
+    for key in keys:
+        measure = TRUTH_FREE if key == TRUTH_FREE else None
+        mode = "sequence" if key == TRUTH_FREE else key
+        mine_all = [r for r in rows if _table_key(r) == key]
+        scope = top_scope(mine_all, mode, measure)
+        mine = [r for r in mine_all if r.scope == scope]
+        names = sorted({r.scope for r in mine_all if r.scope != POOLED}) or [scope]
         where = f"pooled over {', '.join(names)}" if scope == POOLED else scope
-        out.append(f"**{TITLES.get(mode, mode)}** ({where}; {mine[0].measure}: within "
-                   f"{thr.dist_m * 100:g} cm and {thr.orient_deg:g}° of the truth):\n")
+        rule = "share of scans believed tracked, judged without the truth (docs/truth-free.md)" \
+            if key == TRUTH_FREE else f"{mine[0].measure}: within {thr.dist_m * 100:g} cm and " \
+            f"{thr.orient_deg:g}° of the truth"
+        out.append(f"**{TITLES.get(key, key)}** ({where}; {rule}):\n")
         out.append(headline_table(mine))
     out.append("Best first. Interval: Wilson's over scans (tracking pooled over sequences: bootstrap "
-               "over sequences). *Against the next*: exact McNemar test on the scans both answered, "
+               "over sequences; the truth-free verdict: moving-block bootstrap over scans). *Against the next*: exact McNemar test on the scans both answered, "
                "Holm-adjusted within the table; *ahead* where p < 0.05. `headline.csv` has every "
                "dataset's table.\n")
     return "\n".join(out)

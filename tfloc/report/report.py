@@ -37,6 +37,7 @@ from . import sections as S
 from .failures import draw_failures, failures_section
 from .figures import MANY_MATCHERS
 from .headline import headline_section
+from .truthfree import load_truth_free, truth_free_section
 from .landscape import draw_landscapes, landscape_section
 from .mdtable import num
 from .sessions import this_run
@@ -359,8 +360,13 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
     thr = thresholds or info.thresholds
     names = list(df["dataset"].unique())
     seq, glob = info.datasets_in(names, SEQUENCE), info.datasets_in(names, GLOBAL)
-    top = headline_section(prepare(df, thr), {n: info.mode(n) for n in names}, thr, run_dir)
+    prepared = prepare(df, thr)
+    tf = load_truth_free(run_dir, prepared, sorted(seq), thr)
+    top = headline_section(prepared, {n: info.mode(n) for n in names}, thr, run_dir, tf)
     tracking = _tracking(run_dir, df[df["dataset"].isin(seq)], info, thr, with_figures) if seq else ""
+    if seq:
+        blind = sorted(n for n in seq if not prepared.loc[prepared["dataset"] == n, "truth"].any())
+        tracking += "\n" + truth_free_section(tf, blind)
     if glob:
         tracking = _relocalization(run_dir, df[df["dataset"].isin(glob)], info, thr) + "\n" + tracking
     if df["dataset"].isin(seq | glob).all():

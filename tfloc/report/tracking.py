@@ -305,7 +305,12 @@ def tracking_section(df: pd.DataFrame, datasets: dict[str, Scenario], maps: dict
                      out_dir: Path, thresholds: Thresholds = DEFAULT,
                      figures: bool = True) -> str:
     """The markdown of the tracking section (tables, then figures written under
-    ``out_dir/figures/tracking/``); ``maps``: dataset name → its map, for the figures."""
+    ``out_dir/figures/tracking/``); ``maps``: dataset name → its map, for the figures. A
+    dataset without truth gets no truth-based figure or table: its trajectories and jumps only
+    (the truth-free verdict ranks it, :mod:`tfloc.report.truthfree`)."""
+    truth = pd.to_numeric(df["true_x"], errors="coerce").notna().groupby(df["dataset"]).any()
+    blind = [d for d in df["dataset"].unique() if not truth.get(d, False)]
+    everything, df = df, df[~df["dataset"].isin(blind)]
     s = sequence_scores(df, datasets, thresholds)
     text = ["## Tracking\n",
             "Each sequence tracked scan by scan from the last estimate composed with the odometry "
@@ -315,8 +320,12 @@ def tracking_section(df: pd.DataFrame, datasets: dict[str, Scenario], maps: dict
             "evo with no alignment (map frame), over the scans with truth; a jump = an estimate more "
             "than 1 m from the prediction it started from (every scan); `odometry` = dead reckoning, "
             "the floor. Every tracker gets the same odometry, each increment composed whole.\n",
-            *_own_odometry_rules(df),
-            tracking_tables(s, datasets), relations_tables(df, datasets), own_score_table(df, thresholds)]
+            *_own_odometry_rules(everything),
+            tracking_tables(s, datasets) if len(df) else "", relations_tables(df, datasets),
+            own_score_table(df, thresholds) if len(df) else ""]
+    if blind:
+        text.append(f"Without ground truth: {', '.join(blind)}: no truth-based figure; ranked by the "
+                    "truth-free verdict (below); their trajectories and first jumps are drawn.\n")
     ev = kidnap_events(df, datasets, thresholds)
     if len(ev):
         ev.to_csv(Path(out_dir) / "kidnap.csv", index=False, float_format="%.6g")
@@ -338,15 +347,17 @@ def tracking_section(df: pd.DataFrame, datasets: dict[str, Scenario], maps: dict
                  start_tables(st)]
     if figures:
         fig_dir = Path(out_dir) / "figures" / "tracking"
-        for ds, g in df.groupby("dataset", sort=False):
+        for ds, g in everything.groupby("dataset", sort=False):
             sc = datasets.get(ds)
             if sc is None or ds not in maps:
                 continue
             a = fig_trajectories(sc, maps[ds], g, fig_dir / f"{_safe(ds)}-trajectories.png")
-            b = fig_error_distance(sc, g, fig_dir / f"{_safe(ds)}-error.png")
-            j = fig_jumps(ds, maps[ds], g, fig_dir / f"{_safe(ds)}-jumps.png")
             rel = lambda p: p.relative_to(out_dir).as_posix()  # noqa: E731
-            text.append(f"\n![{ds} trajectories]({rel(a)})\n\n![{ds} error over distance]({rel(b)})\n")
+            text.append(f"\n![{ds} trajectories]({rel(a)})\n")
+            if ds not in blind:
+                b = fig_error_distance(sc, g, fig_dir / f"{_safe(ds)}-error.png")
+                text.append(f"![{ds} error over distance]({rel(b)})\n")
+            j = fig_jumps(ds, maps[ds], g, fig_dir / f"{_safe(ds)}-jumps.png")
             if j is not None:
                 text.append(f"\n![{ds}: the first jumps of each tracker]({rel(j)})\n")
     return "\n".join(text)

@@ -22,11 +22,15 @@ def best_fit(fits: np.ndarray) -> np.ndarray:
         return np.where(ok, np.nanmax(np.where(np.isfinite(fits), fits, -np.inf), axis=0), np.nan)
 
 
+def fits_best(fits: np.ndarray, fit_margin: float) -> np.ndarray:
+    """``(M, N)`` whether each answer's fit share is within ``fit_margin`` of its scan's best."""
+    best = best_fit(fits)[None, :]
+    with np.errstate(invalid="ignore"):
+        return np.isfinite(fits) & (fits >= best - fit_margin)
+
+
 def believed(agree: np.ndarray, known: np.ndarray, fits: np.ndarray, odometry_disagrees: np.ndarray,
              fit_margin: float) -> np.ndarray:
     """``(M, N)`` believed tracked: the consensus where ``known``, else a fit share within
     ``fit_margin`` of the scan's best and no disagreement with the odometry (module notes)."""
-    best = best_fit(fits)[None, :]
-    with np.errstate(invalid="ignore"):
-        fit_ok = np.isfinite(fits) & (fits >= best - fit_margin)
-    return np.where(known, agree, fit_ok & ~odometry_disagrees)
+    return np.where(known, agree, fits_best(fits, fit_margin) & ~odometry_disagrees)

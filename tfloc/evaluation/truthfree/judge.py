@@ -40,8 +40,8 @@ def judge(est: np.ndarray, init: np.ndarray, fit: np.ndarray, methods: list[str 
     """The signals and beliefs of one recording (module notes)."""
     agree, known, support = consensus(est, methods, cfg.agree_m, cfg.agree_rad, cfg.min_methods)
     dist, turn = O.corrections(est, init)
-    env = O.envelope(dist, turn, known & agree, cfg.envelope_quantile, cfg.min_envelope_m,
-                     cfg.min_envelope_rad)
+    backed = np.where(known, agree, B.fits_best(fit, cfg.fit_margin))
+    env = O.envelope(dist, turn, backed, cfg.envelope_quantile, cfg.min_envelope_m, cfg.min_envelope_rad)
     odo = O.disagrees(dist, turn, env, cfg.odometry_factor)
     believed = B.believed(agree, known, fit, odo, cfg.fit_margin)
     return Judgement(fit, B.best_fit(fit), agree, known, support, dist, turn, odo, env, believed)

@@ -3,8 +3,9 @@
 A tracker's *correction* at a scan is the distance (metres) and heading difference (radians)
 between its answer and the prediction it started from (its last answer carried by the odometry
 increment: the row's ``init_*``). A good tracker corrects by about the odometry's own error; the
-recording's odometry *envelope* is a quantile of the corrections of the answers the consensus
-backs (what the odometry's error looks like to trackers that agree), never below a floor. A
+recording's odometry *envelope* is a quantile of the corrections of the answers the other
+signals back (the consensus where there is one, else a fit near the scan's best: what the
+odometry's error looks like to answers that are believed), never below a floor. A
 correction beyond ``factor`` × the envelope disagrees with the odometry; beyond ``jump_m`` it is a
 jump. Dead reckoning never disagrees: this signal only ever counts against a tracker.
 """

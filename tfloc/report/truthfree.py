@@ -1,0 +1,138 @@
+"""The report's truth-free parts: the verdict's tables, its check against the truth, and every
+tracker's self-assessment (its own confidence as a lost-detector, written to ``selfassess.csv``).
+
+The verdict itself is made by ``tfloc verdict`` (:mod:`tfloc.report.verdict`); this module only
+reads its files. A verdict of other rows than the run's (stale) is not used: the report says so.
+On a dataset without truth nothing here prints a truth-based figure.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import pandas as pd
+
+from tfloc.core.thresholds import Thresholds
+from tfloc.core.traits import confidence_of
+from tfloc.evaluation.headline import Extras, Verdicts
+from tfloc.evaluation.selfassess import FALSE_ALARM, SelfAssessment, self_assessments
+from tfloc.io.rundir import RunDir
+
+from .mdtable import num, table
+from .verdict import read_verdict
+
+
+@dataclass(frozen=True)
+class TruthFree:
+    """What the headline and the tracking section take from the truth-free files: per-scan
+    beliefs (``dataset, scan_id, matcher, believed``; ``None`` without a verdict), the verdict's
+    score and the self-assessment AUC per (scope, matcher), the verdict and agreement tables, the
+    self-assessments, and a note (why there is no verdict, or ``""``)."""
+
+    beliefs: pd.DataFrame | None
+    free: Verdicts
+    auc: Extras
+    verdict: pd.DataFrame | None
+    agreement: pd.DataFrame | None
+    assessments: list[SelfAssessment] = field(default_factory=list)
+    note: str = ""
+
+
+def load_truth_free(run_dir: Path, p: pd.DataFrame, sequences: list[str], thr: Thresholds) -> TruthFree:
+    """The truth-free parts of a run (prepared rows ``p``; its sequence datasets ``sequences``);
+    writes ``selfassess.csv`` where a tracker reports a confidence."""
+    rd = RunDir(Path(run_dir))
+    assessments = self_assessments(p, sequences, thr)
+    out = rd.path / "selfassess.csv"
+    if assessments:
+        pd.DataFrame([asdict(a) for a in assessments]).to_csv(out, index=False, float_format="%.6g")
+    else:
+        out.unlink(missing_ok=True)
+    auc = {(a.scope, a.matcher): a.auc for a in assessments}
+    v, note = read_verdict(rd.path) if sequences else (None, "")
+    if v is None or note:
+        return TruthFree(None, {}, auc, None, None, assessments, note)
+    free = {(str(r.dataset), str(r.matcher)): (float(r.score_pct), float(r.lo_pct), float(r.hi_pct))
+            for r in v.itertuples()}
+    beliefs = pd.read_csv(rd.verdict_scans, usecols=["dataset", "scan_id", "matcher", "believed"],
+                          dtype={"dataset": str, "scan_id": str, "matcher": str}) \
+        if rd.verdict_scans.is_file() else None
+    agree = pd.read_csv(rd.verdict_agreement) if rd.verdict_agreement.is_file() else None
+    return TruthFree(beliefs, free, auc, v, agree, assessments, "")
+
+
+def _ci(r) -> str:
+    ci = "" if math.isnan(r.lo_pct) else f" [{r.lo_pct:.1f}–{r.hi_pct:.1f}]"
+    return f"{r.score_pct:.1f}{ci}"
+
+
+def verdict_table(v: pd.DataFrame, scope: str) -> str:
+    """One recording's (or the pooled) verdict, best first, with the signal each figure comes from."""
+    g = v[v["dataset"].astype(str) == scope].sort_values(["score_pct", "fit_pct"], ascending=False)
+    body = [[i + 1, f"`{r.matcher}`", _ci(r), num(r.fit_pct, 1), num(r.consensus_pct, 1), num(r.agree_pct, 1),
+             num(r.odometry_pct, 1), int(r.jumps),
+             "—" if not r.restarts else f"{r.reconverged_pct:.0f} % of {int(r.restarts)}"]
+            for i, r in enumerate(g.itertuples())]
+    return table(["#", "tracker", "believed tracked % [95 % CI]", "map fit %", "consensus %", "agrees %",
+                  "odometry disagrees %", "jumps", "restarts back"], body, "rlrrrrrrr")
+
+
+def agreement_table(a: pd.DataFrame) -> str:
+    """The verdict against the truth, per recording with truth."""
+    body = [[r.dataset, int(r.trackers), num(r.rho, 2), f"`{r.truth_top}`", f"`{r.verdict_top}`",
+             r.top + ("" if r.top == "same" else f" (p = {r.p_top:.2g})"), num(r.wrong_pct, 1),
+             int(r.missed_losses), int(r.false_alarms), "agrees" if r.agrees else "**DISAGREES**"]
+            for r in a.itertuples()]
+    return table(["recording", "trackers", "Spearman ρ", "truth's top", "verdict's top", "top",
+                  "scans judged wrongly %", "missed losses", "false alarms", ""], body, "lrrllrrrrl")
+
+
+def selfassess_table(assessments: list[SelfAssessment], scope: str) -> str:
+    """Every tracker's own confidence as a lost-detector on one scope, best AUC first."""
+    mine = sorted((a for a in assessments if a.scope == scope), key=lambda a: -(a.auc if a.auc == a.auc else -1))
+    body = [[f"`{a.matcher}`", f"`{a.key}`", confidence_of(a.matcher).about if confidence_of(a.matcher) else "",
+             num(a.auc, 3), "—" if math.isnan(a.caught) else f"{100 * a.caught:.1f}", a.lost, a.scans]
+            for a in mine]
+    return table(["tracker", "confidence", "what it is", "AUC", f"lost caught at {100 * FALSE_ALARM:g} % "
+                  "false alarms %", "lost scans", "scans"], body, "lllrrrr")
+
+
+def truth_free_section(tf: TruthFree, blind: list[str]) -> str:
+    """The tracking report's truth-free section: the verdict per recording, its check against
+    the truth where there is one, and the self-assessment (``blind``: datasets without truth)."""
+    out = ["## Without ground truth: the truth-free verdict and self-assessment\n"]
+    if tf.verdict is None:
+        out.append(f"_{tf.note or 'no truth-free verdict yet (tfloc verdict RUN)'}._\n")
+    else:
+        out.append("Each tracker judged from what a robot owner has — the scans, the map, the odometry and "
+                   "the other trackers' answers, never the truth (docs/truth-free.md). *Believed tracked*: "
+                   "agrees with the pose independent other trackers agree on where they do, else its map "
+                   "fit is near the scan's best and its correction within the odometry's measured noise. "
+                   "Interval: moving-block bootstrap over scans. Signals: *map fit* (returns within 5 cm of "
+                   "the map), *consensus* (scans where the others agree), *agrees* (of those), *odometry "
+                   "disagrees* (corrections beyond the envelope), *jumps* (> 1 m), *restarts back* (restarted "
+                   "30 cm / 5° off, returned to its own trajectory).\n")
+        scopes = list(dict.fromkeys(tf.verdict["dataset"].astype(str)))
+        for s in (["all"] if "all" in scopes else []) + [s for s in scopes if s != "all"]:
+            tag = " (no ground truth)" if s in blind else ""
+            out += [f"**{'pooled' if s == 'all' else s}**{tag}:\n", verdict_table(tf.verdict, s)]
+    if tf.agreement is not None and len(tf.agreement):
+        bad = tf.agreement[~tf.agreement["agrees"].astype(bool)]
+        out.append("**The verdict against the truth** (made with the truth hidden, then checked on the scans "
+                   "with truth: Spearman ρ of the two rankings, the top tracker, the beliefs that are wrong; "
+                   "*agrees* where ρ ≥ 0.8 and the top is the same or tied by the paired test):\n")
+        out.append(agreement_table(tf.agreement))
+        if len(bad):
+            out.append(f"The truth-free verdict **disagrees with the truth** on {', '.join(bad['dataset'].astype(str))}: "
+                       "there its ranking is not to be trusted.\n")
+    if tf.assessments:
+        scope = "all" if any(a.scope == "all" for a in tf.assessments) else tf.assessments[0].scope
+        out.append(f"**Self-assessment** ({'pooled over the recordings with truth' if scope == 'all' else scope}): "
+                   "each tracker's own confidence read as a lost-detector against *not tracked* on the scans "
+                   "with truth. AUC 0.5 is chance, 1 a perfect detector; *caught*: the lost scans flagged at "
+                   "the threshold that raises a false alarm on 1 % of tracked scans. Per recording: "
+                   "`selfassess.csv`.\n")
+        out.append(selfassess_table(tf.assessments, scope))
+    return "\n".join(out)
