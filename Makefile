@@ -41,7 +41,8 @@ quick: $(STAMP)
 ## timing pass, report, robustness section, relations note, the global index), then the site and
 ## the README's generated tables. About 100 min on 2 cores; run again, it resumes.
 STUDIES := paper-protocol real-csail-relations real-scan-to-map tf-readings tf-readings-heldout \
-	tfplus-ablation sequences kidnap kidnap-controls robustness scaling-quick global native-csail
+	tfplus-ablation sequences kidnap kidnap-controls robustness scaling-quick global native-csail \
+	native-no-truth
 bench: $(STAMP)
 	$(BIN)/tfloc bench $(STUDIES:%=benchmarks/%.toml) --regenerate
 	$(BIN)/tfloc site --readme

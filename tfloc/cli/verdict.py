@@ -13,6 +13,8 @@ for datasets without truth; tfloc bench on such a dataset runs this step itself.
 Examples:
   tfloc verdict results/my-robot
   tfloc verdict results/native --no-restarts   # the signals from the rows alone (no tracker runs)
+  tfloc verdict results/dev/truth-free --sweep fit_margin=0.05,0.2 --sweep min_methods=1,3
+      # other values of the verdict's rules, each checked against the truth (verdict_sweep.csv)
 """
 
 from __future__ import annotations
@@ -27,11 +29,20 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("run", type=Path, metavar="RUN", help="run directory (estimates.csv, run.json)")
     p.add_argument("--no-restarts", action="store_true",
                    help="skip the re-convergence restarts (they run every tracker again on a few stretches)")
+    p.add_argument("--sweep", action="append", default=[], metavar="KEY=V1,V2",
+                   help="also judge with other values of one rule (tfloc.evaluation.truthfree.config), "
+                        "each checked against the truth: RUN/verdict_sweep.csv (repeatable; no restarts)")
 
 
 def run(args: argparse.Namespace) -> int:
     from tfloc.report.verdict import write_verdict
+    from tfloc.report.verdict_sweep import parse_sweep, sweep
 
+    if args.sweep:
+        configs = parse_sweep(args.sweep)
+        sweep(args.run, configs)
+        print(f"sweep: {args.run / 'verdict_sweep.csv'} ({len(configs)} configurations)")
+        return 0
     v = write_verdict(args.run, restarts=not args.no_restarts)
     print(f"verdict: {args.run / 'verdict.csv'} ({len(v.rows)} rows)")
     for a in v.agreements:

@@ -190,7 +190,10 @@ class RunDir:
                               doc="the verdict against the truth, per tracker (recordings with truth)")
     verdict_agreement = property(lambda self: self.path / "verdict_agreement.csv",
                                  doc="the verdict's ranking against the truth's, per recording")
-    VERDICT_FILES = ("verdict.csv", "verdict_scans.csv.gz", "verdict_checks.csv", "verdict_agreement.csv")
+    verdict_flags = property(lambda self: self.path / "verdict_flags.csv",
+                             doc="the recordings' flagged stretches the verdict judged across")
+    VERDICT_FILES = ("verdict.csv", "verdict_scans.csv.gz", "verdict_checks.csv", "verdict_agreement.csv",
+                     "verdict_flags.csv")
 
     def has_rows(self) -> bool:
         """Whether the run has an ``estimates.csv`` with anything in it."""

@@ -38,6 +38,7 @@ class TruthFree:
     agreement: pd.DataFrame | None
     assessments: list[SelfAssessment] = field(default_factory=list)
     note: str = ""
+    flags: pd.DataFrame | None = None
 
 
 def load_truth_free(run_dir: Path, p: pd.DataFrame, sequences: list[str], thr: Thresholds) -> TruthFree:
@@ -60,7 +61,26 @@ def load_truth_free(run_dir: Path, p: pd.DataFrame, sequences: list[str], thr: T
                           dtype={"dataset": str, "scan_id": str, "matcher": str}) \
         if rd.verdict_scans.is_file() else None
     agree = pd.read_csv(rd.verdict_agreement) if rd.verdict_agreement.is_file() else None
-    return TruthFree(beliefs, free, auc, v, agree, assessments, "")
+    flags = pd.read_csv(rd.verdict_flags, dtype=str) if rd.verdict_flags.is_file() else None
+    return TruthFree(beliefs, free, auc, v, agree, assessments, "", flags)
+
+
+#: flagged stretches listed per recording in the report (the rest: ``verdict_flags.csv``)
+SHOWN_FLAGS = 5
+
+
+def flags_text(flags: pd.DataFrame | None, scope: str) -> str:
+    """The recording's flagged stretches in a line or two (its odometry and scan faults)."""
+    if flags is None or scope == "all":
+        return ""
+    g = flags[flags["dataset"] == scope]
+    if not len(g):
+        return "Recording checks: no flagged stretch.\n"
+    counts = g["kind"].value_counts()
+    first = "; ".join(f"{r.kind} {r.first}…{r.last} ({r.scans} scans)" for r in g.head(SHOWN_FLAGS).itertuples())
+    more = f"; {len(g) - SHOWN_FLAGS} more in `verdict_flags.csv`" if len(g) > SHOWN_FLAGS else ""
+    return (f"Recording checks ({', '.join(f'{n} {k}' for k, n in counts.items())}; judged across, "
+            f"marked `flagged` in `verdict_scans.csv.gz`): {first}{more}.\n")
 
 
 def _ci(r) -> str:
@@ -117,7 +137,8 @@ def truth_free_section(tf: TruthFree, blind: list[str]) -> str:
         scopes = list(dict.fromkeys(tf.verdict["dataset"].astype(str)))
         for s in (["all"] if "all" in scopes else []) + [s for s in scopes if s != "all"]:
             tag = " (no ground truth)" if s in blind else ""
-            out += [f"**{'pooled' if s == 'all' else s}**{tag}:\n", verdict_table(tf.verdict, s)]
+            out += [f"**{'pooled' if s == 'all' else s}**{tag}:\n", verdict_table(tf.verdict, s),
+                    flags_text(tf.flags, s)]
     if tf.agreement is not None and len(tf.agreement):
         bad = tf.agreement[~tf.agreement["agrees"].astype(bool)]
         out.append("**The verdict against the truth** (made with the truth hidden, then checked on the scans "

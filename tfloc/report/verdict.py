@@ -8,7 +8,10 @@ re-convergence restarts are run (:mod:`tfloc.harness.restarts`), and four files 
   (:class:`~tfloc.evaluation.truthfree.judge.VerdictRow`);
 * ``verdict_scans.csv.gz``: per scan and tracker, the signals and the belief;
 * ``verdict_checks.csv`` and ``verdict_agreement.csv`` (datasets with truth only): the verdict
-  against the truth, per tracker and per recording (:mod:`tfloc.evaluation.truthfree.agreement`).
+  against the truth, per tracker and per recording (:mod:`tfloc.evaluation.truthfree.agreement`);
+* ``verdict_flags.csv``: each recording's flagged stretches (odometry stalls, jumps and gaps, scan
+  gaps, empty scans: :mod:`tfloc.evaluation.recording`, as ``tfloc check-recording`` finds them);
+  a scan inside one is marked ``flagged`` in the per-scan table, and the report names them.
 
 The truth is read only after the verdict is made, to check it. ``run.json`` records the
 verdict's configuration and the hash of the rows it judged (``verdict``), so a report can tell
@@ -21,13 +24,14 @@ import hashlib
 import json
 import math
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from tfloc.core.traits import method_of
+from tfloc.evaluation.recording import check_recording
 from tfloc.evaluation.trajectory import pooled_share
 from tfloc.evaluation.truthfree import reconverge as R
 from tfloc.evaluation.truthfree.agreement import Agreement, TrackerCheck, agreement, tracker_checks
@@ -98,6 +102,7 @@ class Verdict:
     scans: pd.DataFrame
     checks: list[TrackerCheck]
     agreements: list[Agreement]
+    flags: pd.DataFrame = field(default_factory=pd.DataFrame)
 
 
 def rows_hash(path: Path) -> str:
@@ -136,11 +141,12 @@ def _restarts(scenario, scans, rec: Recording, specs: dict[str, dict], the_map, 
     return out
 
 
-def _scan_table(rec: Recording, j: Judgement) -> pd.DataFrame:
+def _scan_table(rec: Recording, j: Judgement, flagged: np.ndarray) -> pd.DataFrame:
     m, n = j.believed.shape
     state = np.where(j.known, np.where(j.agree, "agree", "disagree"), "none")
     return pd.DataFrame({
         "dataset": rec.name, "scan_id": np.tile(rec.scan_ids, m), "matcher": np.repeat(rec.matchers, n),
+        "flagged": np.tile(flagged.astype(int), m),
         "fit": j.fit.ravel(), "best_fit": np.tile(j.best_fit, m), "consensus": state.ravel(),
         "support": j.support.ravel(), "correction_m": j.dist.ravel(), "correction_rad": j.turn.ravel(),
         "odometry_disagrees": j.odometry_disagrees.ravel().astype(int), "believed": j.believed.ravel().astype(int)})
@@ -179,9 +185,14 @@ def judge_run(run_dir: str | Path, cfg: TruthFreeConfig = DEFAULT, restarts: boo
     rd = RunDir(Path(run_dir))
     df, info = rd.results(), rd.info()
     names = [n for n in df["dataset"].unique() if n in info.datasets_in(list(df["dataset"].unique()), SEQUENCE)]
+    if not names:
+        from tfloc.errors import ResultsError
+
+        raise ResultsError(f"{run_dir}: no sequence dataset: the truth-free verdict judges trackers along "
+                           "recordings (tfloc bench on a sequence dataset first)")
     order, thr = _order(info, df), info.thresholds
     specs = {m.get("label", m.get("name")): m for m in info.matchers}
-    rows, tables, checks, agreements, beliefs = [], [], [], [], {}
+    rows, tables, checks, agreements, beliefs, flags = [], [], [], [], {}, []
     for name in names:
         scenario, by_id = load_dataset(str(info.datasets[name]))
         scans = list(by_id.values())
@@ -189,6 +200,11 @@ def judge_run(run_dir: str | Path, cfg: TruthFreeConfig = DEFAULT, restarts: boo
         if not rec.matchers:
             log(f"{name}: no tracker has a row for every scan: not judged")
             continue
+        check = check_recording(scans, scenario.laser)
+        flagged = np.zeros(len(scans), bool)
+        for f in check.flags:
+            flagged[f.first:f.last + 1] = True
+            flags.append({"dataset": name, **f.record()})
         the_map = map_of(scenario, scans[0])
         field = distance_field(the_map, cfg.field_resolution_m, cap=4 * cfg.fit_tol_m, pad=1.0)
         points = scan_points(np.stack([s.ranges for s in scans]), scenario.laser)
@@ -198,16 +214,16 @@ def judge_run(run_dir: str | Path, cfg: TruthFreeConfig = DEFAULT, restarts: boo
         mine = verdict_rows(name, rec.matchers, j, cfg, back)
         rows += mine
         beliefs.update({(name, m): j.believed[i] for i, m in enumerate(rec.matchers)})
-        tables.append(_scan_table(rec, j))
+        tables.append(_scan_table(rec, j, flagged))
         if rec.has_truth.any():
             c = tracker_checks(name, rec.matchers, [r.score_pct for r in mine], j.believed, rec.tracked,
                                rec.has_truth)
             checks += c
             agreements.append(agreement(name, c, rec.tracked, rec.has_truth))
-        log(f"{name}: judged {len(rec.matchers)} trackers over {len(scans)} scans")
+        log(f"{name}: judged {len(rec.matchers)} trackers over {len(scans)} scans ({check.summary()})")
     rows += pooled_rows(rows, beliefs)
     scans_df = pd.concat(tables, ignore_index=True) if tables else pd.DataFrame()
-    return Verdict(rows, scans_df, checks, agreements)
+    return Verdict(rows, scans_df, checks, agreements, pd.DataFrame(flags))
 
 
 def _frame(items: list) -> pd.DataFrame:
@@ -226,6 +242,10 @@ def write_verdict(run_dir: str | Path, cfg: TruthFreeConfig = DEFAULT, restarts:
             _frame(items).to_csv(path, index=False, float_format="%.6g")
         else:
             path.unlink(missing_ok=True)
+    if len(v.flags):
+        v.flags.to_csv(rd.verdict_flags, index=False)
+    else:
+        rd.verdict_flags.unlink(missing_ok=True)
     rd.update({"verdict": {"config": asdict(cfg), "restarts": restarts, "rows_sha256": rows_hash(rd.estimates)}})
     return v
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from tfloc.evaluation.headline import POOLED
+from tfloc.evaluation.headline import POOLED, TRUTH_FREE
 
 from .board import Board, Column
 
@@ -32,7 +32,8 @@ def _real(c: Column) -> bool:
 def first_run_columns(board: Board, real: bool | None = None) -> list[Column]:
     """The dataset columns (pooled left out) of the board's first run that has any, only real
     ones (``real``), only simulated ones (``not real``) or all (``None``)."""
-    cols = [c for c in board.columns if c.scope != POOLED and (real is None or _real(c) == real)]
+    cols = [c for c in board.columns if c.scope != POOLED and not c.figure and c.measure != TRUTH_FREE
+            and (real is None or _real(c) == real)]
     return [c for c in cols if c.run == cols[0].run] if cols else []
 
 
@@ -137,6 +138,25 @@ def most_often_near(board: Board, cols: list[Column], question: str, what: str) 
                                f"{len(cols)} {what}{worst}{_caveat(cols)}. From `results/{run}/`.", (run,))
 
 
+def knows_when_lost(board: Board, question: str) -> Statement:
+    """The tracker whose own confidence best detects its losses (the first run's pooled self-AUC
+    column; :mod:`tfloc.evaluation.selfassess`), and the one whose confidence says least."""
+    cols = [c for c in board.columns if c.figure == "self_auc"]
+    if not cols:
+        return Statement(question, "Not yet: no tracking run has a self-assessment (tfloc report on a run "
+                                   "with truth).")
+    c = cols[0]
+    have = sorted((m for m in board.matchers if board.cell(m, c)), key=lambda m: -board.cell(m, c).value)
+    best, worst = have[0], have[-1]
+    key = board.cell(best, c).row
+    where = "pooled over its recordings" if c.scope == POOLED else c.scope
+    return Statement(question, f"`{best}`: its own confidence flags its losses best (self-assessment AUC "
+                               f"{board.cell(best, c).value:.2f}, {where}; 0.5 is chance); least: `{worst}` "
+                               f"({board.cell(worst, c).value:.2f}). The report's self-assessment table has the "
+                               f"share of losses each catches at 1 % false alarms. From `results/{c.run}/`.",
+                     (c.run,)) if key is not None else Statement(question, "Not yet.")
+
+
 def statements(boards: dict[str, Board]) -> list[Statement]:
     """The section's statements from the leaderboards by page key (a missing page: "not yet")."""
     def b(key: str) -> Board:
@@ -146,6 +166,7 @@ def statements(boards: dict[str, Board]) -> list[Statement]:
     return [
         cheapest_as_good(track, first_run_columns(track, real=True), "Tracking a real robot",
                          "the real recordings"),
+        knows_when_lost(track, "A tracker that knows when it is lost"),
         leader(single, first_run_columns(single, real=True), "The most accurate single scan on real logs",
                "the real logs"),
         cheapest_as_good(single, first_run_columns(single, real=True), "A single scan on a small CPU budget",

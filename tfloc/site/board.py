@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from tfloc.evaluation.headline import POOLED, HeadlineRow
+from tfloc.evaluation.headline import POOLED, TRUTH_FREE, HeadlineRow
 from tfloc.report.headline import interval
 
 from .pages import Page
@@ -24,16 +24,27 @@ class Column:
     scope: str
     measure: str
     provisional: bool = False
+    figure: str = ""  # a headline row's extra figure shown instead of its measure (:data:`EXTRAS`)
 
     @property
     def key(self) -> str:
-        return f"{self.run}/{self.mode}/{self.scope}"
+        return f"{self.run}/{self.mode}/{self.scope}" + (f"/{self.figure}" if self.figure else "")
 
     @property
     def label(self) -> str:
         if self.mode == "re-timing":
             return "re-timing"
-        return "pooled" if self.scope == POOLED else self.scope
+        where = "pooled" if self.scope == POOLED else self.scope
+        if self.figure:
+            return f"{EXTRAS[self.figure][0]} ({where})"
+        return f"{where} (no truth)" if self.measure == TRUTH_FREE else where
+
+
+#: a tracking row's extra figures, each its own column: field → (label, what it is, format)
+EXTRAS = {"truth_free_score": ("truth-free", "the truth-free verdict made with the truth hidden "
+                               "(believed tracked %, docs/truth-free.md)", "{:.1f}"),
+          "self_auc": ("self-AUC", "the tracker's own confidence as a lost-detector (ROC AUC against "
+                       "not tracked; 0.5 = chance)", "{:.2f}")}
 
 
 @dataclass(frozen=True)
@@ -105,9 +116,23 @@ def _columns(rr: RunRows, modes: tuple[str, ...], short: bool) -> list[Column]:
             scopes = [POOLED] + [s for s in scopes if s != POOLED]
         if short and scopes:
             scopes = scopes[:1]
-        measure = rows[0].measure if rows else ""
-        out += [Column(rr.name, mode, s, measure, rr.provisional) for s in scopes]
+        measure = {r.scope: r.measure for r in rows}
+        cols = [Column(rr.name, mode, s, measure[s], rr.provisional) for s in scopes]
+        if not short and cols and measure[cols[0].scope] != TRUTH_FREE:  # the first column's extras
+            top = [r for r in rows if r.scope == cols[0].scope]
+            cols[1:1] = [Column(rr.name, mode, cols[0].scope, measure[cols[0].scope], rr.provisional, f)
+                         for f in EXTRAS if any(math.isfinite(getattr(r, f)) for r in top)]
+        out += cols
     return out
+
+
+def extra_cell(r: HeadlineRow, run: str, figure: str) -> Cell | None:
+    """The cell of one of a headline row's extra figures (:data:`EXTRAS`), or ``None`` (NaN)."""
+    v = getattr(r, figure)
+    if not math.isfinite(v):
+        return None
+    label, about, fmt = EXTRAS[figure]
+    return Cell(v, fmt.format(v), "", f"{label}: {fmt.format(v)}, {about}", False, run, r)
 
 
 def order(matchers: dict[str, tuple[int, int]]) -> list[str]:
@@ -130,9 +155,15 @@ def headline_board(page: Page, runs: dict[str, RunRows], short: bool = False) ->
         for col in _columns(rr, ref.modes, short):
             columns.append(col)
             for r in rr.rows:
-                if (r.mode, r.scope) == (col.mode, col.scope):
-                    cells[(r.matcher, col.key)] = headline_cell(r, rr.name)
-                    first.setdefault(r.matcher, (len(columns) - 1, r.rank))
+                if (r.mode, r.scope) != (col.mode, col.scope):
+                    continue
+                if col.figure:
+                    c = extra_cell(r, rr.name, col.figure)
+                    if c is not None:
+                        cells[(r.matcher, col.key)] = c
+                    continue
+                cells[(r.matcher, col.key)] = headline_cell(r, rr.name)
+                first.setdefault(r.matcher, (len(columns) - 1, r.rank))
     return Board(page.key, page.title, columns, order(first), cells)
 
 

@@ -29,6 +29,8 @@ class SiteData:
     boards: dict[str, Board] = field(default_factory=dict)
     statements: list[Statement] = field(default_factory=list)
     targets: str = ""  #: the tracking targets, checked (Markdown; :mod:`tfloc.site.targets`)
+    truth_free: str = ""  #: the truth-free verdict against the truth (Markdown; :mod:`tfloc.site.truthfree`)
+    self_assessment: str = ""  #: every tracker's self-assessment (Markdown)
 
 
 def _csv(path: Path) -> pd.DataFrame | None:
@@ -56,7 +58,20 @@ def collect(root: Path, quick: bool = False, pages: list[Page] | None = None) ->
         data.boards[f"{p.key}-short"] = headline_board(p, runs, short=True)
     data.statements = statements(data.boards)
     data.targets = _targets(root, runs)
+    data.truth_free, data.self_assessment = _truth_free(root)
     return data
+
+
+def _truth_free(root: Path) -> tuple[str, str]:
+    """The truth-free blocks from the runs of :data:`tfloc.site.truthfree.RUNS`."""
+    from tfloc.io.rundir import RunDir
+
+    from .truthfree import DEV_RUN, RUNS, agreement_markdown, selfassess_markdown
+
+    agree = {r: t for r in RUNS if (t := _csv(root / r / "verdict_agreement.csv")) is not None}
+    assess = {r: t for r in RUNS if (t := _csv(root / r / "selfassess.csv")) is not None}
+    dev = set(RunDir(root / DEV_RUN).info().datasets) if (root / DEV_RUN / "run.json").is_file() else set()
+    return agreement_markdown(agree, dev), selfassess_markdown(assess)
 
 
 def _reported(root: Path, runs: dict[str, RunRows], name: str) -> RunRows | None:

@@ -1,7 +1,8 @@
 """The leaderboards and statements as Markdown, for the README's and docs' generated blocks:
 the text between ``<!-- tfloc:begin NAME -->`` and ``<!-- tfloc:end NAME -->`` is replaced by
 block NAME (a page key: its full board; ``KEY-short``: the README's short table; ``cost``,
-``cost-slopes``; ``advice``: the statements; ``targets``: the tracking targets, checked). The
+``cost-slopes``; ``advice``: the statements; ``targets``: the tracking targets, checked;
+``truth-free``, ``self-assessment``: :mod:`tfloc.site.truthfree`). The
 cells are the site's: the figure with its 95 % interval (bold where the paired test puts the
 column's first ahead of the next) and the CPU per scan."""
 
@@ -20,6 +21,7 @@ from .pages import COST
 BLOCK = re.compile(r"(<!-- tfloc:begin (?P<name>[\w.-]+) -->\n)(?P<body>.*?)(<!-- tfloc:end (?P=name) -->)", re.S)
 ADVICE = "advice"
 TARGETS = "targets"
+TRUTH_FREE, SELF_ASSESSMENT = "truth-free", "self-assessment"
 #: rows of a README table (``KEY-short``): the first matchers of its first column
 SHORT_ROWS = 4
 
@@ -65,9 +67,13 @@ def block(name: str, data: SiteData) -> str:
         return advice_markdown(data)
     if name == TARGETS:
         return data.targets
+    if name == TRUTH_FREE:
+        return data.truth_free
+    if name == SELF_ASSESSMENT:
+        return data.self_assessment
     if name in data.boards:
         return board_markdown(data.boards[name], data, short=name.endswith("-short"))
-    raise ConfigError(f"unknown generated block {name!r}; known: {', '.join([ADVICE, TARGETS, *data.boards])}")
+    raise ConfigError(f"unknown generated block {name!r}; known: {', '.join([ADVICE, TARGETS, TRUTH_FREE, SELF_ASSESSMENT, *data.boards])}")
 
 
 def block_names(text: str) -> list[str]:

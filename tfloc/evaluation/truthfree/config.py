@@ -39,3 +39,13 @@ class TruthFreeConfig:
     block_scans: int = 50  #: the interval's bootstrap resamples blocks of this many consecutive scans
     resamples: int = 2000  #: bootstrap resamples
     seed: int = 0  #: seeds the restarts' directions and the bootstrap
+
+    def __post_init__(self) -> None:
+        from tfloc.errors import ConfigError
+
+        for rule, keys in self.RULES.items():
+            for k in keys:
+                v = getattr(self, k)
+                ok = v > 0 if rule == "> 0" else v >= 1 if rule == ">= 1" else 0 <= v <= 1
+                if not (isinstance(v, int | float) and math.isfinite(v) and ok):
+                    raise ConfigError(f"truth-free verdict: {k} must be {rule}, got {v!r}")
