@@ -97,7 +97,7 @@ def test_timing_pass_interleaves_matchers_and_restores_the_affinity(small_run):
 
 def test_timing_cli_writes_csv_and_markdown_and_the_report_links_it(small_run):
     r = subprocess.run([sys.executable, "-m", "tfloc.cli", "timing", str(small_run), "--per-stratum", "1",
-                        "--warmup", "1", "--reference", "o3d-icp"], cwd=ROOT, env=ENV, capture_output=True,
+                        "--warmup", "1", "--reference", "o3d-icp", "--allow-contended"], cwd=ROOT, env=ENV, capture_output=True,
                        text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     md = (small_run / "timing.md").read_text()
@@ -126,7 +126,7 @@ def _doc(run_dir: Path) -> dict:
 
 def test_a_complete_timing_pass_is_not_timed_again(small_run, tmp_path, monkeypatch, capsys):
     run_dir = _copy(small_run, tmp_path)
-    timing_pass(run_dir, 1, 1, log=lambda s: None)
+    timing_pass(run_dir, 1, 1, allow_contended=True, log=lambda s: None)
     record = _doc(run_dir)["timing"]
     assert record["complete"] and record["fingerprint"]["run"] == _doc(run_dir)["fingerprint"]
     assert {k: record["fingerprint"][k] for k in ("per_stratum", "warmup", "reference")} == {
@@ -138,18 +138,18 @@ def test_a_complete_timing_pass_is_not_timed_again(small_run, tmp_path, monkeypa
 
     monkeypatch.setattr("tfloc.report.timing_pass.run_timing", no_timing)
     logged: list[str] = []
-    assert timing_pass(run_dir, 1, 1, log=logged.append) == run_dir
+    assert timing_pass(run_dir, 1, 1, allow_contended=True, log=logged.append) == run_dir
     assert logged == [f"{run_dir}: already complete: timing.md is current (--regenerate times it again)"]
-    assert main(["timing", str(run_dir), "--per-stratum", "1", "--warmup", "1"]) == 0
+    assert main(["timing", str(run_dir), "--per-stratum", "1", "--warmup", "1", "--allow-contended"]) == 0
     assert "already complete: timing.md is current" in capsys.readouterr().err
     assert {f: (run_dir / f).read_bytes() for f in before} == before
 
 
 def test_another_configuration_or_a_changed_run_is_timed_again(small_run, tmp_path):
     run_dir = _copy(small_run, tmp_path)
-    timing_pass(run_dir, 1, 1, log=lambda s: None)
+    timing_pass(run_dir, 1, 1, allow_contended=True, log=lambda s: None)
     logged: list[str] = []
-    timing_pass(run_dir, 2, 1, log=logged.append)
+    timing_pass(run_dir, 2, 1, allow_contended=True, log=logged.append)
     assert logged[0] == f"{run_dir}: timing again: per_stratum 1 → 2"
     assert len(pd.read_csv(run_dir / "timing.csv")) == 2 * 2 * 3 and "2 scan(s) per dataset" in (
         run_dir / "timing.md").read_text()
@@ -159,28 +159,28 @@ def test_another_configuration_or_a_changed_run_is_timed_again(small_run, tmp_pa
     doc["fingerprint"]["success"]["dist_m"] = 0.2
     (run_dir / "run.json").write_text(json.dumps(doc))
     logged.clear()
-    timing_pass(run_dir, 2, 1, log=logged.append)
+    timing_pass(run_dir, 2, 1, allow_contended=True, log=logged.append)
     assert logged[0] == f"{run_dir}: timing again: the run changed (success dist_m 0.1 → 0.2)"
     doc = _doc(run_dir)                       # a pass cut off before it finished
     doc["timing"]["complete"] = False
     (run_dir / "run.json").write_text(json.dumps(doc))
     logged.clear()
-    timing_pass(run_dir, 2, 1, log=logged.append)
+    timing_pass(run_dir, 2, 1, allow_contended=True, log=logged.append)
     assert logged[0] == f"{run_dir}: timing again: the last timing pass did not finish"
     logged.clear()
-    timing_pass(run_dir, 2, 1, regenerate=True, log=logged.append)
+    timing_pass(run_dir, 2, 1, regenerate=True, allow_contended=True, log=logged.append)
     assert logged[0] == f"{run_dir}: timing again (--regenerate)"
     assert len(_doc(run_dir)["timing"]["sessions"]) == 1
 
 
 def test_bench_keeps_a_current_timing_pass_and_regenerate_removes_it(small_run, tmp_path):
     run_dir = _copy(small_run, tmp_path)
-    timing_pass(run_dir, 1, 1, log=lambda s: None)
+    timing_pass(run_dir, 1, 1, allow_contended=True, log=lambda s: None)
     ds = Path(next(iter(_doc(run_dir)["datasets"].values())))
     run(_config(ds, run_dir), progress=False)      # complete: nothing runs, a session is recorded
     assert _doc(run_dir)["timing"]["complete"] and len(_doc(run_dir)["sessions"]) == 2
     logged: list[str] = []
-    timing_pass(run_dir, 1, 1, log=logged.append)
+    timing_pass(run_dir, 1, 1, allow_contended=True, log=logged.append)
     assert logged == [f"{run_dir}: already complete: timing.md is current (--regenerate times it again)"]
     run(_config(ds, run_dir, MatcherSpec.make("toy_matchers:Stay", label="stay")), progress=False, regenerate=True)
     assert not (run_dir / "timing.csv").exists() and not (run_dir / "timing.md").exists()
@@ -233,7 +233,7 @@ def test_a_tracking_run_is_timed_step_by_step_side_by_side(tmp_path):
     ds = _copy(tmp_path / "q", 30)
     out = run(cfg(ds, tmp_path / "run", MatcherSpec.make("tf-plus-track"), MatcherSpec.make("odometry"),
                   jobs=1, timeout_s=60.0), progress=False)
-    timing_pass(out, per_stratum=1, warmup=0, log=lambda s: None)
+    timing_pass(out, per_stratum=1, warmup=0, allow_contended=True, log=lambda s: None)
     rows = pd.read_csv(out / "timing.csv")
     assert len(rows) == 30 * 2 and set(rows["matcher"]) == {"tf-plus-track", "odometry"}
     assert rows["scan_id"].nunique() == 30

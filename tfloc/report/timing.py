@@ -8,6 +8,7 @@ from pathlib import Path
 import pandas as pd
 
 from tfloc.core.timing_rows import TimingRow
+from tfloc.evaluation.contention import MAX_INFLATION, Contention, describe, mark
 from tfloc.io.atomic import replace_atomically
 from tfloc.io.rundir import RunDir
 from tfloc.io.timing_rows import write_rows
@@ -38,6 +39,32 @@ def _code_line(info: dict) -> str:
             "re-times the matchers as they are now; their answers are not compared here).")
 
 
+def run_inflation_line(summary: pd.DataFrame) -> str:
+    """Whether the run's own CPU times were inflated: the spread of ``run / quiet`` over the
+    matchers, said inflated where any is above :data:`~tfloc.evaluation.contention.MAX_INFLATION`
+    (empty when the run recorded no CPU times)."""
+    r = pd.to_numeric(summary["run_over_quiet"], errors="coerce").dropna()
+    if r.empty:
+        return ""
+    over = summary.loc[r[r > MAX_INFLATION].index, "matcher"].tolist()
+    spread = f"×{r.min():.2f}–{r.max():.2f}" if r.min() != r.max() else f"×{r.max():.2f}"
+    if not over:
+        return f"- The run's own CPU times: not inflated against this pass (run / quiet {spread})."
+    return (f"- **The run's own CPU times are inflated** against this pass: run / quiet {spread}, above "
+            f"×{MAX_INFLATION:g} for {', '.join(f'`{m}`' for m in over)} (the machine was busier during "
+            "the run; read its CPU column through these ratios).")
+
+
+def contention_line(info: dict) -> str:
+    """The pass's contention (:func:`~tfloc.evaluation.contention.describe`), a warning first when
+    it ran contended; an older pass's: not measured."""
+    c = Contention.from_record(info.get("contention"))
+    if c is not None and c.contended:
+        return (f"- **This pass ran {mark(c)}**: its milliseconds are not the quiet machine's "
+                f"(ratios between matchers hold better). {describe(c)}.")
+    return f"- Contention: {describe(c)}."
+
+
 def timing_markdown(run_name: str, summary: pd.DataFrame, reference: str, info: dict) -> str:
     """The markdown of a timing pass: how it was made, then one row per matcher."""
     has_run = summary["run_cpu_median_ms"].notna().any()
@@ -55,8 +82,10 @@ def timing_markdown(run_name: str, summary: pd.DataFrame, reference: str, info: 
     if has_run:
         headers += ["run's CPU median, same scans (ms)", "run / quiet"]
     cores = ", ".join(str(c) for c in info.get("cores", [])) or "not pinned"
+    title = f"# Timing pass: {run_name}" + (f" ({m})" if (m := mark(Contention.from_record(
+        info.get("contention")))) else "")
     return "\n".join([
-        f"# Timing pass: {run_name}\n",
+        f"{title}\n",
         f"All matchers of the run re-timed side by side on a stratified sample of its scans: "
         f"{info['per_stratum']} scan(s) per dataset × group ({info['strata']} strata, {info['scans']} scans, "
         f"seed {info['seed']}), drawn from the scans every matcher answered in the run. One process pinned to "
@@ -66,11 +95,13 @@ def timing_markdown(run_name: str, summary: pd.DataFrame, reference: str, info: 
         f"(medians: resampling times; ratios: resampling scans, paired).\n",
         f"- Started {info.get('started', '?')}; load average (1 min) at the start {_load(info.get('loadavg_start'))}, "
         f"at the end {_load(info.get('loadavg_end'))}.",
+        contention_line(info),
         _code_line(info),
         f"- Reference matcher for the ratios: `{reference}`.",
         "- `run / quiet`: the run's own median CPU time on the same scans over this pass's; near 1 "
         "when the run's CPU times can be trusted." if has_run else
         "- The run recorded no CPU times (made before `cpu_s`), so it cannot be compared.",
+        *([line] if (line := run_inflation_line(summary)) else []),
         "",
         table(headers, rows)])
 
