@@ -9,9 +9,10 @@ import pandas as pd
 
 from tfloc.core.timing_rows import TimingRow
 from tfloc.evaluation.contention import MAX_INFLATION, Contention, describe, mark
+from tfloc.evaluation.timing import timing_summary
 from tfloc.io.atomic import replace_atomically
 from tfloc.io.rundir import RunDir
-from tfloc.io.timing_rows import write_rows
+from tfloc.io.timing_rows import read_rows, rows_frame, write_rows
 
 from .mdtable import num, table
 
@@ -39,7 +40,7 @@ def _code_line(info: dict) -> str:
             "re-times the matchers as they are now; their answers are not compared here).")
 
 
-def run_inflation_line(summary: pd.DataFrame) -> str:
+def run_inflation_line(summary: pd.DataFrame, against: str = "this pass") -> str:
     """Whether the run's own CPU times were inflated: the spread of ``run / quiet`` over the
     matchers, said inflated where any is above :data:`~tfloc.evaluation.contention.MAX_INFLATION`
     (empty when the run recorded no CPU times)."""
@@ -49,10 +50,30 @@ def run_inflation_line(summary: pd.DataFrame) -> str:
     over = summary.loc[r[r > MAX_INFLATION].index, "matcher"].tolist()
     spread = f"×{r.min():.2f}–{r.max():.2f}" if r.min() != r.max() else f"×{r.max():.2f}"
     if not over:
-        return f"- The run's own CPU times: not inflated against this pass (run / quiet {spread})."
-    return (f"- **The run's own CPU times are inflated** against this pass: run / quiet {spread}, above "
+        return f"- The run's own CPU times: not inflated against {against} (run / quiet {spread})."
+    return (f"- **The run's own CPU times are inflated** against {against}: run / quiet {spread}, above "
             f"×{MAX_INFLATION:g} for {', '.join(f'`{m}`' for m in over)} (the machine was busier during "
             "the run; read its CPU column through these ratios).")
+
+
+def run_cpu_note(run_dir: Path, df: pd.DataFrame) -> list[str]:
+    """The report's line on the run's own CPU times against its timing pass (``timing.csv``;
+    :func:`run_inflation_line`), the pass's contention mark beside it; none without a pass or CPU
+    times. ``df``: the run's rows (``cpu_s``, or a prepared table's ``cpu_ms``)."""
+    rd = RunDir(run_dir)
+    rows = read_rows(rd.timing_csv, TimingRow)
+    if not rows:
+        return []
+    if "cpu_s" not in df and "cpu_ms" in df:
+        df = df.assign(cpu_s=pd.to_numeric(df["cpu_ms"], errors="coerce") / 1000.0)
+    t = rows_frame(rows, TimingRow)
+    line = run_inflation_line(timing_summary(t, str(t["matcher"].iloc[0]), df),
+                              "its timing pass ([timing.md](timing.md), same scans)")
+    sessions = ((rd.info().timing or {}).get("sessions") or [{}])
+    c = Contention.from_record(sessions[-1].get("contention") if isinstance(sessions[-1], dict) else None)
+    tail = (" The timing pass's own contention was not measured (made before the contention probe)."
+            if c is None else f" The timing pass itself ran {mark(c)}." if c.contended else "")
+    return [line + tail] if line else []
 
 
 def contention_line(info: dict) -> str:

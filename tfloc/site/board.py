@@ -24,6 +24,7 @@ class Column:
     scope: str
     measure: str
     provisional: bool = False
+    note: str = ""  #: shown after the label, e.g. a re-timing's ``contended (×1.42 inflated)``
 
     @property
     def key(self) -> str:
@@ -32,7 +33,7 @@ class Column:
     @property
     def label(self) -> str:
         if self.mode == "re-timing":
-            return "re-timing"
+            return "re-timing" + (f", {self.note}" if self.note else "")
         return "pooled" if self.scope == POOLED else self.scope
 
 
