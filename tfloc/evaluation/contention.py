@@ -108,7 +108,8 @@ def assess(reference_ms: list[float], rounds_ms: list[float], busy_s: float, own
     ref = [v for v in reference_ms if v > 0]
     rounds = [v for v in rounds_ms if v > 0]
     every = ref + rounds
-    neighbours = max(0.0, (busy_s - own_s) / wall_s) if wall_s > 0 else math.nan
+    neighbours = (busy_s - own_s) / wall_s if wall_s > 0 else math.nan
+    neighbours = neighbours if math.isnan(neighbours) else max(0.0, neighbours)  # max() keeps 0 over NaN
     return Contention(
         calib_quiet_ms=float(min(ref)) if ref else math.nan,
         calib_min_ms=float(min(every)) if every else math.nan,
