@@ -7,7 +7,7 @@ cache-bound like the matchers' look-ups in distance fields and lattices, determi
 allocation beyond its output. :class:`Probe` times it :data:`REFERENCE` times at the start of a
 pass (the quiet reference) and once per round (a round: one scan or step, every matcher once),
 and reads ``/proc/stat`` (the machine's busy and stolen jiffies, all cores) and ``os.times``
-(this process's own user + system time) at the start and the end. A child process the pass does
+(this process's own user + system time, with its waited-for children's) at the start and the end. A child the pass does
 not wait for counts as a neighbour.
 
 ``python -m tfloc.harness.contention [SECONDS] [--core N]`` runs the probe alone, pinned, for
@@ -82,7 +82,7 @@ def read() -> Reading:
             busy, steal = parse_proc_stat(fh.read(), os.sysconf("SC_CLK_TCK"))
     except (OSError, ValueError):
         busy = steal = math.nan
-    return Reading(time.perf_counter(), busy, steal, t.user + t.system)
+    return Reading(time.perf_counter(), busy, steal, t.user + t.system + t.children_user + t.children_system)
 
 
 class Probe:

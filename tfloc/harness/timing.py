@@ -39,6 +39,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from tfloc.core.jsonable import jsonable
 from tfloc.core.matcher import get_matcher
 from tfloc.core.timing_rows import TimingRow
 from tfloc.errors import ConfigError
@@ -134,7 +135,7 @@ def timing_fingerprint(run_fingerprint: dict | None, params: TimingParams, sampl
     keys = "\n".join(f"{d}\t{s}" for d, s in zip(sample["dataset"], sample["scan_id"], strict=True))
     fp = {"run": run_fingerprint, "tfloc": tfloc_code(), **asdict(params),
           "sample": hashlib.sha256(keys.encode()).hexdigest()}
-    return json.loads(json.dumps(fp, default=str))
+    return jsonable(fp)
 
 
 def stale(rd: RunDir, record: dict | None, fp: dict) -> list[str]:
