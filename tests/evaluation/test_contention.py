@@ -29,7 +29,7 @@ def test_inflation_is_the_rounds_median_over_the_minimum_and_neighbours_exclude_
     assert c.neighbour_cores == pytest.approx(0.5) and c.steal_cores == pytest.approx(0.05)
     assert c.contended and c.reasons() == ["calibration ×1.40 its minimum", "neighbours used 0.50 core"]
     assert mark(c) == "contended (×1.40 inflated)"
-    assert describe(c).startswith("CONTENDED (") and "limits ×1.15 and 0.25 core" in describe(c)
+    assert describe(c).startswith("CONTENDED (") and "limits ×1.25 and 0.25 core" in describe(c)
     # a round faster than the reference lowers the minimum; a non-positive reading is ignored
     d = assess([5.0], [4.0, 4.2, 0.0, -1.0], 10.0, 9.9, 10.0)
     assert d.calib_min_ms == 4.0 and d.rounds == 2 and d.neighbour_cores == pytest.approx(0.01)
@@ -55,9 +55,9 @@ def test_unreadable_proc_stat_leaves_the_calibration_signal():
 
 
 def test_the_record_round_trips_and_older_records_are_not_measured():
-    c = assess([5.0], [5.0, 7.0], 12.0, 10.0, 10.0)
+    c = assess([5.0], [5.0, 8.0], 12.0, 10.0, 10.0)
     r = c.to_record()
-    assert r["contended"] is True and r["inflation"] == pytest.approx(1.2)
+    assert r["contended"] is True and r["inflation"] == pytest.approx(1.3)
     assert Contention.from_record(r) == c and Contention.from_record(r).contended
     assert r["steal_cores"] is None  # NaN is written as null
     for old in (None, "high", [1, 2]):

@@ -1,8 +1,9 @@
 """The contention probe: a fixed calibration workload timed beside the matchers, and the machine's
 busy time over a pass (the verdict's rules: :mod:`tfloc.evaluation.contention`).
 
-The workload (:func:`calibrate`, ≈5 ms) gathers a fixed pseudo-random permutation of a 4 MB
-float32 table (about the last-level cache a core gets here) and sums it: memory- and
+The workload (:func:`calibrate`, ≈5 ms) gathers a fixed pseudo-random permutation of a 1 MB
+float32 table (a core's L2 here; a 4 MB table varied ×1.16–1.19 median / minimum on the quiet
+machine, this one ×1.03) and sums it, 14 times: memory- and
 cache-bound like the matchers' look-ups in distance fields and lattices, deterministic, no
 allocation beyond its output. :class:`Probe` times it :data:`REFERENCE` times at the start of a
 pass (the quiet reference) and once per round (a round: one scan or step, every matcher once),
@@ -28,8 +29,9 @@ from tfloc.evaluation.contention import Contention, assess
 
 from .runner import load_average
 
-TABLE = 1 << 20       # float32 entries: 4 MB
-GATHER = 1 << 20      # look-ups per call (a permutation of the table)
+TABLE = 1 << 18       # float32 entries: 1 MB (a core's L2 here)
+GATHER = 1 << 18      # look-ups per gather (a permutation of the table)
+REPEAT = 14           # gathers per call: ≈5 ms
 REFERENCE = 15        # calibration calls of the quiet reference at the start of a pass
 
 
@@ -45,10 +47,9 @@ def calibrate() -> float:
     """Run the calibration workload once; its CPU time (ms)."""
     table, index, out = _workload()
     t0 = time.process_time()
-    np.take(table, index, out=out)
-    out.sum()
-    np.take(table, index[::-1], out=out)
-    out.sum()
+    for _ in range(REPEAT):
+        np.take(table, index, out=out)
+        out.sum()
     return 1000.0 * (time.process_time() - t0)
 
 
