@@ -11,9 +11,18 @@ RUN/run.json records the pass (its fingerprint: the run's, --per-stratum, --seed
 complete and current, it says so and times nothing; a pass of other options, a run whose rows
 or code changed, or an interrupted pass is timed again; --regenerate always times again.
 
+A contention probe (a fixed calibration workload timed before each scan's matchers, and the
+machine's busy time) says whether the pass ran contended (tfloc.evaluation.contention): such a
+pass is timed again after --wait seconds, --retries times, then refused (exit 2, nothing
+written); with --allow-contended it is written at once and marked contended in timing.md, the
+site and run.json. --verify re-times the committed pass's scans now (--per-stratum N: the first N
+of each stratum), writes nothing, prints the ratio now / committed per matcher and exits 1 if any
+lies outside ×1.3.
+
 Examples:
   tfloc timing results/paper-protocol
   tfloc timing results/paper-protocol --per-stratum 10 --cores 1 --reference o3d-icp
+  tfloc timing results/paper-protocol --verify
 """
 
 from __future__ import annotations
@@ -44,12 +53,21 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--warmup", type=int, default=None, help="untimed localize calls per dataset and matcher (default 2)")
     p.add_argument("--regenerate", action="store_true",
                    help="time again even if the run's timing pass is complete and current")
+    p.add_argument("--allow-contended", action="store_true",
+                   help="keep a pass the contention probe finds contended (marked so) instead of retrying and refusing it")
+    p.add_argument("--retries", type=int, default=None, help="times a contended pass is timed again before "
+                   "it is refused (default 2)")
+    p.add_argument("--wait", type=float, default=None, help="seconds before each of those tries (default 60)")
+    p.add_argument("--verify", action="store_true", help="re-time the committed pass's scans now and "
+                   "compare (exit 1 if a matcher's ratio lies outside ×1.3); writes nothing")
 
 
 def run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
-    from tfloc.report.timing_pass import timing_pass
+    from tfloc.errors import ConfigError
+    from tfloc.report.timing_pass import RETRIES, WAIT_S, timing_pass
+    from tfloc.report.timing_verify import verify_pass
 
     bars: list[tqdm] = []  # made at the first scan timed (none when the pass is current)
 
@@ -58,9 +76,18 @@ def run(args: argparse.Namespace) -> int:
             bars.append(tqdm(total=total, unit="scan", desc="timing", disable=not sys.stderr.isatty()))
         bars[0].update(done - bars[0].n)
 
+    retries = RETRIES if args.retries is None else args.retries
+    wait_s = WAIT_S if args.wait is None else args.wait
+    if retries < 0 or wait_s < 0:
+        raise ConfigError(f"--retries and --wait must be ≥ 0, got {retries} and {wait_s:g}")
     try:
+        if args.verify:
+            return 0 if verify_pass(args.run, args.per_stratum, args.cores, log=print,
+                                    allow_contended=args.allow_contended, retries=retries, wait_s=wait_s,
+                                    progress=progress) else 1
         timing_pass(args.run, args.per_stratum, args.warmup, args.reference, args.regenerate, progress,
-                    seed=args.seed, cores=args.cores, log=lambda s: tqdm.write(s, file=sys.stderr))
+                    seed=args.seed, cores=args.cores, log=lambda s: tqdm.write(s, file=sys.stderr),
+                    allow_contended=args.allow_contended, retries=retries, wait_s=wait_s)
     finally:
         for bar in bars:
             bar.close()

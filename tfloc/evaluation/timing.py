@@ -58,3 +58,22 @@ def timing_summary(t: pd.DataFrame, reference: str, run: pd.DataFrame | None = N
                 row["run_over_quiet"] = row["run_cpu_median_ms"] / float(np.median(cpu[m].reindex(same.index)))
         rows.append(row)
     return pd.DataFrame(rows, columns=TIMING_SUMMARY_COLUMNS)
+
+
+VERIFY_COLUMNS = ["matcher", "n", "committed_ms", "now_ms", "ratio"]
+
+
+def verify_ratios(committed: pd.DataFrame, now: pd.DataFrame) -> pd.DataFrame:
+    """Per matcher (in ``now``'s order), its median CPU ms over the scans both passes timed, in the
+    committed pass and now, and their ratio now / committed; columns :data:`VERIFY_COLUMNS`. Both
+    frames hold a pass's rows (dataset, scan_id, matcher, cpu_ms)."""
+    keys = ["dataset", "scan_id", "matcher"]
+    both = now[keys + ["cpu_ms"]].merge(committed[keys + ["cpu_ms"]], on=keys, suffixes=("_now", "_then"))
+    rows = []
+    for m in dict.fromkeys(now["matcher"]):
+        g = both[both["matcher"] == m]
+        then = float(np.median(g["cpu_ms_then"])) if len(g) else np.nan
+        cur = float(np.median(g["cpu_ms_now"])) if len(g) else np.nan
+        rows.append({"matcher": m, "n": len(g), "committed_ms": then, "now_ms": cur,
+                     "ratio": cur / then if then > 0 else np.nan})
+    return pd.DataFrame(rows, columns=VERIFY_COLUMNS)

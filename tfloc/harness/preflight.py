@@ -11,11 +11,11 @@ tasks, fingerprint and ``run.json`` from.
 from __future__ import annotations
 
 import dataclasses
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from tfloc.core.jsonable import jsonable
 from tfloc.core.matcher import factory_of
 from tfloc.core.presets import resolve
 from tfloc.errors import ConfigError, LibraryMissingError, MatcherError, ParameterError
@@ -43,7 +43,7 @@ def build_matcher(spec: MatcherSpec) -> dict[str, Any]:
                           f"{spec.params}: {type(exc).__name__}: {exc}") from None
     cfg = getattr(m, "config", None)
     if dataclasses.is_dataclass(cfg) and not isinstance(cfg, type):
-        return json.loads(json.dumps(dataclasses.asdict(cfg), default=str))
+        return jsonable(cfg)
     return spec.params
 
 

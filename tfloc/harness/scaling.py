@@ -24,11 +24,10 @@ the directory alone.
 from __future__ import annotations
 
 import gc
-import json
 import time
-from dataclasses import asdict
 from pathlib import Path
 
+from tfloc.core.jsonable import jsonable
 from tfloc.core.matcher import Matcher
 from tfloc.core.timing_rows import MAP, PrepRow, ScanRow, SkipRow
 from tfloc.errors import ConfigError, ResultsError
@@ -69,7 +68,7 @@ def study_doc(cfg: StudyConfig, name: str, matchers: list[str], fp: dict, levels
               done: set[str], command: str) -> dict:
     """``run.json`` of a study but for its sessions (module notes)."""
     config = {"kind": KIND, "name": name, "matchers": [{"label": n, "name": n, "params": {}} for n in matchers],
-              "success": THRESHOLDS.to_dict(), "scaling": json.loads(json.dumps(asdict(cfg)))}
+              "success": THRESHOLDS.to_dict(), "scaling": jsonable(cfg)}
     return {"config": config, **environment(), "datasets": {Path(cfg.map_path).stem: cfg.map_path},
             "fingerprint": fp, "command": command, "levels": [lv.key for lv in levels],
             "done": [lv.key for lv in levels if lv.key in done]}

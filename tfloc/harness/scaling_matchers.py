@@ -18,6 +18,7 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
+from tfloc.core.jsonable import jsonable
 from tfloc.core.matcher import Matcher, available_matchers, get_matcher, solves_global
 from tfloc.core.tracker import has_single_scan_mode
 from tfloc.errors import ConfigError, LibraryMissingError, ResultsError
@@ -75,7 +76,7 @@ def study_fingerprint(cfg: StudyConfig, matchers: Sequence[str]) -> dict[str, An
     fp = {"tfloc": tfloc_code(), "datasets": {"map": {path.name: _sha256(path)}},
           "matchers": {n: matcher_record(MatcherSpec.make(n)) for n in matchers},
           "success": THRESHOLDS.to_dict(), "scaling": asdict(cfg)}
-    return json.loads(json.dumps(fp, default=str))
+    return jsonable(fp)
 
 
 def study_differences(old: dict | None, new: dict) -> list[str]:

@@ -14,6 +14,9 @@ conditions:
 * **Warm-up**: for each dataset and matcher, :func:`tfloc.harness.workspace.warm` and ``warmup``
   untimed ``localize`` calls on sampled scans (kernels, map-only structures, the allocator).
 * Each call is timed by CPU time (``time.process_time``) and wall time (``time.perf_counter``).
+* **Contention probe** (:mod:`tfloc.harness.contention`): a fixed calibration workload timed at
+  the start and before each scan's (or step's) matchers, and the machine's busy time over the
+  pass; :mod:`tfloc.evaluation.contention` says whether the pass ran contended.
 
 :func:`run_timing` returns one :class:`~tfloc.core.timing_rows.TimingRow` per (scan, matcher).
 A pass is one configuration (:func:`timing_fingerprint`: the run's fingerprint, the pass's
@@ -36,6 +39,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from tfloc.core.jsonable import jsonable
 from tfloc.core.matcher import get_matcher
 from tfloc.core.timing_rows import TimingRow
 from tfloc.errors import ConfigError
@@ -43,6 +47,7 @@ from tfloc.evaluation.timing import reference_of
 from tfloc.io.rundir import RunDir, RunInfo
 from tfloc.io.scenario import SEQUENCE
 
+from .contention import Probe
 from .fingerprint import differences
 from .identity import git_state, tfloc_code
 from .pinning import pinned, rotated
@@ -130,7 +135,7 @@ def timing_fingerprint(run_fingerprint: dict | None, params: TimingParams, sampl
     keys = "\n".join(f"{d}\t{s}" for d, s in zip(sample["dataset"], sample["scan_id"], strict=True))
     fp = {"run": run_fingerprint, "tfloc": tfloc_code(), **asdict(params),
           "sample": hashlib.sha256(keys.encode()).hexdigest()}
-    return json.loads(json.dumps(fp, default=str))
+    return jsonable(fp)
 
 
 def stale(rd: RunDir, record: dict | None, fp: dict) -> list[str]:
@@ -163,7 +168,9 @@ def run_timing(run_dir: Path, per_stratum: int = PER_STRATUM, seed: int = SEED, 
     to ``cores`` (default: the last core this process may run on).
 
     Returns the rows (times in ms) and a provenance dict (cores, load averages, sample size,
-    seed). ``run``: the run's rows and ``run.json`` if the caller has already read them
+    seed, ``contention``: the probe's figures as
+    :meth:`~tfloc.evaluation.contention.Contention.to_record` gives them). ``run``: the run's rows
+    and ``run.json`` if the caller has already read them
     (:func:`read_run`); ``sample``: the scans if it has drawn them (:func:`sample_scans`)."""
     df, info_run = read_run(run_dir) if run is None else run
     specs = [m for m in info_run.matchers if m["label"] in set(df["matcher"])]
@@ -173,12 +180,16 @@ def run_timing(run_dir: Path, per_stratum: int = PER_STRATUM, seed: int = SEED, 
     if sample.empty:
         raise ConfigError(f"{run_dir}: no scan that every matcher answered")
     started, load_start = time.strftime("%Y-%m-%dT%H:%M:%S%z"), load_average()
+    probe = Probe()
     with pinned(cores) as on:
         single = sample[~sample["dataset"].isin(sequences)]
         steps = sample[sample["dataset"].isin(sequences)]
-        rows = _time_sample(single, specs, paths, warmup, progress) if len(single) else []
-        rows += _time_sequences(steps, specs, paths, progress, len(single))
+        probe.start()
+        rows = _time_sample(single, specs, paths, warmup, progress, probe) if len(single) else []
+        rows += _time_sequences(steps, specs, paths, progress, len(single), probe)
+        contention = probe.finish()
     info = {"cores": on, "per_stratum": per_stratum, "seed": seed, "warmup": warmup,
+            "contention": contention.to_record(),
             "scans": len(sample), "strata": int(sample.groupby(["dataset", "group"]).ngroups),
             "loadavg_start": load_start, "loadavg_end": load_average(), "started": started,
             "git": git_state(), "run_git": info_run.doc.get("git", {})}
@@ -186,8 +197,9 @@ def run_timing(run_dir: Path, per_stratum: int = PER_STRATUM, seed: int = SEED, 
 
 
 def _time_sample(sample: pd.DataFrame, specs: list[dict], paths: dict[str, Path], warmup: int,
-                 progress: Callable[[int, int], None] | None) -> list[TimingRow]:
-    """Warm up, then time every matcher on every sampled scan, interleaved (module docstring)."""
+                 progress: Callable[[int, int], None] | None, probe: Probe | None = None) -> list[TimingRow]:
+    """Warm up, then time every matcher on every sampled scan, interleaved (module docstring),
+    the calibration workload before each scan's matchers (``probe``)."""
     matchers = [(m["label"], load_matcher(m["name"], json.dumps(m.get("params", {}), sort_keys=True)))
                 for m in specs]
     problems = {}
@@ -205,6 +217,8 @@ def _time_sample(sample: pd.DataFrame, specs: list[dict], paths: dict[str, Path]
     for i, r in enumerate(sample.itertuples(index=False)):
         scenario, scans = problems[r.dataset]
         scan = scans[r.scan_id]
+        if probe is not None:
+            probe.round()
         for pos, (label, m) in rotated(matchers, i):
             t = timed_localize(m, problem_of(scenario, scan))
             rows.append(TimingRow(str(r.dataset), str(r.scan_id), str(r.group), label, pos,
@@ -215,7 +229,8 @@ def _time_sample(sample: pd.DataFrame, specs: list[dict], paths: dict[str, Path]
 
 
 def _time_sequences(sample: pd.DataFrame, specs: list[dict], paths: dict[str, Path],
-                    progress: Callable[[int, int], None] | None, done: int = 0) -> list[TimingRow]:
+                    progress: Callable[[int, int], None] | None, done: int = 0,
+                    probe: Probe | None = None) -> list[TimingRow]:
     """Every tracker of the run along the sampled first steps of each sequence, started and
     warmed up (untimed) as the tracking loop does, their steps interleaved in rotated order
     (:func:`tfloc.harness.track.step`: the tracking loop's own step, each tracker on its own
@@ -234,6 +249,8 @@ def _time_sequences(sample: pd.DataFrame, specs: list[dict], paths: dict[str, Pa
         for _, t in trackers:
             begin(t, scenario, scans, the_map)
         for k, (scan, delta) in enumerate(zip(scans, odom_deltas(scans), strict=True)):
+            if probe is not None:
+                probe.round()
             for pos, (label, t) in rotated(trackers, k):
                 s = step(t, scenario, scan, delta)
                 if s.cpu_s is not None:

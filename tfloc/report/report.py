@@ -41,6 +41,7 @@ from .truthfree import load_truth_free, truth_free_section
 from .landscape import draw_landscapes, landscape_section
 from .mdtable import num
 from .sessions import this_run
+from .timing import run_cpu_note
 
 CONTENTION = 1.5  # median wall / CPU time above this: other processes competed for the cores
 
@@ -106,7 +107,7 @@ def header(run_dir: Path, run: dict, df: pd.DataFrame, thr: Thresholds, s2s: set
         lines.append("- Load average (1 min) at the start of each session: "
                      + ", ".join(num(v[0], 2) if v else "?" for v in starts)
                      + (f"; at the end: {end[0]:.2f}" if end else "") + f" ({mach.get('cpu_count', '?')} CPUs)")
-    lines += contention(df)
+    lines += contention(df) + run_cpu_note(run_dir, df)
     return "\n".join(lines) + "\n"
 
 

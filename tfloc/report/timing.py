@@ -8,9 +8,11 @@ from pathlib import Path
 import pandas as pd
 
 from tfloc.core.timing_rows import TimingRow
+from tfloc.evaluation.contention import MAX_INFLATION, Contention, describe, mark
+from tfloc.evaluation.timing import timing_summary
 from tfloc.io.atomic import replace_atomically
 from tfloc.io.rundir import RunDir
-from tfloc.io.timing_rows import write_rows
+from tfloc.io.timing_rows import read_rows, rows_frame, write_rows
 
 from .mdtable import num, table
 
@@ -38,6 +40,52 @@ def _code_line(info: dict) -> str:
             "re-times the matchers as they are now; their answers are not compared here).")
 
 
+def run_inflation_line(summary: pd.DataFrame, against: str = "this pass") -> str:
+    """Whether the run's own CPU times were inflated: the spread of ``run / quiet`` over the
+    matchers, said inflated where any is above :data:`~tfloc.evaluation.contention.MAX_INFLATION`
+    (empty when the run recorded no CPU times)."""
+    r = pd.to_numeric(summary["run_over_quiet"], errors="coerce").dropna()
+    if r.empty:
+        return ""
+    over = summary.loc[r[r > MAX_INFLATION].index, "matcher"].tolist()
+    spread = f"×{r.min():.2f}–{r.max():.2f}" if r.min() != r.max() else f"×{r.max():.2f}"
+    if not over:
+        return f"- The run's own CPU times: not inflated against {against} (run / quiet {spread})."
+    return (f"- **The run's own CPU times are inflated** against {against}: run / quiet {spread}, above "
+            f"×{MAX_INFLATION:g} for {', '.join(f'`{m}`' for m in over)} (the machine was busier during "
+            "the run; read its CPU column through these ratios).")
+
+
+def run_cpu_note(run_dir: Path, df: pd.DataFrame) -> list[str]:
+    """The report's line on the run's own CPU times against its timing pass (``timing.csv``;
+    :func:`run_inflation_line`), the pass's contention mark beside it; none without a pass or CPU
+    times. ``df``: the run's rows (``cpu_s``, or a prepared table's ``cpu_ms``)."""
+    rd = RunDir(run_dir)
+    rows = read_rows(rd.timing_csv, TimingRow)
+    if not rows:
+        return []
+    if "cpu_s" not in df and "cpu_ms" in df:
+        df = df.assign(cpu_s=pd.to_numeric(df["cpu_ms"], errors="coerce") / 1000.0)
+    t = rows_frame(rows, TimingRow)
+    line = run_inflation_line(timing_summary(t, str(t["matcher"].iloc[0]), df),
+                              "its timing pass ([timing.md](timing.md), same scans)")
+    sessions = ((rd.info().timing or {}).get("sessions") or [{}])
+    c = Contention.from_record(sessions[-1].get("contention") if isinstance(sessions[-1], dict) else None)
+    tail = (" The timing pass's own contention was not measured (made before the contention probe)."
+            if c is None else f" The timing pass itself ran {mark(c)}." if c.contended else "")
+    return [line + tail] if line else []
+
+
+def contention_line(info: dict) -> str:
+    """The pass's contention (:func:`~tfloc.evaluation.contention.describe`), a warning first when
+    it ran contended; an older pass's: not measured."""
+    c = Contention.from_record(info.get("contention"))
+    if c is not None and c.contended:
+        return (f"- **This pass ran {mark(c)}**: its milliseconds are not the quiet machine's "
+                f"(ratios between matchers hold better). {describe(c)}.")
+    return f"- Contention: {describe(c)}."
+
+
 def timing_markdown(run_name: str, summary: pd.DataFrame, reference: str, info: dict) -> str:
     """The markdown of a timing pass: how it was made, then one row per matcher."""
     has_run = summary["run_cpu_median_ms"].notna().any()
@@ -55,8 +103,10 @@ def timing_markdown(run_name: str, summary: pd.DataFrame, reference: str, info: 
     if has_run:
         headers += ["run's CPU median, same scans (ms)", "run / quiet"]
     cores = ", ".join(str(c) for c in info.get("cores", [])) or "not pinned"
+    title = f"# Timing pass: {run_name}" + (f" ({m})" if (m := mark(Contention.from_record(
+        info.get("contention")))) else "")
     return "\n".join([
-        f"# Timing pass: {run_name}\n",
+        f"{title}\n",
         f"All matchers of the run re-timed side by side on a stratified sample of its scans: "
         f"{info['per_stratum']} scan(s) per dataset × group ({info['strata']} strata, {info['scans']} scans, "
         f"seed {info['seed']}), drawn from the scans every matcher answered in the run. One process pinned to "
@@ -66,11 +116,13 @@ def timing_markdown(run_name: str, summary: pd.DataFrame, reference: str, info: 
         f"(medians: resampling times; ratios: resampling scans, paired).\n",
         f"- Started {info.get('started', '?')}; load average (1 min) at the start {_load(info.get('loadavg_start'))}, "
         f"at the end {_load(info.get('loadavg_end'))}.",
+        contention_line(info),
         _code_line(info),
         f"- Reference matcher for the ratios: `{reference}`.",
         "- `run / quiet`: the run's own median CPU time on the same scans over this pass's; near 1 "
         "when the run's CPU times can be trusted." if has_run else
         "- The run recorded no CPU times (made before `cpu_s`), so it cannot be compared.",
+        *([line] if (line := run_inflation_line(summary)) else []),
         "",
         table(headers, rows)])
 

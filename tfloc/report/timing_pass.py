@@ -8,15 +8,23 @@ with its files: nothing is timed ("already complete: timing.md is current"); oth
 (:func:`tfloc.evaluation.timing.timing_summary`, from the typed rows' table) and written
 (:func:`tfloc.report.timing.write_timing`), the record marked complete only once both files are.
 It lives in the report layer because it writes ``timing.md``; the measuring is the harness's.
+
+A pass the contention probe finds contended (:mod:`tfloc.evaluation.contention`) is timed again
+after ``wait_s`` seconds, up to ``retries`` times, then refused with a one-line
+:class:`ContendedError` (nothing written, the record left incomplete); with ``allow_contended``
+it is written at once, marked contended in ``timing.md`` and ``run.json``.
 """
 
 from __future__ import annotations
 
 import sys
+import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from tfloc.core.timing_rows import TimingRow
+from tfloc.errors import TflocError
+from tfloc.evaluation.contention import Contention, describe
 from tfloc.evaluation.timing import timing_summary
 from tfloc.harness.runner import load_average
 from tfloc.harness.timing import (
@@ -35,6 +43,12 @@ from tfloc.io.timing_rows import rows_frame
 from .timing import write_timing
 
 Log = Callable[[str], None]
+RETRIES = 2    # a contended pass is timed again this many times before it is refused
+WAIT_S = 60.0  # seconds between those tries
+
+
+class ContendedError(TflocError):
+    """A timing pass ran contended every time it was tried (and contended passes are not allowed)."""
 
 
 def _stderr(line: str) -> None:
@@ -44,7 +58,8 @@ def _stderr(line: str) -> None:
 def timing_pass(run_dir: Path, per_stratum: int | None = None, warmup: int | None = None,
                 reference: str | None = None, regenerate: bool = False,
                 progress: Callable[[int, int], None] | None = None, *, seed: int | None = None,
-                cores: Sequence[int] | None = None, log: Log | None = None) -> Path:
+                cores: Sequence[int] | None = None, log: Log | None = None, allow_contended: bool = False,
+                retries: int = RETRIES, wait_s: float = WAIT_S) -> Path:
     """Re-time the run in ``run_dir`` side by side unless its recorded timing pass is current
     (module notes); returns the run directory.
 
@@ -53,7 +68,8 @@ def timing_pass(run_dir: Path, per_stratum: int | None = None, warmup: int | Non
     run's first), ``seed`` the sampling seed (default fixed), ``cores`` where to pin (default the
     last allowed core; not part of the pass's fingerprint). ``progress(done, total)`` is told of
     every scan timed; ``log`` (default: standard error) gets why it re-times, the summary table
-    and where it wrote. A bad parameter or a run without rows is a :class:`~tfloc.errors.TflocError`."""
+    and where it wrote. A bad parameter or a run without rows is a :class:`~tfloc.errors.TflocError`;
+    contended passes are retried or refused as the module notes say."""
     log = log or _stderr
     rd = RunDir(run_dir)
     df, info = read_run(rd.path)
@@ -70,12 +86,35 @@ def timing_pass(run_dir: Path, per_stratum: int | None = None, warmup: int | Non
     elif not why:
         log(f"{rd.path}: timing again (--regenerate)")
     rd.start_timing(fp, load_average(), fresh=regenerate or bool(why))
-    rows, meta = run_timing(rd.path, params.per_stratum, params.seed, cores, params.warmup, progress,
-                            run=(df, info), sample=sample)
+    rows, meta = timed_quietly(lambda: run_timing(rd.path, params.per_stratum, params.seed, cores, params.warmup,
+                                                  progress, run=(df, info), sample=sample),
+                               log, allow_contended, retries, wait_s, str(rd.path))
     summary = timing_summary(rows_frame(rows, TimingRow), params.reference, df)
     csv_path, md_path = write_timing(rd.path, rows, summary, params.reference, meta, info.name or rd.path.name)
-    rd.close_timing(load_average(), cores=meta["cores"], scans=meta["scans"])
+    rd.close_timing(load_average(), cores=meta["cores"], scans=meta["scans"], contention=meta["contention"])
     log(summary[["matcher", "cpu_median_ms", "ratio_to_reference", "run_over_quiet"]].to_string(
         index=False, float_format=lambda v: f"{v:.2f}"))
     log(f"timing: {md_path} ({csv_path.name})")
     return rd.path
+
+
+def timed_quietly(timed: Callable[[], tuple[list, dict]], log: Log, allow_contended: bool = False,
+                  retries: int = RETRIES, wait_s: float = WAIT_S, what: str = "timing pass") -> tuple[list, dict]:
+    """``timed()`` (rows and a provenance dict with ``contention``) until its probe finds it
+    quiet: a contended try is timed again after ``wait_s`` s, at most ``retries`` times, then
+    refused (:class:`ContendedError`); with ``allow_contended`` the first try is kept, contended
+    or not (module notes)."""
+    for attempt in range(retries + 1):
+        rows, meta = timed()
+        c = Contention.from_record(meta.get("contention"))
+        if c is None or not c.contended:
+            return rows, meta
+        log(f"{what}: {describe(c)}")
+        if allow_contended:
+            log(f"{what}: kept as contended (--allow-contended)")
+            return rows, meta
+        if attempt < retries:
+            log(f"{what}: timing again in {wait_s:g} s (try {attempt + 2} of {retries + 1})")
+            time.sleep(wait_s)
+    raise ContendedError(f"{what}: contended on each of {retries + 1} tries ({'; '.join(c.reasons())}); "
+                         "run it on a quiet machine, or pass --allow-contended to keep it marked contended")

@@ -25,6 +25,7 @@ class Column:
     measure: str
     provisional: bool = False
     figure: str = ""  # a headline row's extra figure shown instead of its measure (:data:`EXTRAS`)
+    note: str = ""  #: shown after the label, e.g. a re-timing's ``contended (×1.42 inflated)``
 
     @property
     def key(self) -> str:
@@ -33,7 +34,7 @@ class Column:
     @property
     def label(self) -> str:
         if self.mode == "re-timing":
-            return "re-timing"
+            return "re-timing" + (f", {self.note}" if self.note else "")
         where = "pooled" if self.scope == POOLED else self.scope
         if self.figure:
             return f"{EXTRAS[self.figure][0]} ({where})"
@@ -120,7 +121,7 @@ def _columns(rr: RunRows, modes: tuple[str, ...], short: bool) -> list[Column]:
         cols = [Column(rr.name, mode, s, measure[s], rr.provisional) for s in scopes]
         if not short and cols and measure[cols[0].scope] != TRUTH_FREE:  # the first column's extras
             top = [r for r in rows if r.scope == cols[0].scope]
-            cols[1:1] = [Column(rr.name, mode, cols[0].scope, measure[cols[0].scope], rr.provisional, f)
+            cols[1:1] = [Column(rr.name, mode, cols[0].scope, measure[cols[0].scope], rr.provisional, figure=f)
                          for f in EXTRAS if any(math.isfinite(getattr(r, f)) for r in top)]
         out += cols
     return out

@@ -10,6 +10,10 @@ from pathlib import Path
 
 import pandas as pd
 
+from tfloc.errors import TflocError
+from tfloc.evaluation.contention import Contention, mark
+from tfloc.io.rundir import RunDir
+
 from .advice import Statement, statements
 from .board import Board, headline_board, unique_dirs
 from .cost import SLOPES_CSV, cpu_board, slopes_board
@@ -50,7 +54,7 @@ def collect(root: Path, quick: bool = False, pages: list[Page] | None = None) ->
     timing = {d: t for d in runs if (t := _csv(root / d / "timing.csv")) is not None}
     for p in pages:
         if p.key == COST:
-            data.boards[COST] = cpu_board(pages, runs, timing)
+            data.boards[COST] = cpu_board(pages, runs, timing, {d: timing_mark(root / d) for d in timing})
             slopes = {r.dir: s for r in p.runs if (s := _csv(root / r.dir / SLOPES_CSV)) is not None}
             data.boards[f"{COST}-slopes"] = slopes_board(slopes)
             continue
@@ -72,6 +76,18 @@ def _truth_free(root: Path) -> tuple[str, str]:
     assess = {r: t for r in RUNS if (t := _csv(root / r / "selfassess.csv")) is not None}
     dev = set(RunDir(root / DEV_RUN).info().datasets) if (root / DEV_RUN / "run.json").is_file() else set()
     return agreement_markdown(agree, dev), selfassess_markdown(assess)
+
+
+def timing_mark(run_dir: Path) -> str:
+    """The contention mark of the run's timing pass (``contended (×f inflated)``; empty when quiet,
+    not measured by an older pass, or the run's record is unreadable)."""
+    try:
+        record = RunDir(run_dir).info().timing or {}
+    except TflocError:
+        return ""
+    sessions = record.get("sessions") if isinstance(record.get("sessions"), list) else []
+    last = sessions[-1] if sessions and isinstance(sessions[-1], dict) else {}
+    return mark(Contention.from_record(last.get("contention")))
 
 
 def _reported(root: Path, runs: dict[str, RunRows], name: str) -> RunRows | None:

@@ -28,9 +28,13 @@ def _ms(v: float) -> str:
     return "—" if math.isnan(v) else f"{v:.3g}"
 
 
-def cpu_board(pages: list[Page], runs: dict[str, RunRows], timing: dict[str, pd.DataFrame]) -> Board:
+def cpu_board(pages: list[Page], runs: dict[str, RunRows], timing: dict[str, pd.DataFrame],
+              marks: dict[str, str] | None = None) -> Board:
     """CPU ms per scan: per run and mode its pooled column where that has a CPU figure, else
-    each dataset's (at most :data:`MAX_SPLIT`; the run's own page has the rest); then the run's quiet re-timing (``timing``: run → ``timing.csv`` rows)."""
+    each dataset's (at most :data:`MAX_SPLIT`; the run's own page has the rest); then the run's
+    quiet re-timing (``timing``: run → ``timing.csv`` rows), labelled with its contention mark
+    (``marks``: run → :func:`tfloc.evaluation.contention.mark`, e.g. ``contended (×1.42 inflated)``)."""
+    marks = marks or {}
     columns: list[Column] = []
     cells: dict[tuple[str, str], Cell] = {}
     first: dict[str, tuple[int, int]] = {}
@@ -56,12 +60,14 @@ def cpu_board(pages: list[Page], runs: dict[str, RunRows], timing: dict[str, pd.
                         first.setdefault(r.matcher, (len(columns) - 1, 0))
             t = timing.get(ref.dir)
             if t is not None and not t.empty:
-                col = Column(ref.dir, QUIET, POOLED, "CPU ms")
+                note = marks.get(ref.dir, "")
+                col = Column(ref.dir, QUIET, POOLED, "CPU ms", note=note)
                 columns.append(col)
                 for m, g in t.groupby("matcher", sort=False):
                     v = float(pd.to_numeric(g["cpu_ms"], errors="coerce").median())
                     cells[(str(m), col.key)] = Cell(v, _ms(v), "", f"median CPU of {len(g)} scans re-timed "
-                                                    "side by side in one pinned process", False, ref.dir)
+                                                    "side by side in one pinned process"
+                                                    + (f", {note}" if note else ""), False, ref.dir)
                     first.setdefault(str(m), (len(columns) - 1, 0))
     for m, (i, _) in first.items():  # rows by their first column, cheapest first
         v = cells[(m, columns[i].key)].value

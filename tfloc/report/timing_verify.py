@@ -1,0 +1,82 @@
+"""Check a committed timing pass (``tfloc timing RUN --verify``): re-time its sample now and compare.
+
+The scans of ``RUN/timing.csv`` (the first ``per_stratum`` of each dataset × group when asked
+for fewer; a sequence's first steps) are timed again as the pass timed them
+(:func:`tfloc.harness.timing.run_timing`, the record's warm-up), contended tries retried or refused
+as a pass's are (:func:`tfloc.report.timing_pass.timed_quietly`), nothing written. Per matcher the
+median CPU ms over the same scans, committed and now, and the ratio
+(:func:`tfloc.evaluation.timing.verify_ratios`); the check fails where a ratio lies outside
+×1/``tolerance``–×``tolerance`` (default ×1.3: a pass's figures are the quiet machine's within that).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+import pandas as pd
+
+from tfloc.core.timing_rows import TimingRow
+from tfloc.errors import ConfigError
+from tfloc.evaluation.contention import Contention, describe
+from tfloc.evaluation.timing import verify_ratios
+from tfloc.harness.timing import WARMUP, read_run, run_timing
+from tfloc.io.rundir import RunDir
+from tfloc.io.scenario import SEQUENCE
+from tfloc.io.timing_rows import read_rows, rows_frame
+
+from .timing_pass import RETRIES, WAIT_S, Log, _stderr, timed_quietly
+
+TOLERANCE = 1.3
+
+
+def committed_sample(committed: pd.DataFrame, sequences: Sequence[str], per_stratum: int | None) -> pd.DataFrame:
+    """The scans of a committed pass (dataset, scan_id, group in their order), or the first
+    ``per_stratum`` of each dataset × group (of a sequence, its first ``per_stratum`` steps)."""
+    s = committed[["dataset", "scan_id", "group"]].drop_duplicates(["dataset", "scan_id"]).reset_index(drop=True)
+    if per_stratum is None:
+        return s
+    if per_stratum < 1:
+        raise ConfigError(f"per-stratum sample size must be ≥ 1, got {per_stratum}")
+    seq = s["dataset"].isin(set(sequences))
+    return pd.concat([s[~seq].groupby(["dataset", "group"], sort=False).head(per_stratum),
+                      s[seq].groupby("dataset", sort=False).head(per_stratum)]).sort_index()
+
+
+def verify_pass(run_dir: Path, per_stratum: int | None = None, cores: Sequence[int] | None = None,
+                log: Log | None = None, tolerance: float = TOLERANCE, allow_contended: bool = False,
+                retries: int = RETRIES, wait_s: float = WAIT_S,
+                progress: Callable[[int, int], None] | None = None) -> bool:
+    """Re-time the committed pass of ``run_dir`` and log the comparison (module notes); True when
+    every matcher's ratio lies within ``tolerance``. A run without ``timing.csv`` is a
+    :class:`~tfloc.errors.ConfigError`."""
+    log = log or _stderr
+    rd = RunDir(run_dir)
+    df, info = read_run(rd.path)
+    committed = rows_frame(read_rows(rd.timing_csv, TimingRow), TimingRow)
+    if committed.empty:
+        raise ConfigError(f"{rd.path}: no timing pass to verify (no timing.csv; tfloc timing {rd.path} makes one)")
+    record = info.timing or {}
+    fp = record.get("fingerprint") if isinstance(record.get("fingerprint"), dict) else {}
+    sessions = record.get("sessions") or [{}]
+    then = Contention.from_record(sessions[-1].get("contention"))
+    sequences = sorted(info.datasets_in(list(df["dataset"].unique()), SEQUENCE))
+    sample = committed_sample(committed, sequences, per_stratum)
+    warmup = int(fp.get("warmup", WARMUP))
+    rows, meta = timed_quietly(lambda: run_timing(rd.path, cores=cores, warmup=warmup, progress=progress,
+                                                  run=(df, info), sample=sample),
+                               log, allow_contended, retries, wait_s, f"{rd.path} (verify)")
+    table = verify_ratios(committed, rows_frame(rows, TimingRow))
+    now = Contention.from_record(meta["contention"])
+    log(f"committed pass: {describe(then)}")
+    log(f"this re-timing ({len(sample)} scans): {describe(now)}")
+    log(table.to_string(index=False, float_format=lambda v: f"{v:.2f}"))
+    bad = [r.matcher for r in table.itertuples()
+           if math.isnan(r.ratio) or not 1.0 / tolerance <= r.ratio <= tolerance]
+    if bad:
+        log(f"{rd.path}: the committed timing pass does NOT agree within ×{tolerance:g}: {', '.join(bad)}")
+        return False
+    log(f"{rd.path}: the committed timing pass agrees within ×{tolerance:g} for every matcher "
+        f"(ratios {table['ratio'].min():.2f}–{table['ratio'].max():.2f})")
+    return True
