@@ -12,8 +12,11 @@ frozen submap (the constraint builder's answers, ``loop_closure_*_weight``, unde
 and their odometry (``odometry_*_weight``). The Huber loss acts on a block's squared norm s as
 Ceres applies it, ρ(s) = s for s ≤ a², else 2a√s − a²: here by scaling the block's residual by
 √(ρ(s)/s) (its Jacobian by the exact derivative), so that scipy's squared sum is Ceres' cost.
-Solved by ``scipy.optimize.least_squares`` (trust region, sparse Jacobian, LSMR steps) with at most
-``max_num_iterations`` evaluations and Ceres' default tolerances. Metres, radians.
+Solved as Ceres solves it, Levenberg–Marquardt on the sparse normal equations
+(:func:`_levenberg_marquardt`, scipy's sparse LU for the step), at most ``max_num_iterations``
+iterations. (``scipy.optimize.least_squares`` with LSMR steps stops early: the pose graph's
+weights span 1e2–1e5, and its inexact steps barely move the trajectory as a whole, the one
+direction the map's constraints decide.) Metres, radians.
 """
 
 from __future__ import annotations
@@ -21,8 +24,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import least_squares
-from scipy.sparse import csr_matrix
+from scipy.sparse import csr_matrix, diags
+from scipy.sparse.linalg import spsolve
 
 from tfloc.core.pose import wrap_angle
 
@@ -73,28 +76,57 @@ def _huber(r: np.ndarray, robust: np.ndarray, a: float) -> np.ndarray:
     return g, M
 
 
-def solve(x0: np.ndarray, b: Blocks, huber_scale: float, max_num_iterations: int) -> tuple[np.ndarray, object]:
-    """The optimised variable poses ``(V, 3)`` from ``x0`` ``(V, 3)``, and scipy's result."""
+def _levenberg_marquardt(f, x0: np.ndarray, max_num_iterations: int) -> tuple[np.ndarray, dict]:
+    """Ceres' Levenberg–Marquardt (``levenberg_marquardt_strategy.cc``, SPARSE_NORMAL_CHOLESKY):
+    steps from (JᵀJ + diag(JᵀJ)/μ)·δ = −Jᵀr solved exactly (a sparse LU), μ the trust region
+    radius (initial 1e4; ×1/max(⅓, 1 − (2ρ − 1)³) on success, ÷ a doubling factor on failure);
+    Ceres' tolerances (function 1e-6, gradient 1e-10, parameter 1e-8)."""
+    x = x0.copy()
+    r, J = f(x)
+    cost = 0.5 * float(r @ r)
+    radius, decrease = 1e4, 2.0
+    it = 0
+    for it in range(1, max_num_iterations + 1):  # noqa: B007 - reported
+        g = J.T @ r
+        if np.max(np.abs(g), initial=0.0) <= 1e-10:
+            break
+        H = (J.T @ J).tocsc()
+        D = np.clip(H.diagonal(), 1e-6, 1e32)
+        step = -spsolve((H + diags(D / radius)).tocsc(), g)
+        x_new = x + step
+        r_new, J_new = f(x_new)
+        cost_new = 0.5 * float(r_new @ r_new)
+        model = -(float(g @ step) + 0.5 * float(step @ (H @ step)))
+        rho = (cost - cost_new) / model if model > 0 else -1.0
+        if rho > 1e-3:
+            done = (abs(cost - cost_new) <= 1e-6 * cost
+                    or np.linalg.norm(step) <= 1e-8 * (np.linalg.norm(x) + 1e-8))
+            x, r, J, cost = x_new, r_new, J_new, cost_new
+            radius, decrease = radius / max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3), 2.0
+            if done:
+                break
+        else:
+            radius, decrease = radius / decrease, 2.0 * decrease
+    return x, {"cost": cost, "iterations": it}
+
+
+def solve(x0: np.ndarray, b: Blocks, huber_scale: float, max_num_iterations: int) -> tuple[np.ndarray, dict]:
+    """The optimised variable poses ``(V, 3)`` from ``x0`` ``(V, 3)``, and the final cost and
+    iterations."""
     V, B = len(x0), len(b.end)
     rows = np.repeat(np.arange(3 * B).reshape(B, 3), 3, axis=1)  # (B, 9)
     end_cols = (3 * b.end[:, None] + np.tile(np.arange(3), 3)[None, :])
     start_cols = (3 * np.maximum(b.start, 0)[:, None] + np.tile(np.arange(3), 3)[None, :])
     has_start = b.start >= 0
 
-    def fun(v: np.ndarray) -> np.ndarray:
-        r, _, _ = _errors(v.reshape(V, 3), b)
-        g, _ = _huber(r, b.robust, huber_scale)
-        return (g[:, None] * r).ravel()
-
-    def jac(v: np.ndarray) -> csr_matrix:
+    def f(v: np.ndarray) -> tuple[np.ndarray, csr_matrix]:
         r, jE, jS = _errors(v.reshape(V, 3), b)
-        _, M = _huber(r, b.robust, huber_scale)
+        g, M = _huber(r, b.robust, huber_scale)
         jE, jS = M @ jE, M @ jS
         data = np.concatenate((jE.reshape(B, 9).ravel(), jS[has_start].reshape(-1, 9).ravel()))
         rr = np.concatenate((rows.ravel(), rows[has_start].ravel()))
         cc = np.concatenate((end_cols.ravel(), start_cols[has_start].ravel()))
-        return csr_matrix((data, (rr, cc)), shape=(3 * B, 3 * V))
+        return (g[:, None] * r).ravel(), csr_matrix((data, (rr, cc)), shape=(3 * B, 3 * V))
 
-    sol = least_squares(fun, x0.ravel(), jac=jac, method="trf", tr_solver="lsmr", x_scale="jac",
-                        ftol=1e-6, xtol=1e-8, gtol=1e-10, max_nfev=max_num_iterations)
-    return sol.x.reshape(V, 3), sol
+    x, info = _levenberg_marquardt(f, x0.ravel().astype(float), max_num_iterations)
+    return x.reshape(V, 3), info
