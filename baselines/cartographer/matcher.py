@@ -1,5 +1,7 @@
-"""``cartographer-local``: Cartographer's 2D local scan matching (``LocalTrajectoryBuilder2D::ScanMatch``)
-of one scan against the map's probability grid, from the tracker's prediction.
+"""``cartographer-local``: Cartographer's local matcher against the map, a labelled condition
+(Cartographer never matches scan-to-map; its rotation_weight 40 is meant for an IMU heading; the
+whole localization loop is ``cartographer``): ``LocalTrajectoryBuilder2D::ScanMatch`` of one scan
+against the map's probability grid, from the tracker's prediction.
 
 Stages, each a port of Cartographer's source (values: ``trajectory_builder_2d.lua``; the detail,
 the sources and the departures: ``docs/baselines/cartographer-local.md``):
