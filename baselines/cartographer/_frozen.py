@@ -24,8 +24,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-
 from tfloc.baselines._bnb_kernels import angular_step, branch_and_bound, pyramid
+
 from tfloc.core.pose import Pose, wrap_angle
 from tfloc.maps.cache import cached
 

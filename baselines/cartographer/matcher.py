@@ -38,7 +38,7 @@ from typing import ClassVar
 import numpy as np
 
 from tfloc.core.params import Configured
-from tfloc.core.pose import Pose, wrap_angle
+from tfloc.core.pose import Pose
 from tfloc.core.problem import NO_ANSWER, Estimate, Problem
 from tfloc.core.traits import Confidence
 

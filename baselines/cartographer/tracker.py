@@ -204,7 +204,7 @@ class CartographerTracker:
         self._since_optimisation = 0
         if self._inter:
             self._solve()
-        for _, k, _, stamp in new:
+        for _, _, _, stamp in new:
             self._last_connection = max(self._last_connection, stamp)
         self._trim(c.max_submaps_to_keep)
 
@@ -221,7 +221,7 @@ class CartographerTracker:
         for f, k, z, _ in self._inter:
             rows.append((-1, self._frozen[f].pose.as_array(), node_var[k], z, c.loop_closure_translation_weight,
                          c.loop_closure_rotation_weight, True))
-        for a, b in zip(self._nodes, self._nodes[1:]):
+        for a, b in zip(self._nodes[:-1], self._nodes[1:], strict=True):
             if b["index"] != a["index"] + 1:
                 continue
             rows.append((node_var[a["index"]], zero, node_var[b["index"]],
@@ -230,7 +230,7 @@ class CartographerTracker:
             rows.append((node_var[a["index"]], zero, node_var[b["index"]],
                          a["local"].inverse().compose(b["local"]).as_array(), c.local_slam_pose_translation_weight,
                          c.local_slam_pose_rotation_weight, False))
-        cols = list(zip(*rows))
+        cols = list(zip(*rows, strict=True))
         blocks = Blocks(np.array(cols[0], dtype=np.int64), np.array(cols[1], dtype=float),
                         np.array(cols[2], dtype=np.int64), np.array(cols[3], dtype=float),
                         np.array(cols[4], dtype=float), np.array(cols[5], dtype=float), np.array(cols[6], dtype=bool))

@@ -10,13 +10,13 @@ import math
 import numpy as np
 import pytest
 from _paths import SCEN
-
 from tfloc.baselines.cartographer import CartographerTracker
 from tfloc.baselines.cartographer._filters import matched_points
 from tfloc.baselines.cartographer._frozen import frozen_submaps, search
 from tfloc.baselines.cartographer._optimize import Blocks, _errors, _huber, solve
 from tfloc.baselines.cartographer._submaps import ActiveSubmaps, Submap
 from tfloc.baselines.cartographer.tracker import _Sampler
+
 from tfloc.core.pose import Pose
 from tfloc.errors import InvalidProblemError, ParameterError
 from tfloc.harness.track import odom_deltas
@@ -89,7 +89,7 @@ def _chain(offset: Pose, outlier: bool):
     if outlier:
         rows.append((-1, frozen.as_array(), 20, frozen.inverse().compose(Pose(5, 5, 1)).as_array(), 1.1e4, 1e5,
                      True))
-    c = list(zip(*rows))
+    c = list(zip(*rows, strict=True))
     b = Blocks(np.array(c[0]), np.array(c[1], float), np.array(c[2]), np.array(c[3], float), np.array(c[4], float),
                np.array(c[5], float), np.array(c[6], bool))
     return truth, x0, b
