@@ -18,6 +18,7 @@ centre at ``origin + (i + ½, j + ½) · resolution``. Metres.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -41,8 +42,9 @@ class ProbabilityGrid:
     resolution: float
     origin: tuple[float, float]
 
-    @property
+    @cached_property
     def cost(self) -> np.ndarray:
+        """``1 − prob``, computed once (the Ceres matcher reads it at every evaluation)."""
         return 1.0 - self.prob
 
     def cells(self, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

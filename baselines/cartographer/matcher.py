@@ -1,5 +1,7 @@
-"""``cartographer-local``: Cartographer's 2D local scan matching (``LocalTrajectoryBuilder2D::ScanMatch``)
-of one scan against the map's probability grid, from the tracker's prediction.
+"""``cartographer-local``: Cartographer's local matcher against the map, a labelled condition
+(Cartographer never matches scan-to-map; its rotation_weight 40 is meant for an IMU heading; the
+whole localization loop is ``cartographer``): ``LocalTrajectoryBuilder2D::ScanMatch`` of one scan
+against the map's probability grid, from the tracker's prediction.
 
 Stages, each a port of Cartographer's source (values: ``trajectory_builder_2d.lua``; the detail,
 the sources and the departures: ``docs/baselines/cartographer-local.md``):
@@ -34,14 +36,13 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from tfloc.core.params import Configured
-from tfloc.core.pose import Pose, wrap_angle
+from tfloc.core.pose import Pose
 from tfloc.core.problem import NO_ANSWER, Estimate, Problem
 from tfloc.core.traits import Confidence
 
-from . import _csm
+from . import _ceres, _csm
 from ._filters import matched_points
 from ._grid import MIN_PROBABILITY, ProbabilityGrid, cost_at, probability_grid
 
@@ -120,35 +121,10 @@ class CartographerLocalMatcher(Configured):
         return Estimate(pose, bool(sol.success), iterations=int(sol.nfev), info=info)
 
     def _ceres(self, grid: ProbabilityGrid, points: np.ndarray, pred: Pose, start: Pose):  # noqa: ANN202
-        """``CeresScanMatcher2D::Match``: the pose and scipy's result."""
+        """``CeresScanMatcher2D::Match`` (:func:`._ceres.match`): the pose and scipy's result."""
         c = self.config
-        scale = c.occupied_space_weight / math.sqrt(len(points))
-        px, py = points[:, 0], points[:, 1]
-        memo: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
-
-        def evaluate(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            key = v.tobytes()
-            if key not in memo:
-                memo.clear()
-                cos, sin = math.cos(v[2]), math.sin(v[2])
-                xy = np.column_stack((v[0] + cos * px - sin * py, v[1] + sin * px + cos * py))
-                cost, gx, gy = cost_at(grid, xy)
-                r = np.concatenate((scale * cost, c.translation_weight * (v[:2] - (pred.x, pred.y)),
-                                    [c.rotation_weight * (v[2] - start.theta)]))
-                jac = np.zeros((len(r), 3))
-                jac[:len(px), 0] = scale * gx
-                jac[:len(px), 1] = scale * gy
-                jac[:len(px), 2] = scale * (gx * (-sin * px - cos * py) + gy * (cos * px - sin * py))
-                jac[len(px), 0] = jac[len(px) + 1, 1] = c.translation_weight
-                jac[len(px) + 2, 2] = c.rotation_weight
-                memo[key] = (r, jac)
-            return memo[key]
-
-        sol = least_squares(lambda v: evaluate(v)[0], start.as_array(), jac=lambda v: evaluate(v)[1],
-                            method="lm", ftol=1e-6, xtol=1e-8, gtol=1e-10,
-                            max_nfev=c.max_num_iterations + 1)
-        v = sol.x
-        return Pose(float(v[0]), float(v[1]), float(wrap_angle(v[2]))), sol
+        return _ceres.match(grid, points, pred, start, c.occupied_space_weight, c.translation_weight,
+                            c.rotation_weight, c.max_num_iterations)
 
     def score(self, problem: Problem, pose: Pose) -> float:
         """The occupied-space part of Ceres' cost at ``pose`` (module notes; lower is better)."""
