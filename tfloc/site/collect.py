@@ -68,13 +68,13 @@ def collect(root: Path, quick: bool = False, pages: list[Page] | None = None) ->
 
 def _truth_free(root: Path) -> tuple[str, str]:
     """The truth-free blocks from the runs of :data:`tfloc.site.truthfree.RUNS`."""
-    from tfloc.io.rundir import RunDir
+    from tfloc.harness.config import load_study
 
-    from .truthfree import DEV_RUN, RUNS, agreement_markdown, selfassess_markdown
+    from .truthfree import DEV_STUDY, RUNS, agreement_markdown, selfassess_markdown
 
     agree = {r: t for r in RUNS if (t := _csv(root / r / "verdict_agreement.csv")) is not None}
     assess = {r: t for r in RUNS if (t := _csv(root / r / "selfassess.csv")) is not None}
-    dev = set(RunDir(root / DEV_RUN).info().datasets) if (root / DEV_RUN / "run.json").is_file() else set()
+    dev = {d.name for d in load_study(DEV_STUDY).run.datasets} if Path(DEV_STUDY).is_file() else set()
     return agreement_markdown(agree, dev), selfassess_markdown(assess)
 
 

@@ -1,8 +1,8 @@
 """The truth-free verdict's validation and the trackers' self-assessment, as the docs' generated
 blocks ``truth-free`` and ``self-assessment``: from the runs' ``verdict_agreement.csv`` and
 ``selfassess.csv`` (read by :mod:`tfloc.site.collect`), each recording marked *development* (a
-dataset of the development run, :data:`DEV_RUN`, whose datasets the verdict's rules were chosen
-on) or *held out*. Pure: reads no file."""
+dataset of the development study :data:`DEV_STUDY`, on which the verdict's rules were chosen) or
+*held out*. Pure: reads no file."""
 
 from __future__ import annotations
 
@@ -12,10 +12,10 @@ import pandas as pd
 
 from tfloc.report.mdtable import num, table
 
-#: the run the verdict's rules were chosen on (benchmarks/dev/truth-free.toml)
-DEV_RUN = "dev/truth-free"
-#: the runs whose verdicts are checked against the truth, development first
-RUNS = (DEV_RUN, "native", "sequences")
+#: the study file that declares the development split (its datasets)
+DEV_STUDY = "benchmarks/dev/truth-free.toml"
+#: the runs whose verdicts are checked against the truth
+RUNS = ("native", "sequences")
 
 
 def agreement_markdown(tables: dict[str, pd.DataFrame], dev: set[str]) -> str:
@@ -26,7 +26,7 @@ def agreement_markdown(tables: dict[str, pd.DataFrame], dev: set[str]) -> str:
     body, held = [], []
     for run, a in tables.items():
         for r in a.itertuples():
-            split = "development" if run == DEV_RUN or r.dataset in dev else "held out"
+            split = "development" if r.dataset in dev else "held out"
             if split == "held out":
                 held.append(bool(r.agrees))
             top = r.top + ("" if r.top == "same" else f" (p = {r.p_top:.2g})")
@@ -44,7 +44,7 @@ def agreement_markdown(tables: dict[str, pd.DataFrame], dev: set[str]) -> str:
 def selfassess_markdown(tables: dict[str, pd.DataFrame]) -> str:
     """Each tracker's self-assessment pooled over each run's recordings with truth (``tables``:
     run → its ``selfassess.csv``): AUC and the share of losses caught at 1 % false alarms."""
-    runs = [r for r in RUNS if r in tables and r != DEV_RUN] or list(tables)
+    runs = [r for r in RUNS if r in tables] or list(tables)
     if not runs:
         return "_Not yet: no run has a self-assessment (tfloc report on a tracking run with truth)._\n"
     pooled = {r: (t[t["scope"] == "all"] if (t["scope"] == "all").any() else t) for r, t in ((r, tables[r]) for r in runs)}
