@@ -130,8 +130,7 @@ def _program(config: Config) -> ExternalProgram:
     try:
         text = shipped.read_text()
     except OSError:
-        raise ProgramMissingError(f"{shipped} not found (Debian: apt-get install {PACKAGE})",
-                                  name="pf-localization") from None
+        raise ProgramMissingError(f"{shipped} not found (Debian: apt-get install {PACKAGE})") from None
     return ExternalProgram("pf-localization", PACKAGE, _version(), INI, render_ini(text, config.ini_values()))
 
 

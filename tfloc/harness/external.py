@@ -38,8 +38,7 @@ def find_program(executable: str, package: str) -> str:
     """The path of ``executable`` on ``PATH``; :class:`ProgramMissingError` names ``package``."""
     path = shutil.which(executable)
     if path is None:
-        raise ProgramMissingError(f"{executable} not found on PATH (Debian: apt-get install {package})",
-                                  name=executable)
+        raise ProgramMissingError(f"{executable} not found on PATH (Debian: apt-get install {package})")
     return path
 
 
