@@ -53,7 +53,7 @@ class Config:
     ``localization_demo.ini``'s values; metres, degrees where MRPT's keys say ``_deg``."""
 
     RULES: ClassVar[dict] = {
-        ">= 1": ("particles_count", "kld_max_samples", "kld_min_samples", "lf_decimation"),
+        ">= 1": ("aux_max_search_samples", "particles_count", "kld_max_samples", "kld_min_samples", "lf_decimation"),
         ">= 0": ("kld_min_samples_per_bin", "init_half_xy_m", "init_half_theta_deg", "lf_z_random"),
         "> 0": ("kld_bin_xy_m", "kld_bin_phi_deg", "kld_delta", "kld_epsilon", "lf_std_hit_m",
                 "lf_max_corrs_distance_m", "lf_max_range_m", "dummy_min_std_xy_m", "dummy_min_std_phi_deg"),
@@ -63,9 +63,10 @@ class Config:
         (0, 1): ("adaptive_sample_size",),
     }
 
-    pf_algorithm: int = 0  #: [PF_options] PF_algorithm: 0 standard proposal, 2 optimal proposal
+    pf_algorithm: int = 0  #: [PF_options] PF_algorithm: 0 standard proposal, 3 auxiliary PF with the optimal proposal
     resampling_method: int = 0  #: [PF_options] resamplingMethod: 0 multinomial
     adaptive_sample_size: int = 1  #: [PF_options] adaptiveSampleSize: KLD sampling on
+    aux_max_search_samples: int = 10  #: [PF_options] pfAuxFilterOptimal_MaximumSearchSamples (PF_algorithm 3 only)
     beta: float = 0.5  #: [PF_options] BETA: resample when the effective sample size falls below it
     kld_bin_xy_m: float = 0.10  #: [KLD_options] KLD_binSize_XY (metres)
     kld_bin_phi_deg: float = 10.0  #: [KLD_options] KLD_binSize_PHI_deg (degrees)
@@ -94,6 +95,7 @@ class Config:
         return {("PF_options", "PF_algorithm"): self.pf_algorithm,
                 ("PF_options", "resamplingMethod"): self.resampling_method,
                 ("PF_options", "adaptiveSampleSize"): self.adaptive_sample_size,
+                ("PF_options", "pfAuxFilterOptimal_MaximumSearchSamples"): self.aux_max_search_samples,
                 ("PF_options", "BETA"): self.beta,
                 ("KLD_options", "KLD_binSize_XY"): self.kld_bin_xy_m,
                 ("KLD_options", "KLD_binSize_PHI_deg"): self.kld_bin_phi_deg,
