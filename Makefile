@@ -54,10 +54,14 @@ site: $(STAMP)
 	$(BIN)/tfloc site --readme
 
 ## Headless Chromium and chromedriver from Debian's packages, for the site's browser test and
-## screenshots (installed when missing; no browser is downloaded at run time). .ci/run runs it.
+## screenshots, and Debian's mrpt-apps (pf-localization, carmen2rawlog, ros-map-yaml2mrpt: the
+## external program behind mrpt-pf), each installed when missing (nothing is downloaded at run
+## time). .ci/run runs it.
 browser:
 	@command -v chromium >/dev/null && command -v chromedriver >/dev/null || \
 		(apt-get update && apt-get install -y chromium chromium-driver)
+	@command -v pf-localization >/dev/null && command -v carmen2rawlog >/dev/null && \
+		command -v ros-map-yaml2mrpt >/dev/null || (apt-get update && apt-get install -y mrpt-apps)
 
 ## Studies outside make bench, one line each (benchmarks/NAME.toml says what and how long):
 ## native (every native recording, 22 627 scans, 20-40 min), native-single-scan (the same in the

@@ -76,6 +76,8 @@ def overview() -> str:
         try:
             f = factory_of(name)
             kind, about = kind_of(f), _first_line(f)
+            if getattr(f, "EXTERNAL", False):  # an external program (tfloc.core.external)
+                about = f"external program: {about}"
         except MatcherError as exc:
             kind, about = "?", f"(not available here: {exc})"
         lines.append(_row([name, kind, about], [16, 11], total))

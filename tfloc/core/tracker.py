@@ -144,8 +144,10 @@ class LocalTracker:
 
 
 def as_tracker(obj: object) -> Tracker:
-    """``obj`` itself if it is a tracker, else a :class:`LocalTracker` around the matcher."""
-    return obj if is_tracker(obj) else LocalTracker(obj)
+    """``obj`` itself if it is a tracker (or answers whole sequences: an external program,
+    :func:`tfloc.core.external.is_batch_tracker`), else a :class:`LocalTracker` around the
+    matcher."""
+    return obj if is_tracker(obj) or callable(getattr(obj, "run_batch", None)) else LocalTracker(obj)
 
 
 @dataclass(frozen=True)

@@ -4,7 +4,8 @@
 dataset's ``scans.csv``, ``scenario.json`` and map file(s), each matcher label with its *resolved*
 parameters (defaults included, so a changed default shows), the success thresholds and the code
 that answers (:mod:`tfloc.harness.identity`: tfloc's answering source, and each plugin matcher's
-distribution, version and source). ``run.json`` records it; a run directory is resumed only by a
+distribution, version and source; an external program's version and configuration file's hash,
+:meth:`tfloc.core.external.ExternalProgram.identity`). ``run.json`` records it; a run directory is resumed only by a
 run with the same fingerprint (:func:`differences` says what changed). ``jobs``, ``timeout_s`` and
 ``limit_per_group`` are not in it: they decide how many tasks run and how fast, not what a
 finished row holds (timed-out rows can be run again with ``--retry-errors``).

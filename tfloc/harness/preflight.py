@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from tfloc.core.external import ExternalProgram
 from tfloc.core.jsonable import jsonable
 from tfloc.core.matcher import factory_of
 from tfloc.core.presets import resolve
@@ -52,8 +53,12 @@ def matcher_record(spec: MatcherSpec) -> dict[str, Any]:
     it stands for (a preset's or a label's), resolved parameters and the code that answers; what a
     fingerprint records of it."""
     params = build_matcher(spec)
-    return {"name": spec.name, "matcher": resolve(spec.name, {})[0], "params": params,
-            **matcher_code(factory_of(spec.name))}
+    record = {"name": spec.name, "matcher": resolve(spec.name, {})[0], "params": params,
+              **matcher_code(factory_of(spec.name))}
+    program = getattr(load_matcher(spec.name, spec.params_json), "program", None)
+    if isinstance(program, ExternalProgram):  # an external program: its version and configuration file
+        record["program"] = program.identity()
+    return record
 
 
 def build_matchers(config: RunConfig) -> dict[str, dict[str, Any]]:

@@ -234,7 +234,9 @@ def _time_sequences(sample: pd.DataFrame, specs: list[dict], paths: dict[str, Pa
     """Every tracker of the run along the sampled first steps of each sequence, started and
     warmed up (untimed) as the tracking loop does, their steps interleaved in rotated order
     (:func:`tfloc.harness.track.step`: the tracking loop's own step, each tracker on its own
-    answers)."""
+    answers). A tracker that answers whole sequences at once (an external program) has no step
+    to time here: it is left out (its rows carry its child process's CPU time)."""
+    from tfloc.core.external import is_batch_tracker
     from tfloc.core.tracker import as_tracker
 
     from .track import begin, odom_deltas, step
@@ -246,6 +248,7 @@ def _time_sequences(sample: pd.DataFrame, specs: list[dict], paths: dict[str, Pa
         scans = list(by_id.values())[:len(g)]
         the_map = map_of(scenario, scans[0])
         trackers = [(m["label"], as_tracker(get_matcher(m["name"], **m.get("params", {})))) for m in specs]
+        trackers = [(label, t) for label, t in trackers if not is_batch_tracker(t)]
         for _, t in trackers:
             begin(t, scenario, scans, the_map)
         for k, (scan, delta) in enumerate(zip(scans, odom_deltas(scans), strict=True)):

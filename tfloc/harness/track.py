@@ -14,6 +14,13 @@ copied into the rows to score them.
   untimed before the sequence);
 * errors where the truth is known, and the ``outcome`` of the one rule when thresholds are given
   (a tracking loop has no objective to tell a local optimum: such a failure is unscored).
+
+A tracker that answers the whole sequence at once (an external program,
+:func:`tfloc.core.external.is_batch_tracker`) is run once (:func:`batch_steps`); its rows are
+built the same way, ``init_*`` its previous answer ⊕ the odometry increment, ``cpu_s`` its share
+of the child process's CPU time (``info["cpu_from"]`` says how it was split) and ``runtime_s``
+the same share of the child's wall time. A program that fails makes every row ``error:<its
+message>`` at the prediction (dead reckoning from the start).
 """
 
 from __future__ import annotations
@@ -22,6 +29,9 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
+import numpy as np
+
+from tfloc.core.external import is_batch_tracker
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate
 from tfloc.core.result import ResultRow, Status, StatusKind
@@ -68,10 +78,15 @@ def track(scenario: Scenario, scans: Sequence[Scan], matcher, *, label: str | No
     dataset = dataset or scenario.name
     the_map = map if map is not None else map_for(scenario, scans[0], {})
     check_sequence(scenario, scans, the_map)
-    begin(tracker, scenario, scans, the_map)
+    if is_batch_tracker(tracker):
+        steps = iter(batch_steps(tracker, scenario, scans, the_map, scans[0].initial))
+        next_step = lambda scan, delta: next(steps)  # noqa: E731
+    else:
+        begin(tracker, scenario, scans, the_map)
+        next_step = lambda scan, delta: step(tracker, scenario, scan, delta)  # noqa: E731
     rows = []
     for k, (scan, delta) in enumerate(zip(scans, odom_deltas(scans), strict=True)):
-        s = step(tracker, scenario, scan, delta)
+        s = next_step(scan, delta)
         row = result_row(dataset, label, scan.scan_id, scan.group, true=scan.true, init=s.pred, est=s.pose,
                          estimate=s.estimate, status=s.status, wall_s=s.wall_s, cpu_s=s.cpu_s,
                          info=dict(s.estimate.info) if s.estimate is not None else {})
@@ -120,6 +135,37 @@ def step(tracker, scenario: Scenario, scan: Scan, delta: Pose) -> Step:
         pose = pred
         tracker.reset(pred)
     return Step(pred, pose, t.estimate, status_of(t.estimate), t.wall_s, t.cpu_s)
+
+
+def batch_steps(tracker, scenario: Scenario, scans: Sequence[Scan], the_map, start: Pose) -> list[Step]:
+    """The steps of a tracker that answers ``scans`` at once (``run_batch``), started at
+    ``start``: each step's prediction is the previous answer ⊕ the odometry increment (``start``
+    for the first), its answer the program's pose (the prediction where that is not finite). A
+    program that raises gives every step an ``error:`` status at the dead-reckoned prediction."""
+    deltas = odom_deltas(scans)
+    odometry = np.array([[s.odom.x, s.odom.y, s.odom.theta] for s in scans], dtype=float)
+    stamps = np.array([s.stamp for s in scans], dtype=float)
+    try:
+        ans = tracker.run_batch(the_map, scenario.laser, [s.ranges for s in scans], stamps, odometry, start)
+    except Exception as exc:  # noqa: BLE001 - a failing program is a result, every row says why
+        status, out, pose = Status.of(StatusKind.ERROR, f"{type(exc).__name__}: {exc}"), [], start
+        for k, delta in enumerate(deltas):
+            pose = start if k == 0 else pose.compose(delta)
+            out.append(Step(pose, pose, None, status, None, None))
+        return out
+    n = len(scans)
+    wall = ans.cpu_per_scan_s * (ans.wall_s / ans.cpu_s) if ans.cpu_s > 0 else np.full(n, ans.wall_s / n)
+    out, prev = [], start
+    for k, delta in enumerate(deltas):
+        pred = start if k == 0 else prev.compose(delta)
+        info = {**(ans.info[k] if k < len(ans.info) else {}), "cpu_from": ans.cpu_from}
+        pose = Pose(*map(float, ans.poses[k]))
+        est = Estimate(pose, True, info=info)
+        if not pose.is_finite():
+            pose = pred
+        out.append(Step(pred, pose, est, status_of(est), float(wall[k]), float(ans.cpu_per_scan_s[k])))
+        prev = pose
+    return out
 
 
 def dead_reckoning(scenario: Scenario, scans: Sequence[Scan], *, label: str = DeadReckoning.name,
