@@ -28,6 +28,13 @@ from pathlib import Path
 from typing import ClassVar
 
 import numpy as np
+from tfloc.baselines._external import (
+    ExternalProgramError,
+    ProgramMissingError,
+    find_program,
+    read_table,
+    run_program,
+)
 
 from tfloc.core.external import BatchAnswer, ExternalProgram, split_cpu
 from tfloc.core.laser import LaserSpec
@@ -35,9 +42,7 @@ from tfloc.core.map import Map
 from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.traits import Confidence
-from tfloc.harness.external import (ExternalProgramError, ProgramMissingError, find_program,
-                                    read_table, run_program)
-from tfloc.io.rosmap import write_ros_map
+from tfloc.maps.ros_export import write_ros_map
 
 from ._amcl_common import amcl_grid
 from ._mrpt_files import carmen_lines, parse_estimates, render_ini

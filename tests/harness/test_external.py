@@ -1,4 +1,4 @@
-"""The external-localizer protocol (tfloc.core.external, tfloc.harness.external) with a tiny real
+"""The external-localizer protocol (tfloc.core.external, tfloc.baselines._external) with a tiny real
 external program (a Python script): the tracking loop's batch path, the child's CPU time, the
 one-line errors, restarts on slices, the program's identity in the fingerprint."""
 
@@ -15,7 +15,7 @@ from _paths import ROOT
 from tfloc.core.external import CPU_EVEN, CPU_OWN_LOG, BatchAnswer, ExternalProgram, split_cpu
 from tfloc.core.pose import Pose
 from tfloc.evaluation.truthfree.reconverge import Restart
-from tfloc.harness.external import (ExternalProgramError, ProgramMissingError, find_program,
+from tfloc.baselines._external import (ExternalProgramError, ProgramMissingError, find_program,
                                     read_table, run_program)
 from tfloc.harness.fingerprint import differences
 from tfloc.harness.restarts import restart_ends

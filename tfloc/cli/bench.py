@@ -15,12 +15,8 @@ Exit status: 0 the run is complete (rows may be failed, invalid or timeout); 2 n
 that cannot be written); 3 the run is complete but some task raised an error (a matcher bug: see
 the `error:` rows; --retry-errors runs them again).
 
-Matchers named `module:Class` (not registered ones) are imported: that runs the module's code.
-Run only configurations you trust; such matchers are refused without --allow-import.
-
-A sequence dataset without ground truth (scenario.json "truth": false, e.g. tfloc import-bag
-without --pose-topic) named directly is then judged without it (tfloc verdict) and reported: its
-report.md opens with the truth-free ranking, headline.csv's truth_free_score column holds it.
+Matchers named `module:Class` are imported (their code runs): refused without --allow-import.
+A sequence dataset without truth named directly is then judged (tfloc verdict) and reported.
 
 --quick runs the first 3 scans of every group of every dataset into RUN-quick (make quick).
 

@@ -6,7 +6,7 @@ formats, runs, and writes its poses. A tracker that wraps one declares ``run_bat
 (:func:`tfloc.harness.track.track`) detects it (:func:`is_batch_tracker`) and writes the same rows
 as for any tracker: ``init_*`` the last answer composed with the odometry increment, ``est_*`` the
 program's pose of that scan. The harness side (writing files, the subprocess, its CPU time) is
-:mod:`tfloc.harness.external`.
+:mod:`tfloc.baselines._external`.
 
 * :class:`ExternalProgram`: what runs (executable, the Debian package that ships it, its version)
   and with what configuration (the configuration file's text): :meth:`ExternalProgram.identity`

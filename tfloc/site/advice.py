@@ -146,11 +146,17 @@ def knows_when_lost(board: Board, question: str) -> Statement:
         return Statement(question, "Not yet: no tracking run has a self-assessment (tfloc report on a run "
                                    "with truth).")
     c = cols[0]
-    have = sorted((m for m in board.matchers if board.cell(m, c)), key=lambda m: -board.cell(m, c).value)
+    main = next(x for x in board.columns if x.run == c.run and x.scope == c.scope and not x.figure)
+    # a detector needs both kinds of scan: trackers that track at least half of them
+    have = sorted((m for m in board.matchers if board.cell(m, c) and board.cell(m, main)
+                   and board.cell(m, main).value >= 50.0), key=lambda m: -board.cell(m, c).value)
+    if not have:
+        return Statement(question, f"No tracker of `results/{c.run}/` tracks half of its scans.", (c.run,))
     best, worst = have[0], have[-1]
     key = board.cell(best, c).row
     where = "pooled over its recordings" if c.scope == POOLED else c.scope
-    return Statement(question, f"`{best}`: its own confidence flags its losses best (self-assessment AUC "
+    return Statement(question, f"`{best}`: of the trackers that track at least half of the scans, its own "
+                               f"confidence flags its losses best (self-assessment AUC "
                                f"{board.cell(best, c).value:.2f}, {where}; 0.5 is chance); least: `{worst}` "
                                f"({board.cell(worst, c).value:.2f}). The report's self-assessment table has the "
                                f"share of losses each catches at 1 % false alarms. From `results/{c.run}/`.",

@@ -15,7 +15,7 @@ from tfloc.report.mdtable import num, table
 #: the study file that declares the development split (its datasets)
 DEV_STUDY = "benchmarks/dev/truth-free.toml"
 #: the runs whose verdicts are checked against the truth
-RUNS = ("native", "sequences")
+RUNS = ("native-csail", "native", "sequences")
 
 
 def agreement_markdown(tables: dict[str, pd.DataFrame], dev: set[str]) -> str:
