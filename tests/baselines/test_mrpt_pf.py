@@ -9,8 +9,8 @@ import shutil
 import numpy as np
 import pytest
 from _paths import ROOT
-
 from tfloc.baselines._mrpt_files import carmen_lines, parse_estimates, render_ini
+
 from tfloc.core.laser import LaserSpec
 from tfloc.core.matcher import get_matcher, kind_of
 from tfloc.errors import ParameterError

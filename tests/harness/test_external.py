@@ -11,12 +11,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 from _paths import ROOT
+from tfloc.baselines._external import (
+    ExternalProgramError,
+    ProgramMissingError,
+    find_program,
+    read_table,
+    run_program,
+)
 
 from tfloc.core.external import CPU_EVEN, CPU_OWN_LOG, BatchAnswer, ExternalProgram, split_cpu
 from tfloc.core.pose import Pose
 from tfloc.evaluation.truthfree.reconverge import Restart
-from tfloc.baselines._external import (ExternalProgramError, ProgramMissingError, find_program,
-                                    read_table, run_program)
 from tfloc.harness.fingerprint import differences
 from tfloc.harness.restarts import restart_ends
 from tfloc.harness.track import track

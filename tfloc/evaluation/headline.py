@@ -30,6 +30,7 @@ import pandas as pd
 
 from tfloc.core.thresholds import Thresholds
 
+from .metrics import tracked
 from .paired import ALPHA
 from .stats import holm, mcnemar_exact, wilson
 from .trajectory import pooled_share
@@ -82,9 +83,7 @@ def _hits(g: pd.DataFrame, mode: str, thr: Thresholds) -> pd.Series:
         return g["believed"].astype(bool)
     t = g[g["truth"]]
     if mode == "sequence":
-        d = pd.to_numeric(t["dist_err_m"], errors="coerce")
-        o = pd.to_numeric(t["orient_err_rad"], errors="coerce")
-        return pd.Series(thr.success(d.to_numpy(float), o.to_numpy(float)), index=t.index)
+        return pd.Series(tracked(t, thr), index=t.index)
     return t["outcome_eval"] == "success"
 
 

@@ -99,6 +99,14 @@ def has_truth(df: pd.DataFrame) -> pd.Series:
     return pd.to_numeric(df["true_x"], errors="coerce").notna()
 
 
+def tracked(df: pd.DataFrame, thr: Thresholds) -> np.ndarray:
+    """Per row, whether its errors lie within the tracked thresholds (NaN errors: not tracked);
+    the tracking tables' rule, one copy for every reader of rows."""
+    d = pd.to_numeric(df["dist_err_m"], errors="coerce").to_numpy(float)
+    o = pd.to_numeric(df["orient_err_rad"], errors="coerce").to_numpy(float)
+    return np.asarray(thr.success(d, o), dtype=bool).reshape(-1)
+
+
 def has_estimate(df: pd.DataFrame) -> pd.Series:
     """Rows with status ok/failed and finite errors (the rows of the error statistics)."""
     d = pd.to_numeric(df["dist_err_m"], errors="coerce")

@@ -26,6 +26,8 @@ from scipy.stats import rankdata
 
 from tfloc.core.traits import Confidence, confidence_of
 
+from .metrics import tracked
+
 #: the false-alarm rate of the "caught" figure
 FALSE_ALARM = 0.01
 
@@ -107,9 +109,7 @@ def self_assessments(p: pd.DataFrame, sequences: list[str], thr, confidence=None
                 continue
             x = values(g["info"], conf)
             t = g["truth"].to_numpy(bool)
-            dist = pd.to_numeric(g["dist_err_m"], errors="coerce").to_numpy(float)
-            turn = pd.to_numeric(g["orient_err_rad"], errors="coerce").to_numpy(float)
-            lost = ~(thr.success(dist, turn) & np.isfinite(dist))
+            lost = ~tracked(g, thr)
             out.append(assess(d, m, conf, x[t], lost[t]))
             c, xs, ls = pooled.setdefault(m, (conf, [], []))
             xs.append(x[t])

@@ -37,11 +37,11 @@ from . import sections as S
 from .failures import draw_failures, failures_section
 from .figures import MANY_MATCHERS
 from .headline import headline_section
-from .truthfree import load_truth_free, truth_free_section
 from .landscape import draw_landscapes, landscape_section
 from .mdtable import num
 from .sessions import this_run
 from .timing import run_cpu_note
+from .truthfree import load_truth_free, truth_free_section
 
 CONTENTION = 1.5  # median wall / CPU time above this: other processes competed for the cores
 
@@ -371,7 +371,7 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
     if glob:
         tracking = _relocalization(run_dir, df[df["dataset"].isin(glob)], info, thr) + "\n" + tracking
     if df["dataset"].isin(seq | glob).all():
-        p = prepare(df, thr)
+        p = prepared
         report = run_dir / "report.md"
         report.write_text("\n".join([header(run_dir, run, p, thr, set()), top, tracking]))
         return ReportFiles(report, run_dir / ("tracking.csv" if seq else "relocalization.csv"), ())

@@ -31,6 +31,7 @@ import pandas as pd
 from tfloc.core.thresholds import Thresholds
 from tfloc.evaluation.global_start import SETTLE_M, SETTLE_SCANS, score_start, starts_without_pose
 from tfloc.evaluation.kidnap import HOLD, WITHIN, median_scans, score_kidnaps
+from tfloc.evaluation.metrics import has_truth
 from tfloc.evaluation.trajectory import (
     LOST_DIST_M,
     LOST_ORIENT_DEG,
@@ -308,7 +309,7 @@ def tracking_section(df: pd.DataFrame, datasets: dict[str, Scenario], maps: dict
     ``out_dir/figures/tracking/``); ``maps``: dataset name → its map, for the figures. A
     dataset without truth gets no truth-based figure or table: its trajectories and jumps only
     (the truth-free verdict ranks it, :mod:`tfloc.report.truthfree`)."""
-    truth = pd.to_numeric(df["true_x"], errors="coerce").notna().groupby(df["dataset"]).any()
+    truth = has_truth(df).groupby(df["dataset"]).any()
     blind = [d for d in df["dataset"].unique() if not truth.get(d, False)]
     everything, df = df, df[~df["dataset"].isin(blind)]
     s = sequence_scores(df, datasets, thresholds)

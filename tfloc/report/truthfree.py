@@ -111,7 +111,7 @@ def agreement_table(a: pd.DataFrame) -> str:
 
 def selfassess_table(assessments: list[SelfAssessment], scope: str) -> str:
     """Every tracker's own confidence as a lost-detector on one scope, best AUC first."""
-    mine = sorted((a for a in assessments if a.scope == scope), key=lambda a: -(a.auc if a.auc == a.auc else -1))
+    mine = sorted((a for a in assessments if a.scope == scope), key=lambda a: 1.0 if math.isnan(a.auc) else -a.auc)
     body = [[f"`{a.matcher}`", f"`{a.key}`", confidence_of(a.matcher).about if confidence_of(a.matcher) else "",
              num(a.auc, 3), "—" if math.isnan(a.caught) else f"{100 * a.caught:.1f}", a.lost, a.scans]
             for a in mine]

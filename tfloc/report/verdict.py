@@ -31,6 +31,7 @@ import numpy as np
 import pandas as pd
 
 from tfloc.core.traits import method_of
+from tfloc.evaluation.metrics import tracked as tracked_rows
 from tfloc.evaluation.recording import check_recording
 from tfloc.evaluation.trajectory import pooled_share
 from tfloc.evaluation.truthfree import reconverge as R
@@ -81,9 +82,7 @@ def recording(df: pd.DataFrame, name: str, order: list[str], scan_ids: list[str]
         labels.append(m)
         est.append(_poses(g, "est"))
         init.append(_poses(g, "init"))
-        dist = pd.to_numeric(g["dist_err_m"], errors="coerce").to_numpy(float)
-        turn = pd.to_numeric(g["orient_err_rad"], errors="coerce").to_numpy(float)
-        tracked.append(thr.success(dist, turn) & np.isfinite(dist))
+        tracked.append(tracked_rows(g, thr))
         if truth is None:
             truth = pd.to_numeric(g["true_x"], errors="coerce").notna().to_numpy(bool)
     n = len(scan_ids)
