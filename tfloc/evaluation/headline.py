@@ -28,6 +28,8 @@ from dataclasses import asdict, dataclass, fields
 import numpy as np
 import pandas as pd
 
+from tfloc.core.modes import MODES, mode_of
+from tfloc.core.modes import TRUTH_FREE as FREE_MODE
 from tfloc.core.thresholds import Thresholds
 
 from .metrics import tracked
@@ -35,10 +37,8 @@ from .paired import ALPHA
 from .stats import holm, mcnemar_exact, wilson
 from .trajectory import pooled_share
 
-#: a run's dataset modes (``tfloc.io.scenario``) → the measure its headline ranks by
-MEASURES = {"single": "success", "scan-to-scan": "success", "sequence": "tracked", "global": "top-1"}
 #: the measure of a sequence dataset without truth
-TRUTH_FREE = "truth-free"
+TRUTH_FREE = FREE_MODE.key
 POOLED = "all"
 
 
@@ -131,8 +131,7 @@ def _table(p: pd.DataFrame, mode: str, scope: str, thr: Thresholds, free: Verdic
         nxt = stats[i + 1][0] if i + 1 < len(stats) else ""
         p_adj = float(adj[i]) if i < len(adj) else math.nan
         verdict = "" if not nxt or math.isnan(p_adj) else "ahead" if p_adj < ALPHA else "tied"
-        measure = TRUTH_FREE if mode == TRUTH_FREE else MEASURES.get(mode, "success")
-        error = "" if mode == TRUTH_FREE else "APE RMSE" if mode == "sequence" else "median error"
+        measure, error = mode_of(mode).measure, mode_of(mode).error
         out.append(HeadlineRow("sequence" if mode == TRUTH_FREE else mode, scope, i + 1, m, measure, v, lo, hi,
                                n, err, error, cpu, verdict, nxt, p_adj,
                                v if mode == TRUTH_FREE else free.get((scope, m), (math.nan,))[0],
@@ -152,7 +151,7 @@ def headline(p: pd.DataFrame, modes: dict[str, str], thr: Thresholds, beliefs: p
     out: list[HeadlineRow] = []
     with_truth = set(p.loc[p["truth"], "dataset"])
     t = p[p["truth"]]
-    for mode in MEASURES:
+    for mode in MODES:
         names = [d for d in t["dataset"].unique() if modes.get(d, "single") == mode]
         if not names:
             continue

@@ -36,6 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from tfloc.core.laser import LaserSpec
+from tfloc.core.modes import MODES as ALL_MODES
 from tfloc.core.pose import Pose
 from tfloc.core.problem import check_ranges
 from tfloc.errors import DatasetError
@@ -46,8 +47,8 @@ MAX_BEAMS = 1_000_000  # a laser with more beams is a damaged scenario.json, not
 COLUMNS = ["scan_id", "group", "true_x", "true_y", "true_theta", "init_x", "init_y", "init_theta",
            "ranges"]
 ODOM_COLUMNS = ["odom_x", "odom_y", "odom_theta"]
-SINGLE, SCAN_TO_SCAN, SEQUENCE, GLOBAL = "single", "scan-to-scan", "sequence", "global"
-MODES = (SINGLE, SCAN_TO_SCAN, SEQUENCE, GLOBAL)
+SINGLE, SCAN_TO_SCAN, SEQUENCE, GLOBAL = (m.key for m in ALL_MODES.values())
+MODES = tuple(ALL_MODES)
 
 
 @dataclass(frozen=True, eq=False)

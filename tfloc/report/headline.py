@@ -9,15 +9,12 @@ from pathlib import Path
 
 import pandas as pd
 
+from tfloc.core.modes import MODES, mode_of
 from tfloc.core.thresholds import Thresholds
 from tfloc.evaluation.headline import POOLED, TRUTH_FREE, HeadlineRow, headline, headline_frame
 
 from .mdtable import num, table
 
-#: how a mode's table is titled
-TITLES = {"single": "A single scan from a rough guess", "scan-to-scan": "Scan to scan",
-          "sequence": "Tracking along a sequence", "global": "A single scan without a guess (global)",
-          TRUTH_FREE: "Tracking without ground truth: the truth-free verdict"}
 
 
 def interval(r: HeadlineRow) -> str:
@@ -84,7 +81,7 @@ def headline_section(p: pd.DataFrame, modes: dict[str, str], thr: Thresholds, ru
         rule = "share of scans believed tracked, judged without the truth (docs/truth-free.md)" \
             if key == TRUTH_FREE else f"{mine[0].measure}: within {thr.dist_m * 100:g} cm and " \
             f"{thr.orient_deg:g}° of the truth"
-        out.append(f"**{TITLES.get(key, key)}** ({where}; {rule}):\n")
+        out.append(f"**{mode_of(key).title if key in (*MODES, TRUTH_FREE) else key}** ({where}; {rule}):\n")
         out.append(headline_table(mine))
     out.append("Best first. Interval: Wilson's over scans (tracking pooled over sequences: bootstrap "
                "over sequences; the truth-free verdict: moving-block bootstrap over scans). *Against the next*: exact McNemar test on the scans both answered, "

@@ -16,7 +16,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from tfloc.evaluation.headline import MEASURES, POOLED, HeadlineRow, read_headline
+from tfloc.core.modes import mode_of
+from tfloc.evaluation.headline import POOLED, HeadlineRow, read_headline
 from tfloc.evaluation.stats import wilson
 from tfloc.evaluation.trajectory import pooled_share
 
@@ -43,9 +44,8 @@ class RunRows:
 
 def _row(mode: str, scope: str, matcher: str, value: float, lo: float, hi: float, n: int,
          error_cm: float, cpu_ms: float) -> HeadlineRow:
-    err = "APE RMSE" if mode == "sequence" else "median error"
-    return HeadlineRow(mode, scope, 0, matcher, MEASURES.get(mode, "success"), value, lo, hi, n,
-                       error_cm, err, cpu_ms, "", "", math.nan)
+    m = mode_of(mode)
+    return HeadlineRow(mode, scope, 0, matcher, m.measure, value, lo, hi, n, error_cm, m.error, cpu_ms, "", "", math.nan)
 
 
 def _ranked(rows: list[HeadlineRow]) -> list[HeadlineRow]:
