@@ -23,7 +23,7 @@ A run configuration file looks like (relative paths are relative to where tfloc 
 ``skip_per_group`` skips the first N scans of each group (a held-out selection after a development
 split). A configuration is a *study file* (:func:`load_study`): ``extends = "other.toml"`` takes
 that file's keys (tables merged key by key; ``name`` and ``out`` are never inherited) with its
-own on top, ``steps`` lists what makes its tables after the run (:data:`STEPS`; ``index`` runs
+own on top (``matchers`` may name a roster: :mod:`tfloc.harness.rosters`), ``steps`` lists what makes its tables after the run (:data:`STEPS`; ``index`` runs
 before it) and ``kind = "scaling"`` with a ``[scaling]`` table is the scaling study. A matcher named ``module:Class`` runs that module's code: :func:`check_imports` refuses it
 unless imports are allowed (``tfloc bench --allow-import``). Each parameter remembers the key that
 set it, so that a bad one is reported by its key (``[params.csm-corr] search_radiuss``).
@@ -41,6 +41,8 @@ from typing import Any
 from tfloc.core.thresholds import Thresholds
 from tfloc.errors import ConfigError
 from tfloc.io.text import parse_text
+
+from .rosters import expand
 
 #: steps a study file may declare: ``index`` (tf-global's place index of every dataset's map)
 #: runs before the run, the others after it in the order written
@@ -138,8 +140,10 @@ def _defaults(defaults: dict[str, dict], name: str, where: str) -> tuple[dict, d
 
 
 def parse_matchers(entries: list, defaults: dict[str, dict], where: str) -> tuple[MatcherSpec, ...]:
-    """Matcher entries: a registered name, or a table ``{label, name, params}``."""
+    """Matcher entries: a registered name, a table ``{label, name, params}`` or ``@ROSTER``
+    (:mod:`tfloc.harness.rosters`)."""
     specs = []
+    entries = expand(entries, where)
     for i, e in enumerate(entries):
         at = f"{where}: matchers[{i}]" if where != "--matchers" else f"--matchers {e}"
         if isinstance(e, str):
@@ -313,6 +317,8 @@ def config_of(doc: dict, path: Path) -> RunConfig:
         raise ConfigError(f"{path}: unknown key(s) {', '.join(unknown)}")
     if "sweep" in doc:  # a run may consist of sweeps only
         doc.setdefault("matchers", [])
+    if "matchers" in doc:
+        doc["matchers"] = expand(doc["matchers"], str(path))
     for key in ("datasets", "matchers"):
         if not isinstance(doc.get(key), list):
             raise ConfigError(f"{path}: '{key}' must be a list")

@@ -16,7 +16,6 @@ from tfloc.evaluation.headline import POOLED, TRUTH_FREE, HeadlineRow, headline,
 from .mdtable import num, table
 
 
-
 def interval(r: HeadlineRow) -> str:
     """``value [lo–hi]`` in percent (the interval left out where there is none)."""
     ci = "" if math.isnan(r.lo_pct) else f" [{r.lo_pct:.1f}–{r.hi_pct:.1f}]"
