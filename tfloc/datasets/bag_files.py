@@ -7,9 +7,12 @@ from __future__ import annotations
 import shutil
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import yaml
+
+from tfloc.errors import BagError
 
 
 @dataclass(frozen=True)
@@ -32,6 +35,19 @@ class ImportSummary:
 def span(stamps: np.ndarray) -> str:
     """``t=first…last s (N poses)`` of a pose stream, for messages."""
     return f"t={stamps[0]:.3f}…{stamps[-1]:.3f} s ({stamps.size} poses)"
+
+
+def returning_rows(cfg: Any, scans: Any, pick: np.ndarray, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The picked scans to import: those ``keep`` marks that have a return, the first
+    ``cfg.limit`` of them (all if 0); and the kept scans without any return (a mask over
+    ``pick``). One line naming the bag and topic where none is left."""
+    empty = keep & (scans.laser.valid(scans.ranges[pick]).sum(axis=1) == 0)
+    rows = np.flatnonzero(keep & ~empty)
+    if cfg.limit:
+        rows = rows[:cfg.limit]
+    if rows.size == 0:
+        raise BagError(f"{cfg.bag}: no scan on {cfg.scan_topic} is left to import (all lack a return)")
+    return rows, empty
 
 
 def stretches(mask: np.ndarray, t: np.ndarray, index: np.ndarray) -> tuple[dict, ...]:

@@ -21,7 +21,7 @@ from tfloc.core.pose import Pose
 from tfloc.errors import BagError
 from tfloc.io.scenario import SEQUENCE, Scan, usable_sequence, write_scenario
 
-from .bag_files import ImportSummary, save_map, source_record, span, stretches
+from .bag_files import ImportSummary, returning_rows, save_map, source_record, span, stretches
 from .first_pose import FirstPose, global_first_pose
 from .interpolate import interpolate_poses
 
@@ -54,15 +54,9 @@ def import_sequence(cfg, scans, pick: np.ndarray, t: np.ndarray, truth: np.ndarr
         outside_init = int(np.count_nonzero(keep[:first[0]]))
         keep[:first[0]] = False
     las = scans.laser
-    no_return = las.valid(scans.ranges[pick]).sum(axis=1) == 0
-    n_empty = int(np.count_nonzero(keep & no_return))
-    empty = stretches(keep & no_return, t, scans.index[pick])
-    keep &= ~no_return
-    rows = np.flatnonzero(keep)
-    if cfg.limit:
-        rows = rows[:cfg.limit]
-    if rows.size == 0:
-        raise BagError(f"{cfg.bag}: no scan on {cfg.scan_topic} is left to import (all lack a return)")
+    rows, no_return = returning_rows(cfg, scans, pick, keep)
+    n_empty = int(np.count_nonzero(no_return))
+    empty = stretches(no_return, t, scans.index[pick])
     off = cfg.laser_offset
     odom_l = [Pose.from_array(odom_p[k]).compose(off) for k in rows]
     true_p = [Pose.from_array(truth[k]).compose(off) for k in rows] if ref is not None else [None] * rows.size

@@ -17,7 +17,7 @@ from tfloc.core.pose import Pose
 from tfloc.errors import BagError, ConfigError, DatasetError
 from tfloc.io.scenario import Scan, write_scenario
 
-from .bag_files import ImportSummary, save_map, source_record, span
+from .bag_files import ImportSummary, returning_rows, save_map, source_record, span
 from .interpolate import interpolate_poses
 
 if TYPE_CHECKING:
@@ -140,14 +140,8 @@ def import_bag(cfg: BagImport) -> ImportSummary:
     outside_init = 0
     if init is not None:
         start, outside_init, keep = _also_covered(cfg, init, cfg.initial_topic, t, keep)
-    no_return = scans.laser.valid(scans.ranges[pick]).sum(axis=1) == 0
-    n_empty = int(np.count_nonzero(keep & no_return))
-    keep &= ~no_return
-    rows = np.flatnonzero(keep)
-    if cfg.limit:
-        rows = rows[:cfg.limit]
-    if rows.size == 0:
-        raise BagError(f"{cfg.bag}: no scan on {cfg.scan_topic} is left to import (all lack a return)")
+    rows, no_return = returning_rows(cfg, scans, pick, keep)
+    n_empty = int(np.count_nonzero(no_return))
     off = cfg.laser_offset
     true_p = np.array([Pose.from_array(truth[k]).compose(off).as_array() for k in rows])
 
