@@ -86,7 +86,7 @@ def test_statements_say_not_yet_without_data() -> None:
 def test_statements_name_the_leader_and_the_cheapest() -> None:
     page = Page("single-scan", "single", "", "", (RunRef("run", "run", ("single",)),))
     rows = [_row("a", 1, 99.0, "ahead"), _row("b", 2, 98.5, "")]
-    board = headline_board(page, {"run": RunRows("run", Path("run"), True, "headline.csv", rows)})
+    board = headline_board(page, {"run": RunRows("run", Path("run"), True, "headline.csv", rows, {"real-a": "real"})})
     said = {s.question: s.answer for s in statements({"single-scan": board})}
     assert said["The most accurate single scan on real logs"].startswith("`a` ranks first")
     assert "ahead of the next on every one" in said["The most accurate single scan on real logs"]

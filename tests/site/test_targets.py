@@ -48,7 +48,17 @@ def test_the_block_names_its_runs_and_counts_the_simulated_sequences():
     rows = _rows("log", [("tf-plus-track", 99, "ahead"), ("csm-corr-track", 97, "")])
     sim = _rows("seq-a", [("tf-plus-track", 100, "tied"), ("x", 100, "")]) + \
         _rows("seq-b", [("x", 100, "ahead"), ("tf-plus-track", 90, "")]) + _rows("real-c", [("x", 1, "")])
-    text = targets_markdown(("native", rows, _tracking("log")), ("sequences", sim))
+    kinds = {"seq-a": "simulated", "seq-b": "simulated", "real-c": "real"}
+    text = targets_markdown(("native", rows, _tracking("log")), ("sequences", sim, kinds))
     assert "`results/native/`" in text and "| log | 99.0 % (first, ahead)" in text and "| met |" in text
     assert "on 1 of 2 sequences; behind on seq-b (`x`); **missed** there." in text
-    assert "not yet" in simulated_line([], "sequences") and "not yet" in targets_markdown(None, None)
+    assert "not yet" in simulated_line([], "sequences", {}) and "not yet" in targets_markdown(None, None)
+
+
+def test_the_simulated_sequences_are_those_their_scenario_calls_simulated():
+    """The kind decides, not the name: a simulated dataset named real-… counts, a real one named seq-… does not."""
+    sim = _rows("real-x", [("tf-plus-track", 100, "ahead"), ("x", 90, "")]) + \
+        _rows("seq-b", [("x", 100, "ahead"), ("tf-plus-track", 90, "")])
+    line = simulated_line(sim, "sequences", {"real-x": "simulated", "seq-b": "real"})
+    assert "on 1 of 1 sequences; **met**." in line
+    assert "not yet" in simulated_line(sim, "sequences", {})  # kinds unknown: no sequence counted

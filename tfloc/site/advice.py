@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from tfloc.evaluation.headline import POOLED, TRUTH_FREE
 
 from .board import Board, Column
+from .kinds import REAL, SIMULATED
 
 #: how many points below the best share still count as "as good" for the cheapest-choice questions
 WITHIN_POINTS = 1.0
@@ -25,15 +26,13 @@ class Statement:
     sources: tuple[str, ...] = ()
 
 
-def _real(c: Column) -> bool:
-    return c.scope.startswith("real-")
-
-
 def first_run_columns(board: Board, real: bool | None = None) -> list[Column]:
     """The dataset columns (pooled left out) of the board's first run that has any, only real
-    ones (``real``), only simulated ones (``not real``) or all (``None``)."""
+    recordings (``real``), only simulated ones (``not real``) or all (``None``); a column whose
+    dataset's kind is unknown (no readable ``scenario.json``) is in neither."""
+    want = None if real is None else REAL if real else SIMULATED
     cols = [c for c in board.columns if c.scope != POOLED and not c.figure and c.measure != TRUTH_FREE
-            and (real is None or _real(c) == real)]
+            and (want is None or c.kind == want)]
     return [c for c in cols if c.run == cols[0].run] if cols else []
 
 

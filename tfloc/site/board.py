@@ -17,7 +17,8 @@ from .rows import RunRows
 
 @dataclass(frozen=True)
 class Column:
-    """One column: ``scope`` (a dataset or ``all``) of run ``run`` in headline mode ``mode``."""
+    """One column: ``scope`` (a dataset or ``all``) of run ``run`` in headline mode ``mode``;
+    ``kind``: the dataset's (:mod:`tfloc.site.kinds`; empty for ``all`` or where unknown)."""
 
     run: str
     mode: str
@@ -26,6 +27,7 @@ class Column:
     provisional: bool = False
     figure: str = ""  # a headline row's extra figure shown instead of its measure (:data:`EXTRAS`)
     note: str = ""  #: shown after the label, e.g. a re-timing's ``contended (×1.42 inflated)``
+    kind: str = ""
 
     @property
     def key(self) -> str:
@@ -118,10 +120,10 @@ def _columns(rr: RunRows, modes: tuple[str, ...], short: bool) -> list[Column]:
         if short and scopes:
             scopes = scopes[:1]
         measure = {r.scope: r.measure for r in rows}
-        cols = [Column(rr.name, mode, s, measure[s], rr.provisional) for s in scopes]
+        cols = [Column(rr.name, mode, s, measure[s], rr.provisional, kind=rr.kinds.get(s, "")) for s in scopes]
         if not short and cols and measure[cols[0].scope] != TRUTH_FREE:  # the first column's extras
-            top = [r for r in rows if r.scope == cols[0].scope]
-            cols[1:1] = [Column(rr.name, mode, cols[0].scope, measure[cols[0].scope], rr.provisional, figure=f)
+            top, c0 = [r for r in rows if r.scope == cols[0].scope], cols[0]
+            cols[1:1] = [Column(rr.name, mode, c0.scope, c0.measure, rr.provisional, figure=f, kind=c0.kind)
                          for f in EXTRAS if any(math.isfinite(getattr(r, f)) for r in top)]
         out += cols
     return out

@@ -1,7 +1,8 @@
 """Everything the site shows, read from a results root once: each page's runs' headline rows
 (:mod:`tfloc.site.rows`), the re-timings and the scaling slopes of the cost page, and the
-leaderboards and statements built from them. The only module of the package that reads the
-results root's tables; the renderers take what it returns."""
+leaderboards and statements built from them. With :mod:`tfloc.site.rows` (a run's rows) and
+:mod:`tfloc.site.runs` (its ``run.json`` and datasets), the only modules of the package that read
+the results root's tables; the renderers take what it returns (a run's page reads its notes)."""
 
 from __future__ import annotations
 
@@ -10,15 +11,14 @@ from pathlib import Path
 
 import pandas as pd
 
-from tfloc.errors import TflocError
 from tfloc.evaluation.contention import Contention, mark
-from tfloc.io.rundir import RunDir
 
 from .advice import Statement, statements
 from .board import Board, headline_board, unique_dirs
 from .cost import SLOPES_CSV, cpu_board, slopes_board
 from .pages import COST, Page, load_pages
 from .rows import SOURCES, RunRows, run_rows
+from .runs import run_info
 from .targets import NATIVE_RUNS, SIMULATED_RUN, targets_markdown
 
 
@@ -81,10 +81,7 @@ def _truth_free(root: Path) -> tuple[str, str]:
 def timing_mark(run_dir: Path) -> str:
     """The contention mark of the run's timing pass (``contended (×f inflated)``; empty when quiet,
     not measured by an older pass, or the run's record is unreadable)."""
-    try:
-        record = RunDir(run_dir).info().timing or {}
-    except TflocError:
-        return ""
+    record = run_info(run_dir).timing or {}
     sessions = record.get("sessions") if isinstance(record.get("sessions"), list) else []
     last = sessions[-1] if sessions and isinstance(sessions[-1], dict) else {}
     return mark(Contention.from_record(last.get("contention")))
@@ -104,7 +101,7 @@ def _targets(root: Path, runs: dict[str, RunRows]) -> str:
             native = (name, rr.rows, tracking)
             break
     sim = _reported(root, runs, SIMULATED_RUN)
-    return targets_markdown(native, (SIMULATED_RUN, sim.rows) if sim is not None else None)
+    return targets_markdown(native, (SIMULATED_RUN, sim.rows, sim.kinds) if sim is not None else None)
 
 
 def run_note(rr: RunRows | None, name: str, table: str | None = None) -> str:

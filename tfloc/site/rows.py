@@ -4,12 +4,12 @@ derived from the tables the run already has, marked *provisional*: ``tracking.cs
 share with Wilson's interval per sequence, pooled over sequences by the same bootstrap as the
 headline), ``relocalization.csv`` (top-1) or ``summary.csv`` (success per dataset, pooled by
 Wilson over scans). A provisional row has no paired test (verdict empty, never marked best),
-and a pooled one no error or CPU figure (medians do not pool). Percentages in %, errors in cm,
-CPU in ms."""
+and a pooled one no error or CPU figure (medians do not pool). Each dataset's kind (real or
+simulated) comes with the rows, read from its ``scenario.json`` (:mod:`tfloc.site.runs`).
+Percentages in %, errors in cm, CPU in ms."""
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -20,6 +20,9 @@ from tfloc.core.modes import mode_of
 from tfloc.evaluation.headline import POOLED, HeadlineRow, read_headline
 from tfloc.evaluation.stats import wilson
 from tfloc.evaluation.trajectory import pooled_share
+from tfloc.io.rundir import RunInfo
+
+from .runs import dataset_kinds, run_info
 
 #: where a run's rows came from, best first
 SOURCES = ("headline.csv", "tracking.csv", "relocalization.csv", "summary.csv")
@@ -28,13 +31,15 @@ SOURCES = ("headline.csv", "tracking.csv", "relocalization.csv", "summary.csv")
 @dataclass(frozen=True)
 class RunRows:
     """The headline rows of one run directory (``source``: the file they came from, "" where
-    the run has none; ``exists``: the directory is there)."""
+    the run has none; ``exists``: the directory is there; ``kinds``: dataset → ``real`` or
+    ``simulated``, for the datasets whose ``scenario.json`` could be read)."""
 
     name: str
     path: Path
     exists: bool
     source: str = ""
     rows: list[HeadlineRow] = field(default_factory=list)
+    kinds: dict[str, str] = field(default_factory=dict)
 
     @property
     def provisional(self) -> bool:
@@ -101,12 +106,13 @@ def _from_relocalization(df: pd.DataFrame) -> list[HeadlineRow]:
     return pooled + rows
 
 
-def _from_summary(df: pd.DataFrame, declared: dict) -> list[HeadlineRow]:
+def _from_summary(df: pd.DataFrame, info: RunInfo) -> list[HeadlineRow]:
     df = df[(df["grouping"] == "dataset") & (df["bin"] == "all")]
     rows, per = [], {}
+    modes = {d: info.mode(d) for d in dict.fromkeys(str(d) for d in df["dataset"])}
     for r in df.to_dict("records"):
         d = str(r["dataset"])
-        mode = declared.get(d, {}).get("mode", "single")
+        mode = modes[d]
         n, k = int(r["n_truth"]), int(r["n_success"])
         rows.append(_row(mode, d, str(r["matcher"]), float(r["success_rate_pct"]), float(r["success_lo_pct"]),
                          float(r["success_hi_pct"]), n, float(r["dist_median_cm"]), float(r["cpu_median_ms"])))
@@ -118,21 +124,20 @@ def _from_summary(df: pd.DataFrame, declared: dict) -> list[HeadlineRow]:
     return pooled + rows
 
 
-def _declared(path: Path) -> dict:
-    try:
-        return json.loads((path / "run.json").read_text(encoding="utf-8")).get("declared", {}) or {}
-    except (OSError, ValueError):
-        return {}
-
-
 def run_rows(root: Path, name: str) -> RunRows:
     """The headline rows of ``root/name``: from ``headline.csv``, else provisional ones from the
     first of the run's other tables (:data:`SOURCES`), else none."""
     path = Path(root) / name
     if not path.is_dir():
         return RunRows(name, path, False)
+    info = run_info(path)
+
+    def found(source: str, rows: list[HeadlineRow]) -> RunRows:
+        return RunRows(name, path, True, source, rows,
+                       dataset_kinds(info, [r.scope for r in rows if r.scope != POOLED], Path(root).resolve().parent))
+
     if (path / SOURCES[0]).is_file():
-        return RunRows(name, path, True, SOURCES[0], read_headline(path / SOURCES[0]))
+        return found(SOURCES[0], read_headline(path / SOURCES[0]))
     for source in SOURCES[1:]:
         f = path / source
         if not f.is_file():
@@ -145,6 +150,6 @@ def run_rows(root: Path, name: str) -> RunRows:
         elif source == "relocalization.csv":
             rows = _from_relocalization(df)
         else:
-            rows = _from_summary(df, _declared(path))
-        return RunRows(name, path, True, source, _ranked(rows))
+            rows = _from_summary(df, info)
+        return found(source, _ranked(rows))
     return RunRows(name, path, True)

@@ -1,5 +1,6 @@
 """A run's page: its provenance from ``run.json`` (commit, versions, machine, sessions' dates),
-its ``report.md``, ``timing.md`` and other notes rendered as HTML. The page works from disk: a
+its ``report.md``, ``timing.md`` and other notes rendered as HTML (``run.json`` read through
+:mod:`tfloc.site.runs`; a malformed one shows as no provenance). The page works from disk: a
 relative link or image of a note points at the file's place in the results root (the figures
 stay where the run wrote them, nothing is copied), a link to a rendered note at its anchor, and
 a link to nothing is dropped (its text kept)."""
@@ -7,12 +8,12 @@ a link to nothing is dropped (its text kept)."""
 from __future__ import annotations
 
 import html
-import json
 import os
 from pathlib import Path
 from urllib.parse import unquote, urlsplit
 
 from .html import markdown, shell
+from .runs import run_info
 
 #: the notes a run page renders, in this order (any other top-level *.md follows)
 NOTES = ("report.md", "timing.md", "NOTE.md", "robustness.md", "README.md")
@@ -93,10 +94,7 @@ def note_html(text: str, run_dir: Path, page_dir: Path, rendered: set[str]) -> s
 def write_run_page(run_dir: Path, page_dir: Path, title: str, home: str) -> Path:
     """``page_dir/index.html`` for the run in ``run_dir``; returns its path."""
     page_dir.mkdir(parents=True, exist_ok=True)
-    try:
-        run = json.loads((run_dir / "run.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        run = {}
+    run = run_info(run_dir).doc
     notes = [n for n in NOTES if (run_dir / n).is_file()]
     notes += sorted(p.name for p in run_dir.glob("*.md") if p.name not in notes)
     rendered = set(notes)

@@ -17,6 +17,8 @@ import pandas as pd
 from tfloc.evaluation.headline import POOLED, HeadlineRow
 from tfloc.report.mdtable import table
 
+from .kinds import SIMULATED
+
 #: the tracker the targets are set for
 TRACKER = "tf-plus-track"
 #: the runs the native targets read, first found first
@@ -90,10 +92,11 @@ def native_checks(headline: list[HeadlineRow], tracking: pd.DataFrame, me: str =
     return out
 
 
-def simulated_line(headline: list[HeadlineRow], run: str, me: str = TRACKER) -> str:
-    """One sentence: on how many simulated sequences ``me`` is first or tied, and behind whom."""
+def simulated_line(headline: list[HeadlineRow], run: str, kinds: dict[str, str], me: str = TRACKER) -> str:
+    """One sentence: on how many simulated sequences (``kinds``: dataset → kind,
+    :mod:`tfloc.site.kinds`) ``me`` is first or tied, and behind whom."""
     scopes = [s for s in dict.fromkeys(r.scope for r in headline if r.mode == "sequence")
-              if s != POOLED and not s.startswith("real-")]
+              if s != POOLED and kinds.get(s) == SIMULATED]
     per = {s: standing([r for r in headline if r.scope == s], me) for s in scopes}
     per = {s: v for s, v in per.items() if v is not None}
     if not per:
@@ -108,8 +111,9 @@ def simulated_line(headline: list[HeadlineRow], run: str, me: str = TRACKER) -> 
 
 
 def targets_markdown(native: tuple[str, list[HeadlineRow], pd.DataFrame] | None,
-                     simulated: tuple[str, list[HeadlineRow]] | None, me: str = TRACKER) -> str:
-    """The targets block: one row per native recording, then the simulated conditions' line."""
+                     simulated: tuple[str, list[HeadlineRow], dict[str, str]] | None, me: str = TRACKER) -> str:
+    """The targets block: one row per native recording, then the simulated conditions' line
+    (``simulated``: the run, its rows and its datasets' kinds)."""
     parts = []
     if native is None:
         parts.append(f"Native recordings: not yet (no run of {', '.join(NATIVE_RUNS)} with `tracking.csv` "
@@ -126,6 +130,6 @@ def targets_markdown(native: tuple[str, list[HeadlineRow], pd.DataFrame] | None,
                      f"per step, the cheapest tracker with ≥ {TRACKS_PCT:g} % tracked):\n")
         parts.append(table(["recording", "tracked", "APE cm", "jumps > 1 m", "CPU ms", f"cheapest ≥ {TRACKS_PCT:g} %",
                             "targets"], body, "llrrrll"))
-    parts.append("\n" + (simulated_line(simulated[1], simulated[0], me) if simulated else
+    parts.append("\n" + (simulated_line(simulated[1], simulated[0], simulated[2], me) if simulated else
                          f"Simulated conditions: not yet (no `results/{SIMULATED_RUN}/` headline)."))
     return "\n".join(parts) + "\n"
