@@ -12,7 +12,7 @@ from packaging.utils import canonicalize_name
 
 from tfloc.errors import ConfigError
 from tfloc.io.lock import LOCK_NAME, find_lock, lock_differences, read_lock
-from tfloc.report.report import lock_note
+from tfloc.report.provenance import lock_note
 
 
 def test_the_checkout_has_its_lock() -> None:

@@ -3,23 +3,21 @@
 Reads ``estimates.csv`` and ``run.json`` (:class:`tfloc.io.rundir.RunDir`), computes the metrics
 (:mod:`tfloc.evaluation.metrics`, :mod:`tfloc.evaluation.summary`) and the paired tests
 (:mod:`tfloc.evaluation.paired`, also written to ``paired.csv``), draws the figures
-(:mod:`tfloc.report.figures`, :mod:`tfloc.report.failures`) and writes the markdown
-(:mod:`tfloc.report.sections`). A timing pass (``tfloc timing RUN``) is linked when present.
+(:mod:`tfloc.report.figures`, :mod:`tfloc.report.failures`) and writes the markdown: the
+header (:mod:`tfloc.report.provenance`), the definitions (:mod:`tfloc.report.definitions`), the
+tables (:mod:`tfloc.report.sections`). A timing pass (``tfloc timing RUN``) is linked when present.
 """
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
-from datetime import UTC, datetime
 from pathlib import Path
 
 import pandas as pd
 
 from tfloc.core.thresholds import Thresholds
 from tfloc.evaluation.metrics import prepare, summarize
-from tfloc.evaluation.paired import ALPHA, paired_table
-from tfloc.evaluation.paper import CITATION
+from tfloc.evaluation.paired import paired_table
 from tfloc.evaluation.summary import (
     declaring,
     scenario_summary,
@@ -27,23 +25,19 @@ from tfloc.evaluation.summary import (
     write_summary,
 )
 from tfloc.harness.workspace import load_dataset, map_of
-from tfloc.io.estimates import status_kind, status_kinds
-from tfloc.io.lock import LOCK_NAME, find_lock, lock_differences, read_lock
+from tfloc.io.estimates import status_kinds
 from tfloc.io.rundir import RunDir, RunInfo
 from tfloc.io.scenario import GLOBAL, SCAN_TO_SCAN, SEQUENCE
 
 from . import figures as F
 from . import sections as S
+from .definitions import definitions
 from .failures import draw_failures, failures_section
 from .figures import MANY_MATCHERS
 from .headline import headline_section
 from .landscape import draw_landscapes, landscape_section
-from .mdtable import num
-from .sessions import this_run
-from .timing import run_cpu_note
+from .provenance import header
 from .truthfree import load_truth_free, truth_free_section
-
-CONTENTION = 1.5  # median wall / CPU time above this: other processes competed for the cores
 
 
 @dataclass(frozen=True)
@@ -62,149 +56,6 @@ def load_run(run_dir: Path) -> tuple[pd.DataFrame, RunInfo]:
     rd = RunDir(run_dir)
     rd.require_results()
     return rd.results(), rd.info()
-
-
-def header(run_dir: Path, run: dict, df: pd.DataFrame, thr: Thresholds, s2s: set[str]) -> str:
-    """Title and provenance: run, dates, commit, machine, versions, datasets, matchers, thresholds."""
-    cfg = run.get("config", {})
-    git = run.get("git", {})
-    mach = run.get("machine", {})
-    sessions = this_run(run.get("sessions", []))
-    commit = git.get("commit") or "unknown"
-    if git.get("dirty"):
-        commit += " (working tree had uncommitted changes)"
-    lines = [f"# tfloc benchmark report: {cfg.get('name', run_dir.name)}\n",
-             f"- Run directory: `{run_dir}`",
-             f"- Report generated: {datetime.now(UTC).strftime('%Y-%m-%d %H:%M UTC')}",
-             f"- Run started: {sessions[0].get('started', 'unknown') if sessions else 'unknown'}"
-             + (f" ({len(sessions)} sessions, resumed)" if len(sessions) > 1 else ""),
-             f"- Commit: `{commit}`",
-             code_note(run),
-             f"- Machine: {mach.get('platform', '?')}, {mach.get('cpu_count', '?')} CPUs, Python "
-             f"{mach.get('python', '?')}; {cfg.get('jobs', '?')} worker(s) of one thread each; "
-             f"time limit {cfg.get('timeout_s', '?')} s per scan",
-             "- Versions: " + (", ".join(f"{k} {v}" for k, v in run.get("versions", {}).items() if v) or "unknown")]
-    lines += lock_note(run)
-    if not run:
-        lines.append("- **run.json is missing**: provenance unknown, default thresholds used.")
-    lim = cfg.get("limit_per_group")
-    if lim:
-        lines.append(f"- **Smoke run**: only the first {lim} scans of each group were run.")
-    specs = cfg.get("matchers") or [{"label": m, "name": m} for m in sorted(df["matcher"].unique())]
-    lines.append("- Matchers: " + ", ".join(
-        f"`{m['label']}`" + (f" ({m['name']} {json.dumps(m.get('params', {}))})"
-                             if m.get("params") or m["name"] != m["label"] else "") for m in specs))
-    lines.append("- Datasets: " + ", ".join(
-        f"{d} ({df.loc[df['dataset'] == d, 'scan_id'].nunique()} scans"
-        + (", scan-to-scan" if d in s2s else "") + ")" for d in df["dataset"].unique()))
-    lines.append(f"- Success thresholds: distance error ≤ {thr.dist_m * 100:g} cm and orientation "
-                 f"error ≤ {thr.orient_deg:g}°")
-    st = df["status"].map(lambda s: status_kind(s) or s)
-    lines.append(f"- Rows: {len(df)} (" + ", ".join(f"{k}: {v}" for k, v in st.value_counts().items()) + ")")
-    starts = [x.get("loadavg_start") for x in sessions]
-    end = sessions[-1].get("loadavg_end") if sessions else None
-    if any(starts) or end:
-        lines.append("- Load average (1 min) at the start of each session: "
-                     + ", ".join(num(v[0], 2) if v else "?" for v in starts)
-                     + (f"; at the end: {end[0]:.2f}" if end else "") + f" ({mach.get('cpu_count', '?')} CPUs)")
-    lines += contention(df) + run_cpu_note(run_dir, df)
-    return "\n".join(lines) + "\n"
-
-
-def code_note(run: dict) -> str:
-    """The code that made the rows (its source hash, :mod:`tfloc.harness.identity`) and whether it
-    is this checkout's."""
-    from tfloc.harness.identity import tfloc_code
-
-    made = ((run.get("fingerprint") or {}).get("tfloc") or {})
-    if not isinstance(made, dict) or not made.get("source"):
-        return "- Code: not recorded (a run made before code identity was recorded)"
-    same = made["source"] == tfloc_code()["source"]
-    return (f"- Code: tfloc's answering source `{made['source'][:12]}`, "
-            + ("the same as this checkout's" if same else "**not this checkout's** (made by other code)"))
-
-
-def lock_note(run: dict) -> list[str]:
-    """Whether the run's recorded package versions are those of the checkout's
-    ``requirements.lock`` (nothing when there is no lock or nothing was recorded)."""
-    lock, versions = find_lock(), run.get("versions") or {}
-    if lock is None or not versions:
-        return []
-    diff = lock_differences(versions, read_lock(lock, run.get("machine", {}).get("python")))
-    if not diff:
-        return [f"- Versions: those of `{LOCK_NAME}`"]
-    return [f"- **Versions other than `{LOCK_NAME}`'s**: "
-            + ", ".join(f"{k} {got or 'not installed'} (lock {want})" for k, (got, want) in sorted(diff.items()))
-            + "; answers may differ from a run made with the lock in the last digits, or more"]
-
-
-def contention(p: pd.DataFrame) -> list[str]:
-    """A warning when wall time exceeds CPU time (the machine was shared), or when the run has
-    no CPU times (made before ``cpu_s`` was recorded)."""
-    if "cpu_ms" not in p or not p["cpu_ms"].notna().any():
-        return ["- **No CPU times in this run** (made before `cpu_s` was recorded): the runtime "
-                "columns show wall time only, which other processes on the machine inflate."]
-    t = p[(p["cpu_ms"] > 0) & p["runtime_ms"].notna()]
-    ratio = (t["runtime_ms"] / t["cpu_ms"]).groupby(t["matcher"]).median()
-    overall = float((t["runtime_ms"] / t["cpu_ms"]).median())
-    if overall <= CONTENTION:
-        return [f"- Wall / CPU time per task: median {overall:.2f} (no sign of contention)."]
-    return [f"- **Contention**: the median wall / CPU time per task is {overall:.2f} (per matcher: "
-            + ", ".join(f"`{m}` {v:.2f}" for m, v in ratio.items()) + f"; > {CONTENTION:g} means other "
-            "processes shared the cores). Wall times are inflated, unevenly across matchers; the "
-            "runtimes of this report are CPU times, which this affects far less. A quiet side-by-side "
-            "re-timing: `tfloc timing RUN` (timing.md)."]
-
-
-def _scenario_definition(paper: dict) -> str:
-    """Which datasets of the run pose the paper's scenarios (as their ``scenario.json`` declare)."""
-    one, two, three = (", ".join(declaring(paper, k)) or "none in this run" for k in ("I", "II", "III"))
-    return (f"I = datasets {one}; II = {two} by initial angle offset; III = {three} by initial "
-            "distance offset (as each dataset's `scenario.json` declares, `paper_scenarios`)")
-
-
-def definitions(thr: Thresholds, paper: dict | None = None) -> str:
-    """How every number of the report is defined."""
-    return f"""## Definitions
-
-- **Distance error** ‖(x̂, ŷ) − (x, y)‖ in cm; **orientation error** |angdiff(θ̂, θ)| in degrees
-  (the paper's Eq. 6). Mean, median, p90 (linear interpolation between order statistics), max.
-- **Improvement** (the paper's Tables 2–4): per scan, distance improvement = 100·(1 − dist_err /
-  init_dist_err) and orientation improvement = 100·(1 − orient_err / init_orient_err), where
-  init_* is the error of the initial pose; the tables give the **mean of the per-scan values**.
-  It is 100 % for a perfect answer, 0 % for no change and negative when the answer is worse than
-  the initial pose — one diverged scan with a small initial offset can pull the mean far below 0
-  (the worst per-scan value is in summary.csv, `*_impr_min_pct`). Scans with a zero initial
-  offset have no improvement and are left out of it.
-- **Success**: status `ok` and distance error ≤ {thr.dist_m * 100:g} cm and orientation error ≤
-  {thr.orient_deg:g}°. The **success rate** is over all scans with ground truth: a scan without
-  an answer counts as a failure.
-- **Outcome** of each scan: `success`; `local-optimum` (the matcher's own objective is lower at
-  the true pose than at its answer: the search stopped short); `ambiguous` (its objective prefers
-  the wrong pose); `no-answer` (status `failed`: the matcher declined or returned no finite pose;
-  `timeout`; `error`; `invalid`: the data poses no problem, e.g. the initial pose lies outside the
-  map, and no matcher ran; counted apart from errors).
-- **Which rows count**: error and improvement statistics use scans with an estimate (status `ok`,
-  or `failed` with a finite pose). Timeouts, errors and failed scans without a pose have no error;
-  they are **excluded** from those statistics (the `n` column says how many: "(k excl.)") but
-  count as failures in the success rate and as `no-answer` in the outcomes.
-- **Runtime** per scan is **CPU time**: the worker process's CPU time (all its threads; every
-  library runs one thread) during the matcher's `localize` call only (data loading, numba
-  compilation and what depends only on the map are done before timing), median with a bootstrap
-  95 % interval and p95 in ms over scans with status `ok` or `failed`. The wall time is shown
-  beside it; on a shared machine it is inflated by other processes, CPU time far less.
-- **Intervals**: success rates with Wilson 95 % score intervals; medians with percentile
-  bootstrap 95 % intervals (2000 resamples, seeded). Written as `value [low–high]`.
-- **Paired comparisons**: every pair of matchers on the scans both answered (with truth); an
-  exact McNemar test on success (binomial test of the scans where only one succeeded) and a
-  paired bootstrap 95 % interval of the success-rate difference. P-values are Holm-adjusted
-  within each table (all pairs on one dataset, or pooled); significant = adjusted p < {ALPHA:g}.
-- **Bins** come from the true and initial poses (not from group labels): initial distance offset
-  [0, 100), [100, 200), [200, 300), [300, ∞) cm; initial angle offset [0, 5), [5, 10), [10, 15),
-  [15, ∞) degrees. Left edge included: an offset of exactly 100 cm is in 100–200.
-- **Scenarios** (the paper's Section 5): {_scenario_definition(paper or {})}.
-- Published values: {CITATION}. The paper's tables give no success rates, medians or runtimes.
-"""
 
 
 def _dataset_section(p: pd.DataFrame, name: str, s2s: set[str]) -> str:
