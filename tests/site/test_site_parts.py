@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 from _site_results import TRACKING_CSV
 
+from tfloc.core.modes import MODES, TRUTH_FREE
 from tfloc.errors import ConfigError
 from tfloc.evaluation.headline import HeadlineRow
 from tfloc.site.advice import statements
@@ -36,6 +37,12 @@ def test_every_page_names_its_runs_once() -> None:
     for p in load_pages(quick=True):  # a run already quick (make bench's scaling-quick) is not renamed
         dirs = [r.dir for r in p.runs]
         assert len(set(dirs)) == len(dirs) and not any(d.endswith("-quick-quick") for d in dirs), dirs
+
+
+def test_every_mode_is_shown_on_a_page() -> None:
+    """The site finds a mode's board by its Mode.page: each must be a key of pages.toml."""
+    keys = {p.key for p in load_pages()}
+    assert {m.page for m in (*MODES.values(), TRUTH_FREE)} <= keys
 
 
 def test_a_bad_pages_file_is_one_line(tmp_path: Path) -> None:

@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from tfloc.core.modes import GLOBAL, SEQUENCE, SINGLE
 from tfloc.evaluation.headline import POOLED, TRUTH_FREE
 
 from .board import Board, Column
@@ -167,7 +168,7 @@ def statements(boards: dict[str, Board]) -> list[Statement]:
     def b(key: str) -> Board:
         return boards.get(key) or Board(key, key, [], [])
 
-    track, single, glob = b("tracking"), b("single-scan"), b("global")
+    track, single, glob = b(SEQUENCE.page), b(SINGLE.page), b(GLOBAL.page)
     return [
         cheapest_as_good(track, first_run_columns(track, real=True), "Tracking a real robot",
                          "the real recordings"),

@@ -12,6 +12,8 @@ from pathlib import Path
 
 from markdown_it import MarkdownIt
 
+from tfloc.core.modes import SEQUENCE
+
 from .advice import Statement
 from .board import Board, Cell
 from .collect import SiteData, run_note
@@ -133,7 +135,7 @@ def index_html(data: SiteData, families: dict[str, Family], results_label: str) 
                 sec.append(f"<h3>{html.escape(b.title)}</h3>")
             sec.append(board_html(b, families, labels) if b.columns else
                        '<p class="note">Not yet: no run of this page has figures.</p>')
-        if p.key == "tracking" and data.targets:
+        if p.key == SEQUENCE.page and data.targets:
             sec.append(f'<div class="targets"><h3>The tracking targets</h3>{markdown().render(data.targets)}</div>')
         dirs = [r.dir for r in p.runs] if p.key != COST else list(dict.fromkeys(
             c.run for k in (COST, f"{COST}-slopes") for c in data.boards[k].columns))

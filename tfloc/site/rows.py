@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from tfloc.core.modes import mode_of
+from tfloc.core.modes import GLOBAL, SEQUENCE, mode_of
 from tfloc.evaluation.headline import POOLED, HeadlineRow, read_headline
 from tfloc.evaluation.stats import wilson
 from tfloc.evaluation.trajectory import pooled_share
@@ -86,10 +86,10 @@ def _from_tracking(df: pd.DataFrame) -> list[HeadlineRow]:
     for r in df.to_dict("records"):
         k, n = int(r["n_tracked"]), int(r["n_truth"])
         lo, hi = wilson(k, n)
-        rows.append(_row("sequence", str(r["dataset"]), str(r["matcher"]), 100 * k / n if n else math.nan,
+        rows.append(_row(SEQUENCE.key, str(r["dataset"]), str(r["matcher"]), 100 * k / n if n else math.nan,
                          100 * lo, 100 * hi, n, 100 * float(r["ape_rmse_m"]), float(r["cpu_ms_median"])))
         per.setdefault(str(r["matcher"]), []).append((k, n))
-    pooled = _pool(per, "sequence", bootstrap=True) if df["dataset"].nunique() > 1 else []
+    pooled = _pool(per, SEQUENCE.key, bootstrap=True) if df["dataset"].nunique() > 1 else []
     return pooled + rows
 
 
@@ -98,11 +98,11 @@ def _from_relocalization(df: pd.DataFrame) -> list[HeadlineRow]:
     for r in df.to_dict("records"):
         n = int(r["n"])
         k = round(float(r["top1"]) * n)
-        rows.append(_row("global", str(r["dataset"]), str(r["matcher"]), 100 * float(r["top1"]),
+        rows.append(_row(GLOBAL.key, str(r["dataset"]), str(r["matcher"]), 100 * float(r["top1"]),
                          100 * float(r["top1_lo"]), 100 * float(r["top1_hi"]), n, math.nan,
                          float(r["cpu_ms_median"])))
         per.setdefault(str(r["matcher"]), []).append((k, n))
-    pooled = _pool(per, "global", bootstrap=False) if df["dataset"].nunique() > 1 else []
+    pooled = _pool(per, GLOBAL.key, bootstrap=False) if df["dataset"].nunique() > 1 else []
     return pooled + rows
 
 

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import pandas as pd
 
+from tfloc.core.modes import SEQUENCE
 from tfloc.evaluation.headline import POOLED, HeadlineRow
 from tfloc.report.mdtable import table
 
@@ -76,7 +77,7 @@ def native_checks(headline: list[HeadlineRow], tracking: pd.DataFrame, me: str =
     """The native targets per recording from a run's headline rows and ``tracking.csv``."""
     out = []
     for ds, g in tracking.groupby("dataset", sort=False):
-        rows = [r for r in headline if r.scope == ds and r.mode == "sequence"]
+        rows = [r for r in headline if r.scope == ds and r.mode == SEQUENCE.key]
         st, mine = standing(rows, me), g[g["matcher"] == me]
         if st is None or mine.empty:
             continue
@@ -95,7 +96,7 @@ def native_checks(headline: list[HeadlineRow], tracking: pd.DataFrame, me: str =
 def simulated_line(headline: list[HeadlineRow], run: str, kinds: dict[str, str], me: str = TRACKER) -> str:
     """One sentence: on how many simulated sequences (``kinds``: dataset → kind,
     :mod:`tfloc.site.kinds`) ``me`` is first or tied, and behind whom."""
-    scopes = [s for s in dict.fromkeys(r.scope for r in headline if r.mode == "sequence")
+    scopes = [s for s in dict.fromkeys(r.scope for r in headline if r.mode == SEQUENCE.key)
               if s != POOLED and kinds.get(s) == SIMULATED]
     per = {s: standing([r for r in headline if r.scope == s], me) for s in scopes}
     per = {s: v for s, v in per.items() if v is not None}
