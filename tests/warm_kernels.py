@@ -38,6 +38,7 @@ def warm(half: int) -> list[str]:
     import numpy as np
 
     import tfloc
+    from tfloc.core.external import is_batch_tracker
     from tfloc.core.pose import Pose
     from tfloc.maps.build import rasterize
 
@@ -52,6 +53,8 @@ def warm(half: int) -> list[str]:
         for map_ in maps:
             try:
                 m = tfloc.get_matcher(name)
+                if is_batch_tracker(m):  # an external program: no in-process kernel to warm
+                    continue
                 if hasattr(m, "localize"):
                     m.localize(tfloc.Problem(map_, laser, ranges, guess))
                 else:  # a tracker: started at the guess, one scan
