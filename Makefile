@@ -9,7 +9,7 @@ LOCK   := requirements.lock
 UV_VERSION := 0.13.9
 
 ## The site (tfloc site) is written at the end of make bench (results/site/) and make quick (results/site-quick/).
-.PHONY: install lock browser site quick bench native native-single-scan sequences-single-scan global-full global-offices robustness robustness-full scaling scaling-quick ablation-real test test-cpu test-sweeps test-unit timing lint clean-venv real-data fuzz chaos
+.PHONY: install lock browser system site quick bench native native-single-scan sequences-single-scan global-full global-offices robustness robustness-full scaling scaling-quick ablation-real test test-cpu test-sweeps test-unit timing lint clean-venv real-data fuzz chaos
 
 $(STAMP): pyproject.toml $(LOCK)
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -43,7 +43,7 @@ quick: $(STAMP)
 STUDIES := paper-protocol real-csail-relations real-scan-to-map tf-readings tf-readings-heldout \
 	tfplus-ablation sequences kidnap kidnap-controls robustness scaling-quick global native-csail \
 	native-no-truth
-bench: $(STAMP)
+bench: $(STAMP) system
 	$(BIN)/tfloc bench $(STUDIES:%=benchmarks/%.toml) --regenerate
 	$(BIN)/tfloc site --readme
 	$(MAKE) --no-print-directory test-sweeps
@@ -52,6 +52,12 @@ bench: $(STAMP)
 ## the README's and docs' generated blocks from the same rows.
 site: $(STAMP)
 	$(BIN)/tfloc site --readme
+
+## The Debian packages below for make bench and make test, so that the two commands do all the
+## set-up; where they cannot be installed (no root), one note, and the browser test and mrpt-pf's
+## tests are skipped with that reason (mrpt-pf's rows in make bench: one line naming mrpt-apps).
+system:
+	@$(MAKE) --no-print-directory browser || echo "note: Debian's chromium, chromium-driver and mrpt-apps could not be installed (apt-get needs root): the browser test and mrpt-pf are skipped"
 
 ## Headless Chromium and chromedriver from Debian's packages, for the site's browser test and
 ## screenshots, and Debian's mrpt-apps (pf-localization, carmen2rawlog, ros-map-yaml2mrpt: the
@@ -84,7 +90,7 @@ real-data: $(STAMP)
 ## longer members of a parametrised check and the full rebuilds (marker sweep) are left to
 ## make test-sweeps, which make bench runs. The smoke run stays in one process.
 XDIST := -n 2 --dist loadfile
-test: $(STAMP)
+test: $(STAMP) system
 	$(BIN)/python tests/warm_kernels.py
 	$(BIN)/python -m pytest -q $(XDIST) tests
 	$(BIN)/python -m pytest -q benchmarks --benchmark-disable
