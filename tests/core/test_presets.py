@@ -16,7 +16,7 @@ from tfloc.harness.preflight import build_matcher
 def test_every_preset_builds_with_its_values(name: str) -> None:
     base, params = resolve(name, {})
     assert ":" not in base and base not in presets()
-    resolved = build_matcher(MatcherSpec.make(name))
+    _, resolved = build_matcher(MatcherSpec.make(name))
     for key, value in params.items():
         if not isinstance(value, dict):
             assert resolved[key] == value, (name, key)

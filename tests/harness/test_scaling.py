@@ -187,10 +187,10 @@ def test_the_verb_end_to_end_on_a_tiny_configuration(study, tmp_path):
     # run.json: a run directory's record of the code and configuration that made it
     info = RunDir(out).info(required=True)
     doc = info.doc
-    assert info.kind == "scaling" and [m["label"] for m in info.matchers] == ["tf-plus", "cv-corners"]
+    assert info.kind == "scaling" and info.labels == ["tf-plus", "cv-corners"]
     assert doc["config"]["scaling"]["scans_per_level"] == 2 and doc["config"]["scaling"]["matchers"] == [
         "tf-plus", "cv-corners"]
-    assert info.datasets == {"office-1": OFFICE} and info.thresholds.dist_m == 0.1
+    assert info.paths == {"office-1": OFFICE} and info.thresholds.dist_m == 0.1
     assert set(doc["fingerprint"]["matchers"]) == {"tf-plus", "cv-corners"}
     assert doc["fingerprint"]["scaling"] == doc["config"]["scaling"]
     assert "commit" in doc["git"] and "dirty" in doc["git"] and doc["versions"]["numpy"]
@@ -279,7 +279,7 @@ def test_regenerate_starts_another_configuration_or_an_old_directory_over(tmp_pa
         scaling_study(bigger, out, log=lambda s: None)
     scaling_study(bigger, out, regenerate=True, log=lambda s: None)
     info = RunDir(out).info()
-    assert len(raw(out)[0]) == 6 and info.config["scaling"]["scans_per_offset_bin"] == 2 and len(info.sessions) == 1
+    assert len(raw(out)[0]) == 6 and info.config_doc["scaling"]["scans_per_offset_bin"] == 2 and len(info.sessions) == 1
     logged: list[str] = []
     scaling_study(bigger, out, regenerate=True, log=logged.append)   # complete: runs again
     assert not any("already complete" in s for s in logged) and len(RunDir(out).info().sessions) == 1

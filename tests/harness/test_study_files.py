@@ -17,7 +17,7 @@ from test_runner import make_dataset
 from tfloc.core.presets import presets, resolve
 from tfloc.core.thresholds import Thresholds
 from tfloc.errors import ConfigError
-from tfloc.harness.config import DEFAULT_STEPS, RunConfig, load_study, read_doc
+from tfloc.harness.config import DEFAULT_STEPS, MatcherSpec, RunConfig, load_study, read_doc
 
 FILES = sorted((ROOT / "benchmarks").rglob("*.toml"))
 ENV = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "tests"), str(ROOT)])}
@@ -130,3 +130,16 @@ def test_a_studys_steps_make_its_tables(tmp_path: Path, test_room, lms200) -> No
     assert r.returncode == 0, r.stderr
     assert "already complete: 0 tasks run" in r.stderr and "tfloc report" in r.stderr
     assert (tmp_path / "run" / "report.md").read_text().count("## Headline") == 1
+
+
+def test_every_step_a_study_may_declare_is_a_call_of_its_verb() -> None:
+    from tfloc.cli import build_parser
+    from tfloc.cli._study import STEP_CALLS
+    from tfloc.harness.config import STEPS
+
+    assert set(STEP_CALLS) == set(STEPS)
+    cfg = RunConfig("r", Path("results/r"), (Path("data/scenarios/office-pool"),), (MatcherSpec.make("tf"),))
+    parser = build_parser()
+    for step in STEPS:
+        for command, call in STEP_CALLS[step](cfg, quick=True):
+            assert callable(call) and parser.parse_args(command.split())   # the same verb by hand

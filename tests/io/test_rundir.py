@@ -22,7 +22,7 @@ def test_a_scaling_studys_run_json_is_a_run_json(tmp_path):
     rd = RunDir(tmp_path)
     rd.write(SCALING)
     info = rd.info(required=True)
-    assert info.kind == "scaling" and info.done == [] and list(info.datasets) == ["office-1"]
+    assert info.kind == "scaling" and info.done == [] and list(info.paths) == ["office-1"] and info.config is None
     assert RunDir(tmp_path / "none").info().kind == "bench"
     for bad in ({**SCALING, "done": "all"}, {**SCALING, "levels": [1]}, {**SCALING, "timing": []},
                 {**SCALING, "timing": {"sessions": [{"loadavg_start": "high"}]}},
@@ -37,17 +37,17 @@ def test_the_timing_record_survives_a_new_session_and_goes_with_discard(tmp_path
     rd.close_session([1.0, 1.0, 1.0])
     fp = {"run": BENCH["fingerprint"], "per_stratum": 4}
     rd.start_timing(fp, [0.1, 0.1, 0.1], fresh=True)
-    assert rd.info().timing["complete"] is False
+    assert rd.info().timing.complete is False
     rd.close_timing([0.2, 0.2, 0.2], cores=[1])
     record = rd.info().timing
-    assert record["complete"] and record["fingerprint"] == fp and record["sessions"][-1]["cores"] == [1]
+    assert record.complete and record.fingerprint == fp and record.last_session["cores"] == [1]
     rd.start_session(BENCH, 4, 4, None)          # tfloc bench again on the complete run
     info = rd.info()
     assert info.timing == record and len(info.sessions) == 2
     rd.start_timing(fp, None, fresh=False)       # the same pass again: its sessions go on
-    assert len(rd.info().timing["sessions"]) == 2
+    assert len(rd.info().timing.sessions) == 2
     rd.start_timing({**fp, "per_stratum": 1}, None, fresh=True)   # another pass starts over
-    assert len(rd.info().timing["sessions"]) == 1
+    assert len(rd.info().timing.sessions) == 1
     for f in ("estimates.csv", "timing.csv", "timing.md", "scaling.csv"):
         (tmp_path / f).write_text("x\n")
     rd.discard(also=("scaling.csv",))

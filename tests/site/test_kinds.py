@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 from _paths import ROOT, SCEN
 
-from tfloc.io.rundir import RunInfo
+from tfloc.io.rundir import run_of
 from tfloc.io.scenario import read_scenario
 from tfloc.site.kinds import REAL, SIMULATED, dataset_kind
 from tfloc.site.runs import dataset_kinds, run_info
@@ -56,13 +56,13 @@ def _copy(src: str, dst: Path, **fields) -> Path:
 def test_a_renamed_dataset_keeps_its_kind(tmp_path: Path) -> None:
     sim = _copy("seq-easy-a", tmp_path / "elsewhere" / "real-x")
     rec = _copy("real-aces-native", tmp_path / "elsewhere" / "seq-y")
-    info = RunInfo({"datasets": {"real-x": str(sim), "seq-y": str(rec)}})
+    info = run_of({"datasets": {"real-x": str(sim), "seq-y": str(rec)}}, Path("run.json"))
     assert dataset_kinds(info, ["real-x", "seq-y", "unknown"]) == {"real-x": SIMULATED, "seq-y": REAL}
 
 
 def test_a_dataset_the_run_did_not_record_is_looked_for_under_the_checkout(tmp_path: Path) -> None:
     _copy("seq-easy-a", tmp_path / "data" / "scenarios" / "real-z")
-    moved = RunInfo({"datasets": {"real-z": "no/such/dir"}})
+    moved = run_of({"datasets": {"real-z": "no/such/dir"}}, Path("run.json"))
     assert dataset_kinds(moved, ["real-z"], tmp_path) == {"real-z": SIMULATED}
     assert dataset_kinds(moved, ["real-z"]) == {}  # not found from here: unknown, not guessed from the name
 

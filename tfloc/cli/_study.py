@@ -1,47 +1,85 @@
 """What ``tfloc bench STUDY.toml`` runs around a run: the steps a study file declares (the verbs
-that make its tables, run as their commands would) and the scaling study.
+that make its tables, each called as a function on the run) and the scaling study.
 
 A step is a verb of this command line applied to the run: ``index`` (tf-global's place index of
 every global dataset's map, before the run), ``timing`` (the side-by-side timing pass; with
 ``--quick`` one scan per stratum and a contended pass kept, marked; otherwise a pass still
 contended after its retries stops the study with its one-line error, the run kept), ``verdict``
-(the truth-free verdict of its sequences), ``report``,
-``robustness``, ``real-note``. Each is the verb itself (``tfloc STEP RUN``), so a table made by ``make bench`` is the table a user gets by hand.
+(the truth-free verdict of its sequences), ``report``, ``robustness``, ``real-note``. Each is the
+verb's own function (:data:`STEP_CALLS`), and the log names the command that does the same by
+hand (``tfloc report results/x``), so a table made by ``make bench`` is the table a user gets.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 from tfloc.harness.config import RunConfig, Study
 
 
-def step_commands(cfg: RunConfig, step: str, quick: bool) -> list[list[str]]:
-    """The command lines (without ``tfloc``) of one step of the run ``cfg``."""
-    out = str(cfg.out)
-    if step == "index":
-        from tfloc.io.scenario import GLOBAL, read_scenario
+def _index(cfg: RunConfig, quick: bool) -> list[tuple[str, Callable[[], int]]]:
+    from tfloc.io.scenario import GLOBAL, read_scenario
 
-        return [["index", "--dataset", str(d)] for d in cfg.datasets if read_scenario(d).mode == GLOBAL]
-    if step == "timing":
-        return [["timing", out, *(["--per-stratum", "1", "--allow-contended"] if quick else [])]]
-    return [[step, out]]
+    from .index import index
+
+    return [(f"index --dataset {d}", lambda d=d: index(Path(d)))
+            for d in cfg.datasets if read_scenario(d).mode == GLOBAL]
+
+
+def _timing(cfg: RunConfig, quick: bool) -> list[tuple[str, Callable[[], int]]]:
+    from .timing import time_run
+
+    if quick:
+        return [(f"timing {cfg.out} --per-stratum 1 --allow-contended",
+                 lambda: time_run(cfg.out, per_stratum=1, allow_contended=True))]
+    return [(f"timing {cfg.out}", lambda: time_run(cfg.out))]
+
+
+def _verb(step: str, call: Callable[[Path], int]) -> Callable[[RunConfig, bool], list[tuple[str, Callable[[], int]]]]:
+    return lambda cfg, quick: [(f"{step} {cfg.out}", lambda: call(Path(cfg.out)))]
+
+
+def _verdict(run: Path) -> int:
+    from .verdict import judge
+
+    return judge(run)
+
+
+def _report(run: Path) -> int:
+    from .report import report
+
+    return report(run)
+
+
+def _robustness(run: Path) -> int:
+    from .robustness import robustness
+
+    return robustness(run)
+
+
+def _real_note(run: Path) -> int:
+    from .real_note import note
+
+    return note(run)
+
+
+#: step → the calls it makes on a run (each with the command line that does the same by hand)
+STEP_CALLS: dict[str, Callable[[RunConfig, bool], list[tuple[str, Callable[[], int]]]]] = {
+    "index": _index, "timing": _timing, "verdict": _verb("verdict", _verdict), "report": _verb("report", _report),
+    "robustness": _verb("robustness", _robustness), "real-note": _verb("real-note", _real_note)}
 
 
 def run_steps(cfg: RunConfig, steps: list[str], quick: bool = False) -> None:
     """Run ``steps`` of the run ``cfg`` in order (a failing step raises its one-line error)."""
-    from . import build_parser
-
-    parser = build_parser()
     for step in steps:
-        for words in step_commands(cfg, step, quick):
-            print(f"tfloc {' '.join(words)}", file=sys.stderr)
-            args = parser.parse_args(words)
-            code = int(args._run(args) or 0)
+        for command, call in STEP_CALLS[step](cfg, quick):
+            print(f"tfloc {command}", file=sys.stderr)
+            code = int(call() or 0)
             if code:
-                print(f"tfloc {' '.join(words)}: exit {code}", file=sys.stderr)
+                print(f"tfloc {command}: exit {code}", file=sys.stderr)
 
 
 def run_scaling_study(study: Study, args: argparse.Namespace) -> int:

@@ -38,15 +38,21 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    return index(args.dataset, args.matcher, args.param)
+
+
+def index(dataset: Path, matcher_name: str = "tf-global", params: list[str] = ()) -> int:
+    """Build or load the place index of ``dataset``'s map (``params``: ``KEY=VALUE`` texts; the
+    study step ``index`` calls it)."""
     limit_threads(1)
     try:  # a fresh matcher (not the workspace's cached one), so a second call loads from disk
-        matcher = get_matcher(args.matcher, **parse_params(args.param))
+        matcher = get_matcher(matcher_name, **parse_params(list(params)))
     except ParameterError as exc:
-        key = f"--param {exc.names[0]}" if exc.names else f"--matcher {args.matcher}"
+        key = f"--param {exc.names[0]}" if exc.names else f"--matcher {matcher_name}"
         raise ConfigError(f"{key}: {exc}") from None
     if not callable(getattr(matcher, "index", None)):
-        raise ConfigError(f"--matcher {args.matcher}: it keeps no place index")
-    scenario = read_scenario(args.dataset)
+        raise ConfigError(f"--matcher {matcher_name}: it keeps no place index")
+    scenario = read_scenario(dataset)
     scan = next(iter_scans(scenario), None)
     if scan is None:
         raise DatasetError(f"{scenario.scans_path}: no scans")

@@ -21,14 +21,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    return note(args.results, args.datasets, args.max_dist_cm, args.max_angle_deg)
+
+
+def note(results: Path, datasets: list[Path] | None = None, max_dist_cm: float | None = None,
+         max_angle_deg: float | None = None) -> int:
+    """The relations note of the run directory ``results`` (thresholds default to the run's; the
+    study step ``real-note`` calls it)."""
     from tfloc.core.thresholds import Thresholds
     from tfloc.io.rundir import RunDir
     from tfloc.report.relations_note import write_note
 
-    datasets = args.datasets or [Path("data/scenarios/real-csail-relations"),
-                                 Path("data/scenarios/real-csail-relations-perturbed")]
-    run = RunDir(args.results).info().thresholds
-    thr = Thresholds(run.dist_m if args.max_dist_cm is None else args.max_dist_cm / 100.0,
-                     run.orient_deg if args.max_angle_deg is None else args.max_angle_deg)
-    print(write_note(args.results, datasets, thr))
+    datasets = datasets or [Path("data/scenarios/real-csail-relations"),
+                            Path("data/scenarios/real-csail-relations-perturbed")]
+    run = RunDir(results).info().thresholds
+    thr = Thresholds(run.dist_m if max_dist_cm is None else max_dist_cm / 100.0,
+                     run.orient_deg if max_angle_deg is None else max_angle_deg)
+    print(write_note(results, datasets, thr))
     return 0

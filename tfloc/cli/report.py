@@ -31,14 +31,21 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from tfloc.core.thresholds import Thresholds
     from tfloc.io.rundir import RunDir
-    from tfloc.report.report import write_report
 
     thr = None
     if args.success_cm is not None or args.success_deg is not None:
         base = RunDir(args.run).info().thresholds
         thr = Thresholds(base.dist_m if args.success_cm is None else args.success_cm / 100.0,
                          base.orient_deg if args.success_deg is None else args.success_deg)
-    files = write_report(args.run, thr, with_figures=not args.no_figures)
+    return report(args.run, thr, figures=not args.no_figures)
+
+
+def report(run: Path, thresholds=None, figures: bool = True) -> int:
+    """The report of the run directory ``run`` (``thresholds``: a :class:`~tfloc.core.thresholds.Thresholds`
+    to re-score with, default the run's), with where it wrote (the study step ``report`` calls it)."""
+    from tfloc.report.report import write_report
+
+    files = write_report(run, thresholds, with_figures=figures)
     print(f"report: {files.report}\nsummary: {files.summary}", file=sys.stderr)
     if files.figures:
         print(f"figures: {len(files.figures)} in {files.figures[0].parent}", file=sys.stderr)

@@ -24,6 +24,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    return robustness(args.run, figures=not args.no_figures)
+
+
+def robustness(run: Path, figures: bool = True) -> int:
+    """The robustness section of the run directory ``run`` (the study step ``robustness`` calls it)."""
     from tfloc.evaluation.metrics import prepare
     from tfloc.io.rundir import RunDir
     from tfloc.io.scenario import read_scenario
@@ -35,15 +40,15 @@ def run(args: argparse.Namespace) -> int:
         robustness_markdown,
     )
 
-    rd = RunDir(args.run)
+    rd = RunDir(run)
     info = rd.info(required=True)
-    scenarios = [read_scenario(d) for d in info.datasets.values()]
+    scenarios = [read_scenario(d) for d in info.paths.values()]
     axes = axes_of((s.name, s.extra) for s in scenarios)
     prepared = prepare(rd.results(), info.thresholds)
     cells, changes = robustness_cells(prepared, axes), paired_changes(prepared, axes)
-    fig = None if args.no_figures else robustness_figure(cells, args.run / "figures" / "robustness.png")
-    out = args.run / "robustness.md"
-    out.write_text(robustness_markdown(cells, changes, fig.relative_to(args.run).as_posix() if fig else None))
-    cells.to_csv(args.run / "robustness.csv", index=False, float_format="%.4g")
+    fig = robustness_figure(cells, run / "figures" / "robustness.png") if figures else None
+    out = run / "robustness.md"
+    out.write_text(robustness_markdown(cells, changes, fig.relative_to(run).as_posix() if fig else None))
+    cells.to_csv(run / "robustness.csv", index=False, float_format="%.4g")
     print(f"robustness: {out}", file=sys.stderr)
     return 0

@@ -63,6 +63,17 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    return time_run(args.run, args.per_stratum, args.warmup, args.reference, args.regenerate, seed=args.seed,
+                    cores=args.cores, allow_contended=args.allow_contended, retries=args.retries,
+                    wait_s=args.wait, verify=args.verify)
+
+
+def time_run(run: Path, per_stratum: int | None = None, warmup: int | None = None, reference: str | None = None,
+             regenerate: bool = False, *, seed: int | None = None, cores: list[int] | None = None,
+             allow_contended: bool = False, retries: int | None = None, wait_s: float | None = None,
+             verify: bool = False) -> int:
+    """The verb on the run directory ``run`` (its options as arguments; the study step
+    ``timing`` calls it): a progress bar, the pass (or its verification), the exit status."""
     from tqdm import tqdm
 
     from tfloc.errors import ConfigError
@@ -76,18 +87,17 @@ def run(args: argparse.Namespace) -> int:
             bars.append(tqdm(total=total, unit="scan", desc="timing", disable=not sys.stderr.isatty()))
         bars[0].update(done - bars[0].n)
 
-    retries = RETRIES if args.retries is None else args.retries
-    wait_s = WAIT_S if args.wait is None else args.wait
+    retries = RETRIES if retries is None else retries
+    wait_s = WAIT_S if wait_s is None else wait_s
     if retries < 0 or wait_s < 0:
         raise ConfigError(f"--retries and --wait must be ≥ 0, got {retries} and {wait_s:g}")
     try:
-        if args.verify:
-            return 0 if verify_pass(args.run, args.per_stratum, args.cores, log=print,
-                                    allow_contended=args.allow_contended, retries=retries, wait_s=wait_s,
-                                    progress=progress) else 1
-        timing_pass(args.run, args.per_stratum, args.warmup, args.reference, args.regenerate, progress,
-                    seed=args.seed, cores=args.cores, log=lambda s: tqdm.write(s, file=sys.stderr),
-                    allow_contended=args.allow_contended, retries=retries, wait_s=wait_s)
+        if verify:
+            return 0 if verify_pass(run, per_stratum, cores, log=print, allow_contended=allow_contended,
+                                    retries=retries, wait_s=wait_s, progress=progress) else 1
+        timing_pass(run, per_stratum, warmup, reference, regenerate, progress, seed=seed, cores=cores,
+                    log=lambda s: tqdm.write(s, file=sys.stderr), allow_contended=allow_contended,
+                    retries=retries, wait_s=wait_s)
     finally:
         for bar in bars:
             bar.close()

@@ -35,7 +35,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from tfloc.report.verdict import write_verdict
     from tfloc.report.verdict_sweep import parse_sweep, sweep
 
     if args.sweep:
@@ -43,8 +42,16 @@ def run(args: argparse.Namespace) -> int:
         sweep(args.run, configs)
         print(f"sweep: {args.run / 'verdict_sweep.csv'} ({len(configs)} configurations)")
         return 0
-    v = write_verdict(args.run, restarts=not args.no_restarts)
-    print(f"verdict: {args.run / 'verdict.csv'} ({len(v.rows)} rows)")
+    return judge(args.run, restarts=not args.no_restarts)
+
+
+def judge(run: Path, restarts: bool = True) -> int:
+    """The verdict of the run directory ``run``, written, with one line per recording against
+    the truth (the study step ``verdict`` calls it)."""
+    from tfloc.report.verdict import write_verdict
+
+    v = write_verdict(run, restarts=restarts)
+    print(f"verdict: {run / 'verdict.csv'} ({len(v.rows)} rows)")
     for a in v.agreements:
         print(f"{a.dataset}: against the truth rho {a.rho:.2f}, top {a.verdict_top} ({a.top}; truth's "
               f"{a.truth_top}){'' if a.agrees else ': DISAGREES'}")

@@ -127,11 +127,11 @@ def _table(p: pd.DataFrame, mode: str, scope: str, thr: Thresholds, free: Verdic
         pvals.append(mcnemar_exact(int((sa & ~sb).sum()), int((~sa & sb).sum())) if len(both) else math.nan)
     adj = holm(np.array(pvals, dtype=float)) if pvals else np.array([])
     out = []
+    measure, error = mode_of(mode).measure, mode_of(mode).error
     for i, (m, v, lo, hi, n, err, cpu) in enumerate(stats):
         nxt = stats[i + 1][0] if i + 1 < len(stats) else ""
         p_adj = float(adj[i]) if i < len(adj) else math.nan
         verdict = "" if not nxt or math.isnan(p_adj) else "ahead" if p_adj < ALPHA else "tied"
-        measure, error = mode_of(mode).measure, mode_of(mode).error
         out.append(HeadlineRow("sequence" if mode == TRUTH_FREE else mode, scope, i + 1, m, measure, v, lo, hi,
                                n, err, error, cpu, verdict, nxt, p_adj,
                                v if mode == TRUTH_FREE else free.get((scope, m), (math.nan,))[0],

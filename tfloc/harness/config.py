@@ -34,98 +34,25 @@ from __future__ import annotations
 import itertools
 import json
 import tomllib
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from tfloc.core.runconfig import (  # noqa: F401 - the run configuration's values, re-exported
+    DEFAULT_STEPS,
+    STEPS,
+    STEPS_AFTER,
+    STEPS_BEFORE,
+    MatcherSpec,
+    RunConfig,
+)
 from tfloc.core.thresholds import Thresholds
 from tfloc.errors import ConfigError
 from tfloc.io.text import parse_text
 
 from .rosters import expand
 
-#: steps a study file may declare: ``index`` (tf-global's place index of every dataset's map)
-#: runs before the run, the others after it in the order written
-STEPS_BEFORE = ("index",)
-STEPS_AFTER = ("timing", "verdict", "report", "robustness", "real-note")
-STEPS = (*STEPS_BEFORE, *STEPS_AFTER)
-DEFAULT_STEPS = ("report",)
 KINDS = ("bench", "scaling")
-
-
-@dataclass(frozen=True)
-class MatcherSpec:
-    """One matcher column of a run: its ``label`` in the results, registered ``name``, ``params``."""
-
-    label: str
-    name: str
-    params_json: str = "{}"
-    where: str = field(default="", compare=False)      # the configuration entry, e.g. "x.toml: matchers[2]"
-    keys_json: str = field(default="{}", compare=False)  # parameter → the configuration key that set it
-
-    @property
-    def params(self) -> dict[str, Any]:
-        return json.loads(self.params_json)
-
-    @classmethod
-    def make(cls, name: str, params: dict | None = None, label: str | None = None, where: str = "",
-             keys: dict[str, str] | None = None) -> MatcherSpec:
-        return cls(label or name, name, json.dumps(params or {}, sort_keys=True), where,
-                   json.dumps(keys or {}, sort_keys=True))
-
-    def key_of(self, param: str) -> str:
-        """The configuration key that set ``param`` (``a.b`` itself if a key names it, else ``a``,
-        which also set ``a[1]``; else the entry that made this spec)."""
-        keys = json.loads(self.keys_json)
-        top = param.split(".")[0].split("[")[0]
-        return keys.get(param) or keys.get(top) or self.where or f"matcher {self.label}"
-
-
-@dataclass(frozen=True)
-class RunConfig:
-    """A benchmark run. Distances in metres, angles in radians, times in seconds."""
-
-    name: str
-    out: Path
-    datasets: tuple[Path, ...]
-    matchers: tuple[MatcherSpec, ...]
-    jobs: int = 2
-    timeout_s: float = 60.0
-    limit_per_group: int = 0
-    sequence_timeout_s: float = 3600.0
-    success: Thresholds = Thresholds()
-    skip_per_group: tuple[tuple[str, int], ...] = ()
-    steps: tuple[str, ...] = DEFAULT_STEPS
-    extra: dict = field(default_factory=dict, compare=False)
-
-    def skip(self, dataset: Path) -> int:
-        """How many of the first scans of each group of ``dataset`` the run skips (a held-out
-        selection: the scans after a development split)."""
-        return dict(self.skip_per_group).get(str(dataset), 0)
-
-    def __post_init__(self) -> None:
-        if not self.datasets:
-            raise ConfigError(f"run {self.name!r}: no datasets given")
-        if not self.matchers:
-            raise ConfigError(f"run {self.name!r}: no matchers given")
-        labels = [m.label for m in self.matchers]
-        if len(set(labels)) != len(labels):
-            raise ConfigError(f"run {self.name!r}: duplicate matcher labels {labels}")
-        if self.jobs < 1 or self.timeout_s <= 0 or self.sequence_timeout_s <= 0 or self.limit_per_group < 0 or any(
-                n < 0 for _, n in self.skip_per_group):
-            raise ConfigError(f"run {self.name!r}: jobs ≥ 1, timeout_s > 0 and limit_per_group ≥ 0 required")
-
-    def with_overrides(self, **kw: Any) -> RunConfig:
-        return replace(self, **{k: v for k, v in kw.items() if v is not None})
-
-    def to_dict(self) -> dict[str, Any]:
-        return {"name": self.name, "out": str(self.out), "datasets": [str(d) for d in self.datasets],
-                "matchers": [{"label": m.label, "name": m.name, "params": m.params} for m in self.matchers],
-                "jobs": self.jobs, "timeout_s": self.timeout_s, "limit_per_group": self.limit_per_group,
-                **({"sequence_timeout_s": self.sequence_timeout_s} if self.sequence_timeout_s != 3600.0 else {}),
-                **({"skip_per_group": dict(self.skip_per_group)} if self.skip_per_group else {}),
-                "success": self.success.to_dict(), "steps": list(self.steps), **self.extra}
-
 
 def _keys(params: dict, key: str) -> dict[str, str]:
     return {k: f"{key}{k}" for k in params}
@@ -317,11 +244,10 @@ def config_of(doc: dict, path: Path) -> RunConfig:
         raise ConfigError(f"{path}: unknown key(s) {', '.join(unknown)}")
     if "sweep" in doc:  # a run may consist of sweeps only
         doc.setdefault("matchers", [])
-    if "matchers" in doc:
-        doc["matchers"] = expand(doc["matchers"], str(path))
-    for key in ("datasets", "matchers"):
-        if not isinstance(doc.get(key), list):
-            raise ConfigError(f"{path}: '{key}' must be a list")
+    if not isinstance(doc.get("datasets"), list):
+        raise ConfigError(f"{path}: 'datasets' must be a list")
+    if "matchers" not in doc:
+        raise ConfigError(f"{path}: 'matchers' must be a list or a roster's name")
     success = doc.get("success", {})
     try:
         return RunConfig(

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import hashlib
 import importlib
+import re
 import subprocess
 import sys
 from functools import cache
@@ -123,3 +124,16 @@ def git_state() -> dict:
     except (OSError, subprocess.SubprocessError):
         commit, dirty = None, None
     return {"commit": commit, "dirty": dirty}
+
+
+def recorded_packages() -> tuple[str, ...]:
+    """The distributions whose versions ``run.json`` records: tfloc and what its installed
+    metadata requires (its dependencies and every extra but the development tools'), in the
+    order declared: a new baseline's library is recorded once its extra names it."""
+    try:
+        reqs = metadata.requires("tfloc") or []
+    except metadata.PackageNotFoundError:
+        reqs = []
+    names = [re.split(r"[\s;<>=!~\[(]", r, maxsplit=1)[0] for r in reqs
+             if ";" not in r or 'extra == "dev"' not in r]
+    return tuple(dict.fromkeys(["tfloc", *names]))

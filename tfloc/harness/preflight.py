@@ -28,8 +28,8 @@ from .identity import matcher_code
 from .workspace import load_matcher
 
 
-def build_matcher(spec: MatcherSpec) -> dict[str, Any]:
-    """Build the matcher of ``spec`` (cached per process) and return its resolved parameters.
+def build_matcher(spec: MatcherSpec) -> tuple[Any, dict[str, Any]]:
+    """Build the matcher of ``spec`` (cached per process): the matcher and its resolved parameters.
 
     Raises :class:`ConfigError` naming the configuration key of a bad parameter."""
     try:
@@ -44,18 +44,18 @@ def build_matcher(spec: MatcherSpec) -> dict[str, Any]:
                           f"{spec.params}: {type(exc).__name__}: {exc}") from None
     cfg = getattr(m, "config", None)
     if dataclasses.is_dataclass(cfg) and not isinstance(cfg, type):
-        return jsonable(cfg)
-    return spec.params
+        return m, jsonable(cfg)
+    return m, spec.params
 
 
 def matcher_record(spec: MatcherSpec) -> dict[str, Any]:
     """The matcher of ``spec`` built once (:func:`build_matcher`): its name, the registered matcher
     it stands for (a preset's or a label's), resolved parameters and the code that answers; what a
     fingerprint records of it."""
-    params = build_matcher(spec)
+    m, params = build_matcher(spec)
     record = {"name": spec.name, "matcher": resolve(spec.name, {})[0], "params": params,
               **matcher_code(factory_of(spec.name))}
-    program = getattr(load_matcher(spec.name, spec.params_json), "program", None)
+    program = getattr(m, "program", None)
     if isinstance(program, ExternalProgram):  # an external program: its version and configuration file
         record["program"] = program.identity()
     return record
@@ -89,16 +89,14 @@ def available(config: RunConfig, log=None) -> RunConfig:
 @dataclass(frozen=True)
 class Preflight:
     """A run checked before it starts: its configuration (without matchers whose library is
-    missing), each dataset read once (directory → :class:`Scenario`) and each matcher built once
-    (label → name, registered matcher, resolved parameters, code)."""
+    missing), each dataset read once (directory → :class:`Scenario`), each matcher built once
+    (label → name, registered matcher, resolved parameters, code) and the run's fingerprint,
+    computed once from them (:func:`tfloc.harness.fingerprint.fingerprint`)."""
 
     config: RunConfig
     scenarios: dict[Path, Scenario] = field(hash=False)
     matchers: dict[str, dict[str, Any]] = field(hash=False)
-
-    def fingerprint(self) -> dict[str, Any]:
-        """The run's fingerprint (:func:`tfloc.harness.fingerprint.fingerprint`)."""
-        return fingerprint(self.config, self.matchers, list(self.scenarios.values()))
+    fingerprint: dict[str, Any] = field(hash=False, default_factory=dict)
 
 
 def preflight(config: RunConfig, log=None) -> Preflight:
@@ -106,4 +104,5 @@ def preflight(config: RunConfig, log=None) -> Preflight:
     parameter or dataset, before anything is written."""
     config = available(config, log=log)
     scenarios = {Path(d): read_scenario(d) for d in config.datasets}
-    return Preflight(config, scenarios, build_matchers(config))
+    matchers = build_matchers(config)
+    return Preflight(config, scenarios, matchers, fingerprint(config, matchers, list(scenarios.values())))

@@ -45,16 +45,13 @@ from tfloc.io.scenario import (
 
 from .config import RunConfig
 from .fingerprint import differences
-from .identity import git_state
+from .identity import git_state, recorded_packages
 from .preflight import Preflight, preflight
 from .task import Task, error_status, failure_row, run_task, warm_up
 from .threads import limit_threads
 from .workspace import load_matcher
 
 WORKER_DIED = "worker died"  # an error row's message when the task's process died
-PACKAGES = ("tfloc", "numpy", "scipy", "shapely", "numba", "pandas", "open3d", "kiss-icp",
-            "opencv-python-headless", "small-gicp", "karto-scanmatcher", "pebble", "matplotlib",
-            "llvmlite", "evo", "amcl")
 
 
 def make_tasks(config: RunConfig, log: Callable[[str], None] | None = None,
@@ -125,7 +122,7 @@ def cpu_model() -> str:
 def environment() -> dict:
     """Package versions, git commit and machine (with the CPU's model), for ``run.json``."""
     versions = {}
-    for pkg in PACKAGES:
+    for pkg in recorded_packages():
         try:
             versions[pkg] = metadata.version(pkg)
         except metadata.PackageNotFoundError:
@@ -145,7 +142,7 @@ def session_doc(pre: Preflight) -> dict:
             "datasets": {sc.name: str(d) for sc, d in zip(scenarios, config.datasets, strict=True)},
             "declared": {sc.name: {"mode": sc.mode, "paper_scenarios": list(sc.paper_scenarios)}
                          for sc in scenarios},
-            "fingerprint": pre.fingerprint()}
+            "fingerprint": pre.fingerprint}
 
 
 #: the time limit of one warm-up (seconds): kernels compiled and cached, map-only data built
@@ -230,7 +227,7 @@ def run(config: RunConfig, progress: bool | None = None, executor: Executor = ex
     pre = preflight(config, log=log)
     config = pre.config
     rd = RunDir(Path(config.out))
-    fp = pre.fingerprint()
+    fp = pre.fingerprint
     tasks = make_tasks(config, log, pre.scenarios)
     try:
         done = done_keys(rd.estimates) if rd.path.is_dir() else set()

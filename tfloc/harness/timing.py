@@ -41,10 +41,11 @@ import pandas as pd
 
 from tfloc.core.jsonable import jsonable
 from tfloc.core.matcher import get_matcher
+from tfloc.core.run import Run, RunMatcher, TimingRecord
 from tfloc.core.timing_rows import TimingRow
 from tfloc.errors import ConfigError
 from tfloc.evaluation.timing import reference_of
-from tfloc.io.rundir import RunDir, RunInfo
+from tfloc.io.rundir import RunDir
 from tfloc.io.scenario import SEQUENCE
 
 from .contention import Probe
@@ -89,7 +90,7 @@ class TimingParams:
         return p
 
 
-def read_run(run_dir: Path) -> tuple[pd.DataFrame, RunInfo]:
+def read_run(run_dir: Path) -> tuple[pd.DataFrame, Run]:
     """The rows and ``run.json`` of a run (:class:`~tfloc.io.rundir.RunDir`; both required)."""
     rd = RunDir(run_dir)
     info = rd.info(required=True)
@@ -138,14 +139,14 @@ def timing_fingerprint(run_fingerprint: dict | None, params: TimingParams, sampl
     return jsonable(fp)
 
 
-def stale(rd: RunDir, record: dict | None, fp: dict) -> list[str]:
+def stale(rd: RunDir, record: TimingRecord | None, fp: dict) -> list[str]:
     """Why the run's recorded timing pass (``record``: ``run.json``'s ``timing``) is not the one
     of ``fp``, one phrase each; empty when it is complete, its files are there and it is current.
     With no record and no ``timing.md``, ``[NO_PASS]``."""
-    if not isinstance(record, dict):
+    if record is None:
         return ["timing.md records no fingerprint (made by an older tfloc)" if rd.timing_md.exists() else NO_PASS]
-    old = record.get("fingerprint") if isinstance(record.get("fingerprint"), dict) else {}
-    out = [] if record.get("complete") else ["the last timing pass did not finish"]
+    old = dict(record.fingerprint or {})
+    out = [] if record.complete else ["the last timing pass did not finish"]
     out += [f"{f}: none" for f in ("timing.csv", "timing.md") if not (rd.path / f).exists()]
     params = [f"{k} {json.dumps(old.get(k))} → {json.dumps(fp[k])}" for k in asdict(TimingParams()) if old.get(k) != fp[k]]
     out += params
@@ -162,7 +163,7 @@ def stale(rd: RunDir, record: dict | None, fp: dict) -> list[str]:
 
 def run_timing(run_dir: Path, per_stratum: int = PER_STRATUM, seed: int = SEED, cores: Sequence[int] | None = None,
                warmup: int = WARMUP, progress: Callable[[int, int], None] | None = None,
-               run: tuple[pd.DataFrame, RunInfo] | None = None,
+               run: tuple[pd.DataFrame, Run] | None = None,
                sample: pd.DataFrame | None = None) -> tuple[list[TimingRow], dict]:
     """Re-time a stratified sample of the run in ``run_dir`` (see the module docstring), pinned
     to ``cores`` (default: the last core this process may run on).
@@ -173,8 +174,8 @@ def run_timing(run_dir: Path, per_stratum: int = PER_STRATUM, seed: int = SEED, 
     and ``run.json`` if the caller has already read them
     (:func:`read_run`); ``sample``: the scans if it has drawn them (:func:`sample_scans`)."""
     df, info_run = read_run(run_dir) if run is None else run
-    specs = [m for m in info_run.matchers if m["label"] in set(df["matcher"])]
-    paths = info_run.datasets
+    specs = [m for m in info_run.matchers if m.label in set(df["matcher"])]
+    paths = info_run.paths
     sequences = sorted(info_run.datasets_in(list(df["dataset"].unique()), SEQUENCE))
     sample = sample_scans(df, per_stratum, seed, sequences) if sample is None else sample
     if sample.empty:
@@ -192,16 +193,15 @@ def run_timing(run_dir: Path, per_stratum: int = PER_STRATUM, seed: int = SEED, 
             "contention": contention.to_record(),
             "scans": len(sample), "strata": int(sample.groupby(["dataset", "group"]).ngroups),
             "loadavg_start": load_start, "loadavg_end": load_average(), "started": started,
-            "git": git_state(), "run_git": info_run.doc.get("git", {})}
+            "git": git_state(), "run_git": dict(info_run.git)}
     return rows, info
 
 
-def _time_sample(sample: pd.DataFrame, specs: list[dict], paths: dict[str, Path], warmup: int,
+def _time_sample(sample: pd.DataFrame, specs: list[RunMatcher], paths: dict[str, Path], warmup: int,
                  progress: Callable[[int, int], None] | None, probe: Probe | None = None) -> list[TimingRow]:
     """Warm up, then time every matcher on every sampled scan, interleaved (module docstring),
     the calibration workload before each scan's matchers (``probe``)."""
-    matchers = [(m["label"], load_matcher(m["name"], json.dumps(m.get("params", {}), sort_keys=True)))
-                for m in specs]
+    matchers = [(m.label, load_matcher(m.name, m.params_json)) for m in specs]
     problems = {}
     for d, g in sample.groupby("dataset", sort=False):
         if d not in paths:
@@ -228,7 +228,7 @@ def _time_sample(sample: pd.DataFrame, specs: list[dict], paths: dict[str, Path]
     return rows
 
 
-def _time_sequences(sample: pd.DataFrame, specs: list[dict], paths: dict[str, Path],
+def _time_sequences(sample: pd.DataFrame, specs: list[RunMatcher], paths: dict[str, Path],
                     progress: Callable[[int, int], None] | None, done: int = 0,
                     probe: Probe | None = None) -> list[TimingRow]:
     """Every tracker of the run along the sampled first steps of each sequence, started and
@@ -247,7 +247,7 @@ def _time_sequences(sample: pd.DataFrame, specs: list[dict], paths: dict[str, Pa
         scenario, by_id = load_dataset(str(paths[d]))
         scans = list(by_id.values())[:len(g)]
         the_map = map_of(scenario, scans[0])
-        trackers = [(m["label"], as_tracker(get_matcher(m["name"], **m.get("params", {})))) for m in specs]
+        trackers = [(m.label, as_tracker(get_matcher(m.name, **m.params))) for m in specs]
         trackers = [(label, t) for label, t in trackers if not is_batch_tracker(t)]
         for _, t in trackers:
             begin(t, scenario, scans, the_map)

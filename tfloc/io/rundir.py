@@ -3,8 +3,8 @@
 ``tfloc bench`` writes a run directory, and so does the scaling study (``tfloc scaling``);
 ``timing``, ``report``, ``export``, ``real-note`` and the guard read it. All of them go through
 :class:`RunDir`: it knows the paths (``estimates.csv``, ``run.json``, ``timing.*``, ``report.md``,
-``figures/``), reads and checks ``run.json`` once (:meth:`RunDir.info`, a :class:`RunInfo`:
-configuration, matchers, datasets, thresholds, the datasets' modes, sessions, fingerprint), and
+``figures/``), reads and checks ``run.json`` once (:meth:`RunDir.info`, a :class:`~tfloc.core.run.Run`:
+configuration, matchers, datasets with their modes, thresholds, sessions, fingerprint, timing record), and
 writes it atomically (a kill leaves the old or the new file, never half of one). A malformed
 ``run.json`` is one :class:`ResultsError` naming the file and the field.
 
@@ -23,14 +23,17 @@ from __future__ import annotations
 
 import json
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
+from tfloc.core.presets import resolve
+from tfloc.core.run import Run, RunDataset, RunMatcher, TimingRecord
+from tfloc.core.runconfig import RunConfig
 from tfloc.core.thresholds import Thresholds
-from tfloc.errors import ResultsError, TflocError
+from tfloc.errors import ConfigError, ResultsError, TflocError
 
 from .atomic import replace_atomically
 from .estimates import REQUIRED, read_estimates
@@ -83,89 +86,57 @@ def check_run_doc(doc: object, path: Path) -> dict:
     return doc
 
 
-@dataclass(frozen=True)
-class RunInfo:
-    """What ``run.json`` says about a run (checked). ``doc`` is the whole document (``{}`` when
-    the run has no ``run.json``: provenance unknown, default thresholds)."""
+def _base(name: str, recorded: object) -> str:
+    """The registered matcher a configured name stands for: as the fingerprint recorded it, else
+    its preset resolved (the name itself if it is neither)."""
+    if isinstance(recorded, dict) and isinstance(recorded.get("matcher"), str):
+        return recorded["matcher"]
+    try:
+        return resolve(name, {})[0]
+    except TflocError:
+        return name
 
-    doc: dict = field(default_factory=dict)
 
-    @property
-    def config(self) -> dict:
-        return self.doc.get("config", {})
+def _declared(doc: dict, name: str, path: Path) -> dict:
+    """What a dataset declares in its ``scenario.json`` (``mode``, ``paper_scenarios``): read
+    from the dataset if it is on disk, else as the run recorded it (``declared``)."""
+    try:
+        sc = read_scenario(path)
+        return {"mode": sc.mode, "paper_scenarios": list(sc.paper_scenarios)}
+    except TflocError:
+        return dict(doc.get("declared", {}).get(name, {}))
 
-    @property
-    def name(self) -> str | None:
-        return self.config.get("name")
 
-    @property
-    def kind(self) -> str:
-        """What made the run: ``bench`` (a run configuration), or a study's kind (``scaling``)."""
-        return str(self.config.get("kind", "bench"))
-
-    @property
-    def matchers(self) -> list[dict]:
-        """The run's matchers in configuration order: ``{label, name, params}``."""
-        return list(self.config.get("matchers", []))
-
-    @property
-    def datasets(self) -> dict[str, Path]:
-        """Dataset name → directory, as the run recorded them."""
-        return {k: Path(v) for k, v in self.doc.get("datasets", {}).items()}
-
-    @property
-    def thresholds(self) -> Thresholds:
-        """The success thresholds the run was made with (defaults if it records none)."""
-        return Thresholds.from_run(self.doc)
-
-    @property
-    def sessions(self) -> list[dict]:
-        return list(self.doc.get("sessions", []))
-
-    @property
-    def fingerprint(self) -> dict | None:
-        return self.doc.get("fingerprint")
-
-    @property
-    def done(self) -> list[str]:
-        """The steps (a scaling study's levels) the run has finished, in order."""
-        return list(self.doc.get("done", []))
-
-    @property
-    def timing(self) -> dict | None:
-        """The timing pass's record (``fingerprint``, ``sessions``, ``complete``), None if none."""
-        return self.doc.get("timing")
-
-    def declared(self, dataset: str) -> dict:
-        """What a dataset of the run declares in its ``scenario.json`` (``mode``,
-        ``paper_scenarios``): read from the dataset if it is on disk, else as the run recorded
-        it (``run.json``'s ``declared``); ``{}`` if neither knows."""
-        path = self.datasets.get(dataset)
+def run_of(doc: dict, path: Path) -> Run:
+    """The :class:`~tfloc.core.run.Run` of a checked ``run.json`` document (``path`` names the
+    file in errors): the configuration read back, each matcher's base name and resolved
+    parameters, each dataset's mode read once."""
+    cfg = doc.get("config", {})
+    config = None
+    if cfg.get("kind", "bench") == "bench" and "datasets" in cfg and "matchers" in cfg:
         try:
-            if path is not None:
-                sc = read_scenario(path)
-                return {"mode": sc.mode, "paper_scenarios": list(sc.paper_scenarios)}
-        except TflocError:
-            pass
-        return dict(self.doc.get("declared", {}).get(dataset, {}))
+            config = RunConfig.from_dict(cfg)
+        except ConfigError as exc:
+            raise ResultsError(f"{path}: {exc}") from None
+    recorded = (doc.get("fingerprint") or {}).get("matchers") or {}
+    matchers = []
+    for m in cfg.get("matchers", []):
+        rec = recorded.get(m["label"]) if isinstance(recorded, dict) else None
+        params = dict(m.get("params", {}))
+        resolved = rec.get("params") if isinstance(rec, dict) and isinstance(rec.get("params"), dict) else params
+        matchers.append(RunMatcher(m["label"], m["name"], _base(m["name"], rec), params, resolved))
+    datasets = []
+    for name, where in doc.get("datasets", {}).items():
+        declared = _declared(doc, name, Path(where))
+        datasets.append(RunDataset(name, Path(where), str(declared.get("mode", SINGLE)),
+                                   tuple(declared.get("paper_scenarios", ()))))
+    timing = TimingRecord.from_dict(doc["timing"]) if isinstance(doc.get("timing"), dict) else None
+    return Run(doc, config, tuple(matchers), tuple(datasets), Thresholds.from_run(doc), timing)
 
-    def mode(self, dataset: str) -> str:
-        """The mode of a dataset of the run (:data:`tfloc.io.scenario.MODES`; ``single`` when
-        nothing says otherwise)."""
-        return str(self.declared(dataset).get("mode", SINGLE))
 
-    def paper_scenarios(self) -> dict[str, tuple[str, ...]]:
-        """Dataset → the paper scenarios it declares (datasets that declare none left out)."""
-        out = {}
-        for name in self.datasets:
-            got = tuple(self.declared(name).get("paper_scenarios", ()))
-            if got:
-                out[name] = got
-        return out
-
-    def datasets_in(self, names: list[str], mode: str) -> set[str]:
-        """Which of ``names`` are datasets of ``mode``."""
-        return {n for n in names if self.mode(n) == mode}
+def _file(name: str, what: str) -> property:
+    """A run directory's file ``name`` as a read-only attribute (``what`` it holds)."""
+    return property(lambda self: self.path / name, doc=f"{what}: {name}")
 
 
 @dataclass(frozen=True)
@@ -177,21 +148,17 @@ class RunDir:
     def __post_init__(self) -> None:
         object.__setattr__(self, "path", Path(self.path))
 
-    estimates = property(lambda self: self.path / ESTIMATES, doc="the rows: estimates.csv")
-    run_json = property(lambda self: self.path / RUN_JSON, doc="run.json")
-    timing_csv = property(lambda self: self.path / "timing.csv", doc="the timing pass's rows")
-    timing_md = property(lambda self: self.path / "timing.md", doc="the timing pass's summary")
-    report = property(lambda self: self.path / "report.md", doc="the report")
-    figures = property(lambda self: self.path / "figures", doc="the report's figures")
-    verdict = property(lambda self: self.path / "verdict.csv", doc="the truth-free verdict per tracker")
-    verdict_scans = property(lambda self: self.path / "verdict_scans.csv.gz",
-                             doc="the truth-free verdict's per-scan signals and beliefs")
-    verdict_checks = property(lambda self: self.path / "verdict_checks.csv",
-                              doc="the verdict against the truth, per tracker (recordings with truth)")
-    verdict_agreement = property(lambda self: self.path / "verdict_agreement.csv",
-                                 doc="the verdict's ranking against the truth's, per recording")
-    verdict_flags = property(lambda self: self.path / "verdict_flags.csv",
-                             doc="the recordings' flagged stretches the verdict judged across")
+    estimates = _file(ESTIMATES, "the rows")
+    run_json = _file(RUN_JSON, "the run's record")
+    timing_csv = _file("timing.csv", "the timing pass's rows")
+    timing_md = _file("timing.md", "the timing pass's summary")
+    report = _file("report.md", "the report")
+    figures = _file("figures", "the report's figures")
+    verdict = _file("verdict.csv", "the truth-free verdict per tracker")
+    verdict_scans = _file("verdict_scans.csv.gz", "the truth-free verdict's per-scan signals and beliefs")
+    verdict_checks = _file("verdict_checks.csv", "the verdict against the truth, per tracker (recordings with truth)")
+    verdict_agreement = _file("verdict_agreement.csv", "the verdict's ranking against the truth's, per recording")
+    verdict_flags = _file("verdict_flags.csv", "the recordings' flagged stretches the verdict judged across")
     VERDICT_FILES = ("verdict.csv", "verdict_scans.csv.gz", "verdict_checks.csv", "verdict_agreement.csv",
                      "verdict_flags.csv")
 
@@ -213,26 +180,32 @@ class RunDir:
             raise ResultsError(f"{self.estimates}: no results yet (no task of the run has finished)")
         return df
 
-    def info(self, required: bool = False) -> RunInfo:
-        """``run.json``, read and checked once; without one, an empty :class:`RunInfo` (or, if
-        ``required``, a :class:`ResultsError`)."""
-        if not self.run_json.is_file():
-            if required:
-                raise ResultsError(f"{self.path}: needs {RUN_JSON} (run 'tfloc bench' first)")
-            return RunInfo()
-        doc = parse_text(self.run_json, ResultsError, "run.json file", json.loads, ValueError, "JSON")
-        info = RunInfo(check_run_doc(doc, self.run_json))
-        if required and (not info.matchers or not info.datasets):
-            raise ResultsError(f"{self.run_json}: no 'config.matchers' or 'datasets' (not written by tfloc bench?)")
-        return info
+    def info(self, required: bool = False) -> Run:
+        """``run.json``, read and checked once (:func:`run_of`); without one, an empty
+        :class:`~tfloc.core.run.Run` (or, if ``required``, a :class:`ResultsError`)."""
+        doc = self._doc(required)
+        return run_of(doc, self.run_json) if doc else Run()
 
     def recorded_fingerprint(self) -> dict | None:
         """The fingerprint ``run.json`` records, or None if there is none or it is unreadable
         (a resume then reports that the run records no fingerprint)."""
         try:
-            return self.info().fingerprint
+            return self._doc().get("fingerprint")
         except ResultsError:
             return None
+
+    def _doc(self, required: bool = False) -> dict:
+        """``run.json``'s document, read and checked (``{}`` without one; with ``required``, a
+        :class:`ResultsError` unless it names the run's matchers and datasets)."""
+        if not self.run_json.is_file():
+            if required:
+                raise ResultsError(f"{self.path}: needs {RUN_JSON} (run 'tfloc bench' first)")
+            return {}
+        doc = parse_text(self.run_json, ResultsError, "run.json file", json.loads, ValueError, "JSON")
+        doc = check_run_doc(doc, self.run_json)
+        if required and (not doc.get("config", {}).get("matchers") or not doc.get("datasets")):
+            raise ResultsError(f"{self.run_json}: no 'config.matchers' or 'datasets' (not written by tfloc bench?)")
+        return doc
 
     def write(self, doc: dict[str, Any]) -> None:
         """Write ``run.json`` atomically (a temporary file, fsynced, renamed)."""
@@ -245,7 +218,7 @@ class RunDir:
         done before, ``extra`` fields, e.g. the cores it is pinned to); the timing pass's record
         is kept (its own fingerprint says whether it is still current)."""
         try:
-            old = self.info().doc
+            old = self._doc()
         except ResultsError:
             old = {}
         session = {"started": _now(), "tasks": n_tasks, "already_done": n_done, "loadavg_start": loadavg,
@@ -256,7 +229,7 @@ class RunDir:
     def update(self, fields: dict[str, Any], **session: Any) -> None:
         """Replace top-level ``fields`` of ``run.json`` (e.g. the steps ``done``) and update the
         last session with ``session`` (e.g. its CPU seconds so far)."""
-        doc = self.info().doc
+        doc = self._doc()
         doc.update(fields)
         if session and doc.get("sessions"):
             doc["sessions"][-1].update(session)
@@ -265,7 +238,7 @@ class RunDir:
     def close_session(self, loadavg: list | None, **extra: Any) -> None:
         """Record the end time and load average of the last session (and ``extra`` fields)."""
         try:
-            doc = self.info().doc
+            doc = self._doc()
         except ResultsError:
             return
         if doc.get("sessions"):
@@ -276,7 +249,7 @@ class RunDir:
         """Record in ``run.json`` that a timing pass of ``fingerprint`` starts (not complete until
         :meth:`close_timing`): a new session, after the sessions of the same pass unless
         ``fresh`` (another pass: its record starts over)."""
-        doc = self.info(required=True).doc
+        doc = self._doc(required=True)
         old = doc.get("timing") or {}
         previous = [] if fresh or old.get("fingerprint") != fingerprint else list(old.get("sessions", []))
         session = {"started": _now(), "loadavg_start": loadavg}
@@ -286,7 +259,7 @@ class RunDir:
     def close_timing(self, loadavg: list | None, **extra: Any) -> None:
         """Record that the timing pass started last is complete (``timing.csv`` and ``timing.md``
         are written and current), with ``extra`` fields of its session (e.g. its cores)."""
-        doc = self.info(required=True).doc
+        doc = self._doc(required=True)
         record = doc.get("timing") or {"sessions": [{}]}
         record["sessions"][-1].update(ended=_now(), loadavg_end=loadavg, **extra)
         doc["timing"] = {**record, "complete": True}

@@ -50,7 +50,7 @@ def _read_rows(path: Path) -> list[dict]:
 def _dataset_dirs(run_dir: Path) -> dict[str, Path]:
     """The run's datasets (name → directory) as ``run.json`` records them (none without one)."""
     try:
-        return RunDir(run_dir).info().datasets
+        return RunDir(run_dir).info().paths
     except TflocError:
         return {}
 

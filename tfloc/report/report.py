@@ -15,6 +15,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from tfloc.core.run import Run
 from tfloc.core.thresholds import Thresholds
 from tfloc.evaluation.metrics import prepare, summarize
 from tfloc.evaluation.paired import paired_table
@@ -26,7 +27,7 @@ from tfloc.evaluation.summary import (
 )
 from tfloc.harness.workspace import load_dataset, map_of
 from tfloc.io.estimates import status_kinds
-from tfloc.io.rundir import RunDir, RunInfo
+from tfloc.io.rundir import RunDir
 from tfloc.io.scenario import GLOBAL, SCAN_TO_SCAN, SEQUENCE
 
 from . import figures as F
@@ -50,7 +51,7 @@ class ReportFiles:
 
 
 
-def load_run(run_dir: Path) -> tuple[pd.DataFrame, RunInfo]:
+def load_run(run_dir: Path) -> tuple[pd.DataFrame, Run]:
     """The rows and the ``run.json`` of a run directory (:class:`~tfloc.io.rundir.RunDir`;
     ``run.json`` may be missing: provenance unknown, default thresholds)."""
     rd = RunDir(run_dir)
@@ -172,29 +173,29 @@ def line_figure_matchers(p: pd.DataFrame, order: list[str], most: int = 8) -> li
     return [order[0], *best]
 
 
-def _maps(info: RunInfo, names: set[str]) -> dict:
+def _maps(info: Run, names: set[str]) -> dict:
     """The maps of the run's datasets ``names``, from the workspace (read once per process)."""
     out = {}
-    for n, d in info.datasets.items():
+    for n, d in info.paths.items():
         scenario, scans = load_dataset(str(d)) if n in names else (None, {})
         if scans:
             out[n] = map_of(scenario, next(iter(scans.values())))
     return out
 
 
-def _tracking(run_dir: Path, df: pd.DataFrame, info: RunInfo, thr: Thresholds, with_figures: bool) -> str:
+def _tracking(run_dir: Path, df: pd.DataFrame, info: Run, thr: Thresholds, with_figures: bool) -> str:
     """The tracking section of a run's sequence datasets (:mod:`tfloc.report.tracking`); their
     scores per (sequence, matcher) go to ``tracking.csv``."""
     from .tracking import sequence_scores, tracking_section
 
-    scenarios = {n: load_dataset(str(d))[0] for n, d in info.datasets.items() if n in set(df["dataset"])}
+    scenarios = {n: load_dataset(str(d))[0] for n, d in info.paths.items() if n in set(df["dataset"])}
     maps = _maps(info, set(df["dataset"])) if with_figures else {}
     sequence_scores(df, scenarios, thr).drop(columns="cpu_ms_all").to_csv(
         run_dir / "tracking.csv", index=False, float_format="%.6g")
     return tracking_section(df, scenarios, maps, run_dir, thr, figures=with_figures)
 
 
-def _relocalization(run_dir: Path, df: pd.DataFrame, info: RunInfo, thr: Thresholds) -> str:
+def _relocalization(run_dir: Path, df: pd.DataFrame, info: Run, thr: Thresholds) -> str:
     """The global section of a run's global datasets (:mod:`tfloc.report.relocalization`)."""
     from .relocalization import relocalization_section
 
@@ -246,9 +247,9 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
                 F.fig_runtime(p, fd / "runtime.png"), F.fig_outcomes(p, fd / "outcomes.png", s2s)]
         figs = [f for f in made if f is not None]
         drawn = p[p["matcher"] == order[0]] if sweep else p
-        failures = failures_section(draw_failures(run_dir, drawn, info.datasets))
+        failures = failures_section(draw_failures(run_dir, drawn, info.paths))
         binned = sorted(set(declaring(paper, "II")) | set(declaring(paper, "III")))
-        landscape = landscape_section(*draw_landscapes(run_dir, p, info.datasets, binned))
+        landscape = landscape_section(*draw_landscapes(run_dir, p, info.paths, binned))
     report = run_dir / "report.md"
     text = render(run_dir, run, p, thr, s2s, figs, pt, failures, landscape, line_labels, sweep, paper, top)
     report.write_text(text + ("\n" + tracking if tracking else ""))

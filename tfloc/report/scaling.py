@@ -282,7 +282,7 @@ def render_scaling(run_dir: Path) -> pd.DataFrame:
         raise ResultsError(f"{rd.path}: no scaling study here (its run.json is missing or not of kind "
                            "'scaling'; run 'tfloc scaling' first)")
     rows, prep, skips = (rows_frame(read_rows(rd.path / FILES[c], c), c) for c in (ScanRow, PrepRow, SkipRow))
-    return render(rd.path, rows, prep, skips, info.config.get("scaling", {}), provenance(info.doc))
+    return render(rd.path, rows, prep, skips, info.config_doc.get("scaling", {}), provenance(info.doc))
 
 
 def render(out: Path, rows: pd.DataFrame, prep: pd.DataFrame, skips: pd.DataFrame, config: dict,

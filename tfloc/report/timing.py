@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from tfloc.core.run import TimingRecord
 from tfloc.core.timing_rows import TimingRow
 from tfloc.evaluation.contention import MAX_INFLATION, Contention, describe, mark
 from tfloc.evaluation.timing import timing_summary
@@ -69,8 +70,8 @@ def run_cpu_note(run_dir: Path, df: pd.DataFrame) -> list[str]:
     t = rows_frame(rows, TimingRow)
     line = run_inflation_line(timing_summary(t, str(t["matcher"].iloc[0]), df),
                               "its timing pass ([timing.md](timing.md), same scans)")
-    sessions = ((rd.info().timing or {}).get("sessions") or [{}])
-    c = Contention.from_record(sessions[-1].get("contention") if isinstance(sessions[-1], dict) else None)
+    last = (rd.info().timing or TimingRecord()).last_session
+    c = Contention.from_record(last.get("contention") if isinstance(last, dict) else None)
     tail = (" The timing pass's own contention was not measured (made before the contention probe)."
             if c is None else f" The timing pass itself ran {mark(c)}." if c.contended else "")
     return [line + tail] if line else []

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from tfloc.core.run import TimingRecord
 from tfloc.core.timing_rows import TimingRow
 from tfloc.errors import ConfigError
 from tfloc.evaluation.contention import Contention, describe
@@ -57,10 +58,9 @@ def verify_pass(run_dir: Path, per_stratum: int | None = None, cores: Sequence[i
     committed = rows_frame(read_rows(rd.timing_csv, TimingRow), TimingRow)
     if committed.empty:
         raise ConfigError(f"{rd.path}: no timing pass to verify (no timing.csv; tfloc timing {rd.path} makes one)")
-    record = info.timing or {}
-    fp = record.get("fingerprint") if isinstance(record.get("fingerprint"), dict) else {}
-    sessions = record.get("sessions") or [{}]
-    then = Contention.from_record(sessions[-1].get("contention"))
+    record = info.timing or TimingRecord()
+    fp = record.fingerprint or {}
+    then = Contention.from_record(record.last_session.get("contention"))
     sequences = sorted(info.datasets_in(list(df["dataset"].unique()), SEQUENCE))
     sample = committed_sample(committed, sequences, per_stratum)
     warmup = int(fp.get("warmup", WARMUP))

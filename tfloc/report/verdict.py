@@ -21,7 +21,6 @@ a verdict of other rows.
 from __future__ import annotations
 
 import hashlib
-import json
 import math
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
@@ -30,6 +29,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from tfloc.core.run import Run, RunMatcher
 from tfloc.core.traits import method_of
 from tfloc.evaluation.metrics import tracked as tracked_rows
 from tfloc.evaluation.recording import check_recording
@@ -41,7 +41,7 @@ from tfloc.evaluation.truthfree.judge import Judgement, VerdictRow, judge, verdi
 from tfloc.evaluation.truthfree.mapfit import fit_shares, scan_points
 from tfloc.harness.restarts import restart_ends
 from tfloc.harness.workspace import load_dataset, load_matcher, map_of
-from tfloc.io.rundir import RunDir, RunInfo
+from tfloc.io.rundir import RunDir
 from tfloc.io.scenario import SEQUENCE
 from tfloc.maps.fields import distance_field
 
@@ -113,13 +113,13 @@ def rows_hash(path: Path) -> str:
     return h.hexdigest()
 
 
-def _order(info: RunInfo, df: pd.DataFrame) -> list[str]:
-    labels = [m.get("label", m.get("name")) for m in info.matchers]
+def _order(info: Run, df: pd.DataFrame) -> list[str]:
+    labels = info.labels
     present = set(df["matcher"])
     return [m for m in labels if m in present] or sorted(present)
 
 
-def _restarts(scenario, scans, rec: Recording, specs: dict[str, dict], the_map, cfg: TruthFreeConfig,
+def _restarts(scenario, scans, rec: Recording, specs: dict[str, RunMatcher], the_map, cfg: TruthFreeConfig,
               log: Callable[[str], None]) -> dict[str, np.ndarray]:
     """Per tracker, whether each of its restarts returned (:mod:`~tfloc.evaluation.truthfree.reconverge`)."""
     plan = R.plan(len(scans), cfg.restarts, cfg.restart_scans, cfg.restart_offset_m, cfg.restart_offset_rad,
@@ -129,9 +129,9 @@ def _restarts(scenario, scans, rec: Recording, specs: dict[str, dict], the_map, 
         return out
     last = np.array([r.last for r in plan])
     for i, m in enumerate(rec.matchers):
-        spec = specs.get(m, {"name": m, "params": {}})
+        spec = specs.get(m) or RunMatcher(m, m, m)
         try:
-            matcher = load_matcher(spec["name"], json.dumps(spec.get("params") or {}, sort_keys=True))
+            matcher = load_matcher(spec.name, spec.params_json)
         except Exception as exc:  # noqa: BLE001 - a tracker that cannot be built is reported, not fatal
             log(f"{rec.name}: {m}: no restarts ({type(exc).__name__}: {exc})")
             continue
@@ -190,10 +190,10 @@ def judge_run(run_dir: str | Path, cfg: TruthFreeConfig = DEFAULT, restarts: boo
         raise ResultsError(f"{run_dir}: no sequence dataset: the truth-free verdict judges trackers along "
                            "recordings (tfloc bench on a sequence dataset first)")
     order, thr = _order(info, df), info.thresholds
-    specs = {m.get("label", m.get("name")): m for m in info.matchers}
+    specs = {m.label: m for m in info.matchers}
     rows, tables, checks, agreements, beliefs, flags = [], [], [], [], {}, []
     for name in names:
-        scenario, by_id = load_dataset(str(info.datasets[name]))
+        scenario, by_id = load_dataset(str(info.paths[name]))
         scans = list(by_id.values())
         rec = recording(df, name, order, [s.scan_id for s in scans], thr)
         if not rec.matchers:

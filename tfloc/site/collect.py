@@ -81,9 +81,8 @@ def _truth_free(root: Path) -> tuple[str, str]:
 def timing_mark(run_dir: Path) -> str:
     """The contention mark of the run's timing pass (``contended (×f inflated)``; empty when quiet,
     not measured by an older pass, or the run's record is unreadable)."""
-    record = run_info(run_dir).timing or {}
-    sessions = record.get("sessions") if isinstance(record.get("sessions"), list) else []
-    last = sessions[-1] if sessions and isinstance(sessions[-1], dict) else {}
+    timing = run_info(run_dir).timing
+    last = timing.last_session if timing is not None and isinstance(timing.last_session, dict) else {}
     return mark(Contention.from_record(last.get("contention")))
 
 

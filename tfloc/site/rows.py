@@ -17,10 +17,10 @@ from pathlib import Path
 import pandas as pd
 
 from tfloc.core.modes import GLOBAL, SEQUENCE, mode_of
+from tfloc.core.run import Run
 from tfloc.evaluation.headline import POOLED, HeadlineRow, read_headline
 from tfloc.evaluation.stats import wilson
 from tfloc.evaluation.trajectory import pooled_share
-from tfloc.io.rundir import RunInfo
 
 from .runs import dataset_kinds, run_info
 
@@ -106,7 +106,7 @@ def _from_relocalization(df: pd.DataFrame) -> list[HeadlineRow]:
     return pooled + rows
 
 
-def _from_summary(df: pd.DataFrame, info: RunInfo) -> list[HeadlineRow]:
+def _from_summary(df: pd.DataFrame, info: Run) -> list[HeadlineRow]:
     df = df[(df["grouping"] == "dataset") & (df["bin"] == "all")]
     rows, per = [], {}
     modes = {d: info.mode(d) for d in dict.fromkeys(str(d) for d in df["dataset"])}

@@ -9,8 +9,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from tfloc.core.run import Run
 from tfloc.errors import TflocError
-from tfloc.io.rundir import RunDir, RunInfo
+from tfloc.io.rundir import RunDir
 from tfloc.io.scenario import read_scenario
 
 from .kinds import dataset_kind
@@ -19,21 +20,21 @@ from .kinds import dataset_kind
 SCENARIOS = Path("data/scenarios")
 
 
-def run_info(run_dir: Path) -> RunInfo:
-    """The run's checked ``run.json`` (an empty :class:`RunInfo` when it has none or it is
-    malformed)."""
+def run_info(run_dir: Path) -> Run:
+    """The run's checked ``run.json`` (an empty :class:`~tfloc.core.run.Run` when it has none
+    or it is malformed)."""
     try:
         return RunDir(run_dir).info()
     except TflocError:
-        return RunInfo()
+        return Run()
 
 
-def dataset_kinds(info: RunInfo, names: list[str], base: Path | None = None) -> dict[str, str]:
+def dataset_kinds(info: Run, names: list[str], base: Path | None = None) -> dict[str, str]:
     """Dataset name → ``real`` or ``simulated`` (:func:`tfloc.site.kinds.dataset_kind`) for the
     ``names`` whose ``scenario.json`` is readable; the others are left out (kind unknown). A
     relative directory is tried as it is (from where the verb runs) and, with ``base`` (the
     results root's parent: the checkout the run was made in), under ``base``."""
-    recorded = info.datasets
+    recorded = info.paths
     out = {}
     for name in dict.fromkeys(names):
         places = [p for p in (recorded.get(name), SCENARIOS / name) if p is not None]
