@@ -5,7 +5,8 @@ what ``AmclNode`` (``nav2_amcl/src/amcl_node.cpp``) does around it. Metres, radi
 
 * :func:`amcl_grid`: the grid AMCL runs on, a grid map as given, a vector map rasterised at 5 cm
   (as a user exports it for Nav2).
-* :func:`check_counts`: the particle and beam counts refused before a run.
+* :func:`resolve_config`: a tracker's parameters resolved and checked, the particle and beam
+  counts Nav2 would mend or skip refused before a run.
 * :class:`ScanLimits`: a scan as ``AmclNode::updateFilter`` hands it to the sensor model.
 * :func:`carry`: a map pose carried by the odometry (Nav2's map→odom transform): between filter
   updates the estimate is the last published pose carried so, and a start or ``reset`` pose is
@@ -15,11 +16,13 @@ what ``AmclNode`` (``nav2_amcl/src/amcl_node.cpp``) does around it. Metres, radi
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 
 from tfloc.core.laser import LaserSpec
 from tfloc.core.map import Map
+from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.errors import InvalidProblemError, ParameterError
 from tfloc.maps.build import rasterize
@@ -28,6 +31,7 @@ from tfloc.maps.grid import GridMap
 
 #: Grid resolution (m) a vector map is rasterised at, as a user would export it for Nav2
 VECTOR_MAP_RESOLUTION = 0.05
+C = TypeVar("C")
 
 
 def amcl_grid(map_: Map) -> GridMap:
@@ -37,16 +41,19 @@ def amcl_grid(map_: Map) -> GridMap:
     return cached(map_, ("amcl-grid", VECTOR_MAP_RESOLUTION), lambda: rasterize(map_, VECTOR_MAP_RESOLUTION))
 
 
-def check_counts(min_particles: int, max_particles: int, max_beams: int) -> None:
-    """Refuse, naming the parameters, what Nav2 would mend or skip quietly: ``min_particles`` above
-    ``max_particles`` (Nav2 warns and raises ``max_particles``) and ``max_beams`` below 2 (the
-    models step by ``(n − 1) / (max_beams − 1)``: Nav2 then skips the sensor update without a word,
-    the wheel divides by zero)."""
-    if min_particles > max_particles:
-        raise ParameterError(f"min_particles ({min_particles}) must not exceed max_particles "
-                             f"({max_particles})", ("min_particles", "max_particles"))
-    if max_beams < 2:
-        raise ParameterError(f"max_beams must be >= 2, got {max_beams}", ("max_beams",))
+def resolve_config(kind: type[C], config: C | None, overrides: dict[str, object]) -> C:
+    """An AMCL tracker's parameters: ``config`` (or ``kind()``) with ``overrides``, checked by
+    :func:`~tfloc.core.params.resolve_params`; then refused, naming the parameters, what Nav2 would
+    mend or skip quietly: ``min_particles`` above ``max_particles`` (Nav2 warns and raises
+    ``max_particles``) and ``max_beams`` below 2 (the models step by ``(n − 1) / (max_beams − 1)``:
+    Nav2 then skips the sensor update without a word, the wheel divides by zero)."""
+    c = resolve_params(kind, config, overrides)
+    if c.min_particles > c.max_particles:
+        raise ParameterError(f"min_particles ({c.min_particles}) must not exceed max_particles "
+                             f"({c.max_particles})", ("min_particles", "max_particles"))
+    if c.max_beams < 2:
+        raise ParameterError(f"max_beams must be >= 2, got {c.max_beams}", ("max_beams",))
+    return c
 
 
 @dataclass(frozen=True)

@@ -44,7 +44,6 @@ import numpy as np
 
 from tfloc.core.laser import LaserSpec
 from tfloc.core.map import Map
-from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose, wrap_angle
 from tfloc.core.problem import Estimate
 from tfloc.core.traits import Confidence
@@ -52,7 +51,7 @@ from tfloc.errors import InvalidProblemError, ParameterError
 from tfloc.maps.cache import cached
 from tfloc.maps.grid import GridMap
 
-from ._amcl_common import ScanLimits, amcl_grid, carry, check_counts
+from ._amcl_common import ScanLimits, amcl_grid, carry, resolve_config
 
 try:
     import amcl as _amcl
@@ -151,9 +150,7 @@ class AmclWheelTracker:
     CONFIDENCE = Confidence("sigma_xy_m", False, "the filter's position standard deviation (metres)")
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
-        self.config = resolve_params(Config, config, overrides)
-        c = self.config
-        check_counts(c.min_particles, c.max_particles, c.max_beams)
+        self.config = c = resolve_config(Config, config, overrides)
         if c.laser_model_type != "beam":
             raise ParameterError(f"laser_model_type must be 'beam', got {c.laser_model_type!r}: the amcl wheel "
                                  "compiles only AMCL's beam model (no likelihood field)", ("laser_model_type",))

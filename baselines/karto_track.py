@@ -28,10 +28,9 @@ from typing import ClassVar
 
 import numpy as np
 
-from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate
-from tfloc.core.tracker import LocalTracker
+from tfloc.core.tracker import ConfiguredTracker
 from tfloc.core.traits import Confidence
 
 from .karto import Config as KartoConfig
@@ -53,7 +52,7 @@ class Config:
     local: KartoConfig = field(default_factory=KartoConfig)
 
 
-class KartoGatedTracker(LocalTracker):
+class KartoGatedTracker(ConfiguredTracker):
     """``karto`` matched only when slam_toolbox's gate passes (see the module docstring). ``info``
     of each step: ``matched`` (whether Karto ran) and ``travel_m`` (odometry since the last match)."""
 
@@ -62,10 +61,11 @@ class KartoGatedTracker(LocalTracker):
     CONFIDENCE = Confidence("response", True, "Karto's correlation response (the last matched scan's between matches)")
     CONFIG = Config
 
+    def matcher_of(self, config: Config) -> KartoMatcher:
+        return KartoMatcher(config.local)
+
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
-        self.config = resolve_params(Config, config, overrides)
-        super().__init__(KartoMatcher(self.config.local))
-        self.name = "karto-gated"
+        super().__init__(config, **overrides)
         self._reset_gate()
 
     def _reset_gate(self) -> None:

@@ -25,10 +25,9 @@ import numpy as np
 from kiss_icp.pybind import kiss_icp_pybind
 from kiss_icp.registration import Registration
 
-from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
-from tfloc.core.tracker import LocalTracker
+from tfloc.core.tracker import ConfiguredTracker
 from tfloc.core.traits import Confidence
 
 from ._geometry import embed_z0, matrix_to_pose, pose_to_matrix
@@ -89,7 +88,7 @@ class _AdaptiveStage:
         return Estimate(matrix_to_pose(t), True, info={"sigma": self.sigma})
 
 
-class KissIcpAdaptiveTracker(LocalTracker):
+class KissIcpAdaptiveTracker(ConfiguredTracker):
     """KISS-ICP with its adaptive threshold along a sequence (see the module docstring)."""
 
     name = "kiss-icp-adaptive"
@@ -97,9 +96,11 @@ class KissIcpAdaptiveTracker(LocalTracker):
     CONFIDENCE = Confidence("sigma", False, "its adaptive threshold's sigma (metres)")
     CONFIG = Config
 
+    def matcher_of(self, config: Config) -> _AdaptiveStage:
+        return _AdaptiveStage(config)
+
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
-        self.config = resolve_params(Config, config, overrides)
-        super().__init__(_AdaptiveStage(self.config))
+        super().__init__(config, **overrides)
         self._threshold = None
 
     def start(self, map, laser, pose: Pose) -> None:  # noqa: ANN001 - the Tracker protocol's

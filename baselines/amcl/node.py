@@ -35,7 +35,6 @@ import numpy as np
 
 from tfloc.core.laser import LaserSpec
 from tfloc.core.map import Map
-from tfloc.core.params import resolve_params
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate
 from tfloc.core.tracker import GLOBAL_START, START_KEY
@@ -43,7 +42,7 @@ from tfloc.core.traits import Confidence
 from tfloc.errors import InvalidProblemError
 from tfloc.maps.cache import cached
 
-from .._amcl_common import ScanLimits, amcl_grid, carry, check_counts
+from .._amcl_common import ScanLimits, amcl_grid, carry, resolve_config
 from .angleutils import angle_diff
 from .map.map import NavMap, nav_map
 from .map.map_cspace import occ_dist
@@ -120,9 +119,7 @@ class AmclTracker:
     CONFIDENCE = Confidence("sigma_xy_m", False, "the particles' position spread (metres)")
 
     def __init__(self, config: Config | None = None, **overrides: object) -> None:
-        self.config = resolve_params(Config, config, overrides)
-        c = self.config
-        check_counts(c.min_particles, c.max_particles, c.max_beams)
+        self.config = resolve_config(Config, config, overrides)
         self._nav: NavMap | None = None
         self._weighed = self._scan_used = self._motion = None  # what the accessors read (start resets them)
         self.reproducible = True  #: runs with the same seed repeat bit for bit

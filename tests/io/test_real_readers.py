@@ -136,8 +136,9 @@ def test_robotlaser1_line(tmp_path: Path) -> None:
             f"{s.timestamp:.6f} b21 {s.logger_timestamp:.6f}")
     log = read_carmen(_write(tmp_path, [line]))
     rl = log.lasers[0]
-    assert rl.kind == "ROBOTLASER1" and rl.max_range == pytest.approx(81.9)
-    assert rl.fov == pytest.approx(math.pi, abs=1e-6) and rl.angle_min == pytest.approx(-math.pi / 2, abs=1e-6)
+    assert rl.kind == "ROBOTLASER1" and rl.laser.max_range == pytest.approx(81.9) and s.laser is None
+    assert rl.laser.fov == pytest.approx(math.pi, abs=1e-6)
+    assert rl.laser.angle_min == pytest.approx(-math.pi / 2, abs=1e-6) and rl.laser.n_beams == len(rl.ranges)
     np.testing.assert_allclose(rl.ranges, s.ranges)
     assert rl.pose.x == pytest.approx(s.pose.x)
     with pytest.raises(LogFormatError, match=r":1: ROBOTLASER1: .*truncated"):

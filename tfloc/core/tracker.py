@@ -15,7 +15,7 @@ step's ``info["status"]`` saying so. Units: metres, radians, seconds.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Protocol, runtime_checkable
+from typing import Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -23,7 +23,7 @@ from tfloc.errors import InvalidProblemError
 
 from .laser import LaserSpec
 from .map import Map
-from .params import Configured
+from .params import Configured, resolve_params
 from .pose import Pose
 from .problem import Estimate, Problem
 
@@ -141,6 +141,25 @@ class LocalTracker:
     def reset(self, pose: Pose) -> None:
         """Put the estimate at ``pose`` (e.g. the prediction after a matcher raised)."""
         self.pose = pose
+
+
+class ConfiguredTracker(LocalTracker):
+    """A :class:`LocalTracker` configured by one dataclass, ``CONFIG``, as a
+    :class:`~tfloc.core.params.Configured` matcher is: ``Tracker(config=None, **overrides)`` sets
+    ``self.config`` through :func:`~tfloc.core.params.resolve_params`, runs the single-scan matcher
+    :meth:`matcher_of` builds from it, and keeps the class's ``name`` (not the matcher's)."""
+
+    CONFIG: ClassVar[type]
+    name: str
+
+    def __init__(self, config: Any = None, **overrides: Any) -> None:
+        self.config = resolve_params(self.CONFIG, config, overrides)
+        super().__init__(self.matcher_of(self.config))
+        self.name = type(self).name
+
+    def matcher_of(self, config: Any) -> Any:
+        """The single-scan matcher this tracker runs, made from its resolved ``config``."""
+        raise NotImplementedError
 
 
 def as_tracker(obj: object) -> Tracker:

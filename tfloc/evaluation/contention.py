@@ -33,6 +33,8 @@ MAX_INFLATION = 1.25
 #: the neighbours' CPU share (cores) above which a pass is contended
 MAX_NEIGHBOUR_CORES = 0.25
 NOT_MEASURED = "contention not measured (made before the contention probe)"
+#: the keys of :attr:`Contention.loadavg` (start, end) in a ``run.json`` record
+LOADAVG_KEYS = ("loadavg_start", "loadavg_end")
 
 
 @dataclass(frozen=True)
@@ -48,8 +50,7 @@ class Contention:
     rounds: int
     neighbour_cores: float
     steal_cores: float = math.nan
-    loadavg_start: float = math.nan
-    loadavg_end: float = math.nan
+    loadavg: tuple[float, float] = (math.nan, math.nan)
     thresholds: dict = field(default_factory=lambda: {"inflation": MAX_INFLATION,
                                                       "neighbour_cores": MAX_NEIGHBOUR_CORES})
 
@@ -74,8 +75,15 @@ class Contention:
         return bool(self.reasons())
 
     def to_record(self) -> dict:
-        """The figures for ``run.json`` (NaN as None), the inflation and the verdict beside them."""
-        d = {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in asdict(self).items()}
+        """The figures for ``run.json`` (NaN as None; the load average as ``loadavg_start`` and
+        ``loadavg_end``), the inflation and the verdict beside them."""
+        d = {}
+        for k, v in asdict(self).items():
+            if k == "loadavg":
+                d.update(zip(LOADAVG_KEYS, v, strict=True))
+            else:
+                d[k] = v
+        d = {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in d.items()}
         inf = self.inflation
         return {**d, "inflation": None if math.isnan(inf) else round(inf, 4), "contended": self.contended}
 
@@ -93,8 +101,10 @@ class Contention:
                     kw[f.name] = v
             elif f.name == "rounds":
                 kw[f.name] = int(v) if isinstance(v, (int, float)) else 0
+            elif f.name == "loadavg":
+                kw[f.name] = tuple(_number(record.get(k)) for k in LOADAVG_KEYS)
             else:
-                kw[f.name] = float(v) if isinstance(v, (int, float)) else math.nan
+                kw[f.name] = _number(v)
         return cls(**kw)
 
 
@@ -115,7 +125,12 @@ def assess(reference_ms: list[float], rounds_ms: list[float], busy_s: float, own
         calib_median_ms=float(np.median(rounds)) if rounds else math.nan,
         rounds=len(rounds), neighbour_cores=neighbours,
         steal_cores=max(0.0, steal_s / wall_s) if wall_s > 0 and not math.isnan(steal_s) else math.nan,
-        loadavg_start=loadavg[0], loadavg_end=loadavg[1])
+        loadavg=(loadavg[0], loadavg[1]))
+
+
+def _number(v: object) -> float:
+    """A recorded figure as a float, NaN where it is missing or not a number."""
+    return float(v) if isinstance(v, (int, float)) else math.nan
 
 
 def mark(c: Contention | None) -> str:

@@ -139,4 +139,4 @@ if __name__ == "__main__":
     a = ap.parse_args()
     with pinned(None if a.core is None else [a.core]) as on:
         c = probe_alone(a.seconds)
-    print(f"core(s) {on}: {describe(c)}; load {c.loadavg_start:.2f} → {c.loadavg_end:.2f}")
+    print(f"core(s) {on}: {describe(c)}; load {c.loadavg[0]:.2f} → {c.loadavg[1]:.2f}")

@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from tfloc.core.laser import LaserSpec
 from tfloc.core.pose import Pose
 from tfloc.errors import LogFormatError
 
@@ -45,8 +46,9 @@ class LaserRecord:
         odom: the robot's odometry pose of the line.
         timestamp: ``ipc_timestamp`` (s). logger_timestamp: ``logger_timestamp`` (s).
         host: the ipc host name. line: 1-based line number in the file.
-        angle_min, fov, resolution, max_range: radians/metres, only ROBOTLASER1 stores them
-            (``None`` for FLASER/RLASER, which store no angles).
+        laser: the scanner as the line states it (ROBOTLASER1's ``start_angle``, ``fov``,
+            ``resolution``, ``max_range``: radians, metres); ``None`` for FLASER/RLASER, which
+            store no angles.
     """
 
     kind: str
@@ -57,10 +59,7 @@ class LaserRecord:
     logger_timestamp: float
     host: str
     line: int
-    angle_min: float | None = None
-    fov: float | None = None
-    resolution: float | None = None
-    max_range: float | None = None
+    laser: LaserSpec | None = None
 
 
 @dataclass(frozen=True)
@@ -190,7 +189,8 @@ def _robotlaser1(c: _Line) -> LaserRecord:
         c.num(w)
     t, host, lt = c.stamps()
     c.end()
-    return LaserRecord("ROBOTLASER1", r, laser, robot, t, lt, host, c.lineno, start, fov, res, maxr)
+    return LaserRecord("ROBOTLASER1", r, laser, robot, t, lt, host, c.lineno,
+                       LaserSpec(maxr, fov, res, start))
 
 
 def _odom(c: _Line) -> OdomRecord:
