@@ -2,7 +2,8 @@
 the text between ``<!-- tfloc:begin NAME -->`` and ``<!-- tfloc:end NAME -->`` is replaced by
 block NAME (a page key: its full board; ``KEY-short``: the README's short table; ``cost``,
 ``cost-slopes``; ``advice``: the statements; ``targets``: the tracking targets, checked;
-``truth-free``, ``self-assessment``: :mod:`tfloc.site.truthfree`). The
+``truth-free``, ``self-assessment``: :mod:`tfloc.site.truthfree`; ``peers.RUN.M1.M2…``:
+chosen matchers of one run side by side, :mod:`tfloc.site.peers`). The
 cells are the site's: the figure with its 95 % interval (bold where the paired test puts the
 column's first ahead of the next) and the CPU per scan."""
 
@@ -17,6 +18,7 @@ from .board import Board, Cell
 from .collect import SiteData, run_note
 from .cost import SLOPES, SLOPES_CSV
 from .pages import COST
+from .peers import is_peers, peers_markdown
 
 BLOCK = re.compile(r"(<!-- tfloc:begin (?P<name>[\w.-]+) -->\n)(?P<body>.*?)(<!-- tfloc:end (?P=name) -->)", re.S)
 ADVICE = "advice"
@@ -73,6 +75,8 @@ def block(name: str, data: SiteData) -> str:
         return data.self_assessment
     if name in data.boards:
         return board_markdown(data.boards[name], data, short=name.endswith("-short"))
+    if is_peers(name):
+        return peers_markdown(name, data.root)
     raise ConfigError(f"unknown generated block {name!r}; known: {', '.join([ADVICE, TARGETS, TRUTH_FREE, SELF_ASSESSMENT, *data.boards])}")
 
 
