@@ -4,13 +4,14 @@ resolved once, each dataset with its mode."""
 from pathlib import Path
 
 import pytest
+from _paths import BENCHMARKS, SCEN
 
 from tfloc.core.runconfig import RunConfig
 from tfloc.errors import ConfigError, ResultsError
 from tfloc.harness.config import load_study
 from tfloc.io.rundir import RunDir
 
-STUDIES = sorted(Path("benchmarks").glob("*.toml"))
+STUDIES = sorted(BENCHMARKS.glob("*.toml"))
 
 
 @pytest.mark.parametrize("path", STUDIES, ids=[p.stem for p in STUDIES])
@@ -32,10 +33,10 @@ def test_a_malformed_recorded_configuration_names_its_field() -> None:
 
 
 def test_run_json_is_one_typed_run(tmp_path: Path) -> None:
-    doc = {"config": {"name": "r", "datasets": ["data/scenarios/office-pool", "nowhere/seq"],
+    doc = {"config": {"name": "r", "datasets": [str(SCEN / "office-pool"), "nowhere/seq"],
                       "matchers": [{"label": "fast", "name": "tf-plus-changed", "params": {}},
                                    {"label": "t", "name": "tf", "params": {"spacing": 0.5}}]},
-           "datasets": {"office-pool": "data/scenarios/office-pool", "seq": "nowhere/seq"},
+           "datasets": {"office-pool": str(SCEN / "office-pool"), "seq": "nowhere/seq"},
            "declared": {"seq": {"mode": "sequence"}},
            "fingerprint": {"matchers": {"t": {"matcher": "tf", "params": {"spacing": 0.5, "straw_t": 0.95}}}}}
     rd = RunDir(tmp_path)
