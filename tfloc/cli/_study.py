@@ -13,6 +13,7 @@ hand (``tfloc report results/x``), so a table made by ``make bench`` is the tabl
 from __future__ import annotations
 
 import argparse
+import importlib
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -38,38 +39,17 @@ def _timing(cfg: RunConfig, quick: bool) -> list[tuple[str, Callable[[], int]]]:
     return [(f"timing {cfg.out}", lambda: time_run(cfg.out))]
 
 
-def _verb(step: str, call: Callable[[Path], int]) -> Callable[[RunConfig, bool], list[tuple[str, Callable[[], int]]]]:
-    return lambda cfg, quick: [(f"{step} {cfg.out}", lambda: call(Path(cfg.out)))]
-
-
-def _verdict(run: Path) -> int:
-    from .verdict import judge
-
-    return judge(run)
-
-
-def _report(run: Path) -> int:
-    from .report import report
-
-    return report(run)
-
-
-def _robustness(run: Path) -> int:
-    from .robustness import robustness
-
-    return robustness(run)
-
-
-def _real_note(run: Path) -> int:
-    from .real_note import note
-
-    return note(run)
+def _verb(step: str, function: str) -> Callable[[RunConfig, bool], list[tuple[str, Callable[[], int]]]]:
+    """Step ``step``: the verb module's ``function`` on the run directory (imported when called)."""
+    module = f"{__package__}.{step.replace('-', '_')}"
+    return lambda cfg, quick: [(f"{step} {cfg.out}",
+                                lambda: getattr(importlib.import_module(module), function)(Path(cfg.out)))]
 
 
 #: step → the calls it makes on a run (each with the command line that does the same by hand)
 STEP_CALLS: dict[str, Callable[[RunConfig, bool], list[tuple[str, Callable[[], int]]]]] = {
-    "index": _index, "timing": _timing, "verdict": _verb("verdict", _verdict), "report": _verb("report", _report),
-    "robustness": _verb("robustness", _robustness), "real-note": _verb("real-note", _real_note)}
+    "index": _index, "timing": _timing, "verdict": _verb("verdict", "judge"), "report": _verb("report", "report"),
+    "robustness": _verb("robustness", "robustness"), "real-note": _verb("real-note", "note")}
 
 
 def run_steps(cfg: RunConfig, steps: list[str], quick: bool = False) -> None:

@@ -71,7 +71,7 @@ def run_cpu_note(run_dir: Path, df: pd.DataFrame) -> list[str]:
     line = run_inflation_line(timing_summary(t, str(t["matcher"].iloc[0]), df),
                               "its timing pass ([timing.md](timing.md), same scans)")
     last = (rd.info().timing or TimingRecord()).last_session
-    c = Contention.from_record(last.get("contention") if isinstance(last, dict) else None)
+    c = Contention.from_record(last.get("contention"))
     tail = (" The timing pass's own contention was not measured (made before the contention probe)."
             if c is None else f" The timing pass itself ran {mark(c)}." if c.contended else "")
     return [line + tail] if line else []

@@ -81,8 +81,8 @@ def _truth_free(root: Path) -> tuple[str, str]:
 def timing_mark(run_dir: Path) -> str:
     """The contention mark of the run's timing pass (``contended (×f inflated)``; empty when quiet,
     not measured by an older pass, or the run's record is unreadable)."""
-    timing = run_info(run_dir).timing
-    last = timing.last_session if timing is not None and isinstance(timing.last_session, dict) else {}
+    timing = run_info(run_dir).timing   # (run.json's sessions are checked to be tables)
+    last = timing.last_session if timing is not None else {}
     return mark(Contention.from_record(last.get("contention")))
 
 

@@ -41,7 +41,7 @@ def peers_markdown(name: str, root: Path) -> str:
     for scope in scopes:
         s = df[df["scope"] == scope]
         n = s["matcher"].nunique()
-        rows = {m: r for m, r in zip(s["matcher"], (r for _, r in s.iterrows()), strict=True)}
+        rows = {r["matcher"]: r for _, r in s.iterrows()}
         body.append(["pooled" if scope == POOLED else scope] + [_cell(rows.get(m), n) for m in matchers])
     measure = str(df["measure"].iloc[0]) if len(df) else "measure"
     note = (f"`results/{run}/headline.csv`: {measure} (%, rank among the run's matchers) · "
