@@ -1,6 +1,9 @@
 # tfloc: the commands of the README are `make quick`, `make bench` and `make test`.
 # Each creates .venv on first use and (re)installs when pyproject.toml or requirements.lock changes:
 # the exact versions of requirements.lock (hash-checked), then tfloc itself without dependencies.
+# The lock is complete (uv's universal resolution), so pip installs it with --no-deps: pip resolves
+# nothing against the index (a newer release on PyPI cannot change or break the install), and
+# pip check then proves that the installed set satisfies every requirement of every package.
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
@@ -13,7 +16,8 @@ UV_VERSION := 0.13.9
 
 $(STAMP): pyproject.toml $(LOCK)
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install -qq --require-hashes -r $(LOCK)
+	$(BIN)/python -m pip install -qq --no-deps --require-hashes -r $(LOCK)
+	$(BIN)/python -m pip check
 	$(BIN)/python -m pip install -qq --no-deps --no-build-isolation -e .
 	@$(BIN)/python -c 'import sys; v = sys.version_info[:2]; v < (3, 12) or print("note: matcher karto left out: karto-scanmatcher has wheels for Python 3.8-3.11 only, this is Python %d.%d" % v)'
 	@touch $(STAMP)

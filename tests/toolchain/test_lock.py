@@ -26,7 +26,7 @@ def test_markers_are_evaluated_for_the_runs_python() -> None:
 
 
 def test_this_environment_is_the_lock() -> None:
-    """make installs exactly the lock's versions (pip install --require-hashes -r requirements.lock)."""
+    """make installs exactly the lock's versions (pip install --no-deps --require-hashes -r requirements.lock)."""
     lock = read_lock(ROOT / LOCK_NAME, platform.python_version())
     installed = {canonicalize_name(d.metadata["Name"]): d.version for d in metadata.distributions()}
     wrong = {k: (installed.get(k), v) for k, v in lock.items() if installed.get(k) != v}
