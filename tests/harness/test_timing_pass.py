@@ -350,3 +350,34 @@ def test_verify_fails_where_a_committed_time_is_off_by_more_than_the_tolerance(s
     bad = out.split("does NOT agree within ×1.3: ")[1].splitlines()[0].split(", ")
     assert "o3d-icp" in bad and "committed_ms" in out  # the others may disagree on a busy machine
     assert main(["timing", str(tmp_path / "nope"), "--verify"]) == 2
+
+
+def test_verify_compares_only_passes_made_at_the_same_machine_speed(small_run, tmp_path):
+    """The probe judges a pass against itself, so a machine slowed throughout reads quiet; --verify
+    also compares the calibration's best round with the committed pass's and refuses a re-timing
+    outside ×1.25 of it (with --allow-contended: compared, the machine ratio said)."""
+    import math
+
+    from tfloc.evaluation.contention import Contention
+    from tfloc.report.timing_pass import ContendedError
+    from tfloc.report.timing_verify import apart_from, machine_ratio, verify_pass
+
+    then = Contention(4.0, 4.0, 4.4, 10, 0.0)
+    assert machine_ratio(then, Contention(5.2, 5.2, 5.6, 10, 0.0)) == pytest.approx(1.3)
+    assert math.isnan(machine_ratio(None, then))
+    assert apart_from(then)(Contention(4.8, 4.8, 5.0, 10, 0.0)) is None
+    assert apart_from(then)(Contention(3.3, 3.3, 3.5, 10, 0.0)) is None
+    assert "×1.30 the committed pass's (5.20 ms against 4.00" in apart_from(then)(Contention(5.2, 5.2, 5.6, 10, 0.0))
+    assert "×0.75" in apart_from(then)(Contention(3.0, 3.0, 3.1, 10, 0.0))
+
+    run_dir = _copy(small_run, tmp_path)
+    timing_pass(run_dir, 1, 1, allow_contended=True, log=lambda s: None)
+    doc = _doc(run_dir)
+    doc["timing"]["sessions"][-1]["contention"]["calib_min_ms"] /= 4.0  # the pass was made on a machine 4× faster
+    (run_dir / "run.json").write_text(json.dumps(doc))
+    with pytest.raises(ContendedError, match=r"contended on each of 1 tries \(.*the calibration's best round is ×"):
+        verify_pass(run_dir, retries=0, log=lambda s: None)
+    logged: list[str] = []
+    assert verify_pass(run_dir, tolerance=1e9, allow_contended=True, log=logged.append)
+    machine = next(s for s in logged if s.startswith("machine now / then: ×"))
+    assert float(machine.split("×")[1].split()[0]) > 2 and "per_machine" in "\n".join(logged)

@@ -17,7 +17,8 @@ pass is timed again after --wait seconds, --retries times, then refused (exit 2,
 written); with --allow-contended it is written at once and marked contended in timing.md, the
 site and run.json. --verify re-times the committed pass's scans now (--per-stratum N: the first N
 of each stratum), writes nothing, prints the ratio now / committed per matcher and exits 1 if any
-lies outside ×1.3.
+lies outside ×1.3; a re-timing whose calibration runs outside ×1.25 of the committed pass's
+speed (the machine itself slower or faster) is retried and refused as a contended one is.
 
 Examples:
   tfloc timing results/paper-protocol

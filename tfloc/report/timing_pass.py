@@ -99,22 +99,28 @@ def timing_pass(run_dir: Path, per_stratum: int | None = None, warmup: int | Non
 
 
 def timed_quietly(timed: Callable[[], tuple[list, dict]], log: Log, allow_contended: bool = False,
-                  retries: int = RETRIES, wait_s: float = WAIT_S, what: str = "timing pass") -> tuple[list, dict]:
+                  retries: int = RETRIES, wait_s: float = WAIT_S, what: str = "timing pass",
+                  apart: Callable[[Contention], str | None] | None = None) -> tuple[list, dict]:
     """``timed()`` (rows and a provenance dict with ``contention``) until its probe finds it
     quiet: a contended try is timed again after ``wait_s`` s, at most ``retries`` times, then
     refused (:class:`ContendedError`); with ``allow_contended`` the first try is kept, contended
-    or not (module notes)."""
+    or not (module notes). ``apart``, when given, names a further reason a try's figures cannot
+    be used (None: they can), treated as contention (``--verify``: the machine itself runs at
+    another speed than when the pass it checks was made)."""
+    why: list[str] = []
     for attempt in range(retries + 1):
         rows, meta = timed()
         c = Contention.from_record(meta.get("contention"))
-        if c is None or not c.contended:
+        far = apart(c) if apart is not None and c is not None else None
+        why = (c.reasons() if c is not None else []) + ([far] if far else [])
+        if not why:
             return rows, meta
-        log(f"{what}: {describe(c)}")
+        log(f"{what}: {describe(c)}" + (f"; {far}" if far else ""))
         if allow_contended:
             log(f"{what}: kept as contended (--allow-contended)")
             return rows, meta
         if attempt < retries:
             log(f"{what}: timing again in {wait_s:g} s (try {attempt + 2} of {retries + 1})")
             time.sleep(wait_s)
-    raise ContendedError(f"{what}: contended on each of {retries + 1} tries ({'; '.join(c.reasons())}); "
+    raise ContendedError(f"{what}: contended on each of {retries + 1} tries ({'; '.join(why)}); "
                          "run it on a quiet machine, or pass --allow-contended to keep it marked contended")

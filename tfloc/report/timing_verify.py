@@ -7,6 +7,13 @@ as a pass's are (:func:`tfloc.report.timing_pass.timed_quietly`), nothing writte
 median CPU ms over the same scans, committed and now, and the ratio
 (:func:`tfloc.evaluation.timing.verify_ratios`); the check fails where a ratio lies outside
 ×1/``tolerance``–×``tolerance`` (default ×1.3: a pass's figures are the quiet machine's within that).
+
+The probe judges each pass against itself (its calibration's median over its minimum), so a
+machine slowed throughout a pass reads quiet. Two passes are compared only when the machine ran
+the calibration at the same speed in both: its best round now over its best round then
+(:func:`machine_ratio`) within the probe's own limit (×1/1.25–×1.25, :data:`MAX_INFLATION`); a
+re-timing outside it is retried and refused as a contended one is (with ``allow_contended``,
+compared and said so). The table's ``per_machine`` column is each ratio over that machine ratio.
 """
 
 from __future__ import annotations
@@ -20,7 +27,7 @@ import pandas as pd
 from tfloc.core.run import TimingRecord
 from tfloc.core.timing_rows import TimingRow
 from tfloc.errors import ConfigError
-from tfloc.evaluation.contention import Contention, describe
+from tfloc.evaluation.contention import MAX_INFLATION, Contention, describe
 from tfloc.evaluation.timing import verify_ratios
 from tfloc.harness.timing import WARMUP, read_run, run_timing
 from tfloc.io.rundir import RunDir
@@ -45,6 +52,26 @@ def committed_sample(committed: pd.DataFrame, sequences: Sequence[str], per_stra
                       s[seq].groupby("dataset", sort=False).head(per_stratum)]).sort_index()
 
 
+def machine_ratio(then: Contention | None, now: Contention | None) -> float:
+    """The calibration's fastest round now over its fastest round in the committed pass (NaN where
+    either pass was not measured): how much slower the machine itself runs the same work now."""
+    if then is None or now is None or not then.calib_min_ms > 0 or not now.calib_min_ms > 0:
+        return math.nan
+    return now.calib_min_ms / then.calib_min_ms
+
+
+def apart_from(then: Contention | None, limit: float = MAX_INFLATION) -> Callable[[Contention], str | None]:
+    """For :func:`~tfloc.report.timing_pass.timed_quietly`: why a re-timing cannot be compared
+    with the committed pass ``then`` (the machine ratio outside ×1/``limit``–×``limit``), or None."""
+    def apart(now: Contention) -> str | None:
+        m = machine_ratio(then, now)
+        if math.isnan(m) or 1.0 / limit <= m <= limit:
+            return None
+        return (f"the calibration's best round is ×{m:.2f} the committed pass's "
+                f"({now.calib_min_ms:.2f} ms against {then.calib_min_ms:.2f}; limit ×{limit:g})")
+    return apart
+
+
 def verify_pass(run_dir: Path, per_stratum: int | None = None, cores: Sequence[int] | None = None,
                 log: Log | None = None, tolerance: float = TOLERANCE, allow_contended: bool = False,
                 retries: int = RETRIES, wait_s: float = WAIT_S,
@@ -66,11 +93,16 @@ def verify_pass(run_dir: Path, per_stratum: int | None = None, cores: Sequence[i
     warmup = int(fp.get("warmup", WARMUP))
     rows, meta = timed_quietly(lambda: run_timing(rd.path, cores=cores, warmup=warmup, progress=progress,
                                                   run=(df, info), sample=sample),
-                               log, allow_contended, retries, wait_s, f"{rd.path} (verify)")
+                               log, allow_contended, retries, wait_s, f"{rd.path} (verify)",
+                               apart=apart_from(then))
     table = verify_ratios(committed, rows_frame(rows, TimingRow))
     now = Contention.from_record(meta["contention"])
+    machine = machine_ratio(then, now)
+    table["per_machine"] = table["ratio"] / machine
     log(f"committed pass: {describe(then)}")
     log(f"this re-timing ({len(sample)} scans): {describe(now)}")
+    if not math.isnan(machine):
+        log(f"machine now / then: ×{machine:.2f} (the calibration's best round); per_machine = ratio over it")
     log(table.to_string(index=False, float_format=lambda v: f"{v:.2f}"))
     bad = [r.matcher for r in table.itertuples()
            if math.isnan(r.ratio) or not 1.0 / tolerance <= r.ratio <= tolerance]
