@@ -52,6 +52,11 @@ def committed_sample(committed: pd.DataFrame, sequences: Sequence[str], per_stra
                       s[seq].groupby("dataset", sort=False).head(per_stratum)]).sort_index()
 
 
+def within(ratio: float, limit: float) -> bool:
+    """Whether ``ratio`` lies within ×1/``limit``–×``limit`` (False for NaN)."""
+    return 1.0 / limit <= ratio <= limit
+
+
 def machine_ratio(then: Contention | None, now: Contention | None) -> float:
     """The calibration's fastest round now over its fastest round in the committed pass (NaN where
     either pass was not measured): how much slower the machine itself runs the same work now."""
@@ -65,7 +70,7 @@ def apart_from(then: Contention | None, limit: float = MAX_INFLATION) -> Callabl
     with the committed pass ``then`` (the machine ratio outside ×1/``limit``–×``limit``), or None."""
     def apart(now: Contention) -> str | None:
         m = machine_ratio(then, now)
-        if math.isnan(m) or 1.0 / limit <= m <= limit:
+        if math.isnan(m) or within(m, limit):
             return None
         return (f"the calibration's best round is ×{m:.2f} the committed pass's "
                 f"({now.calib_min_ms:.2f} ms against {then.calib_min_ms:.2f}; limit ×{limit:g})")
@@ -104,8 +109,7 @@ def verify_pass(run_dir: Path, per_stratum: int | None = None, cores: Sequence[i
     if not math.isnan(machine):
         log(f"machine now / then: ×{machine:.2f} (the calibration's best round); per_machine = ratio over it")
     log(table.to_string(index=False, float_format=lambda v: f"{v:.2f}"))
-    bad = [r.matcher for r in table.itertuples()
-           if math.isnan(r.ratio) or not 1.0 / tolerance <= r.ratio <= tolerance]
+    bad = [r.matcher for r in table.itertuples() if not within(r.ratio, tolerance)]
     if bad:
         log(f"{rd.path}: the committed timing pass does NOT agree within ×{tolerance:g}: {', '.join(bad)}")
         return False
