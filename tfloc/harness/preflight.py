@@ -24,7 +24,7 @@ from tfloc.io.scenario import Scenario, read_scenario
 
 from .config import MatcherSpec, RunConfig
 from .fingerprint import fingerprint
-from .identity import matcher_code
+from .identity import ROW_CODE, matcher_code
 from .workspace import load_matcher
 
 
@@ -48,13 +48,14 @@ def build_matcher(spec: MatcherSpec) -> tuple[Any, dict[str, Any]]:
     return m, spec.params
 
 
-def matcher_record(spec: MatcherSpec) -> dict[str, Any]:
+def matcher_record(spec: MatcherSpec, row_code: tuple[str, ...] = ROW_CODE) -> dict[str, Any]:
     """The matcher of ``spec`` built once (:func:`build_matcher`): its name, the registered matcher
-    it stands for (a preset's or a label's), resolved parameters and the code that answers; what a
-    fingerprint records of it."""
+    it stands for (a preset's or a label's), resolved parameters and the code that decides its
+    rows (:func:`tfloc.harness.identity.matcher_code`, with ``row_code`` the harness code that
+    writes them); what a fingerprint records of it."""
     m, params = build_matcher(spec)
     record = {"name": spec.name, "matcher": resolve(spec.name, {})[0], "params": params,
-              **matcher_code(factory_of(spec.name))}
+              **matcher_code(factory_of(spec.name), row_code)}
     program = getattr(m, "program", None)
     if isinstance(program, ExternalProgram):  # an external program: its version and configuration file
         record["program"] = program.identity()

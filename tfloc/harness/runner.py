@@ -44,7 +44,7 @@ from tfloc.io.scenario import (
 )
 
 from .config import RunConfig
-from .fingerprint import differences
+from .fingerprint import Staleness, stale
 from .identity import git_state, recorded_packages
 from .preflight import Preflight, preflight
 from .task import Task, error_status, failure_row, run_task, warm_up
@@ -210,6 +210,18 @@ def _drop_cut_sequences(rd: RunDir, tasks: list[Task], done: set) -> set:
     return done - cut
 
 
+def _what(st: Staleness, done: set) -> str:
+    """What ``--regenerate`` re-runs of a run whose rows ``done`` are made stale by ``st``."""
+    if st.everything or not any(st.keeps(k) for k in done):
+        return "every task (no row of the run stays current)"
+    parts = []
+    if st.matchers:
+        parts.append(f"the tasks of {', '.join(sorted(st.matchers))}")
+    if st.datasets:
+        parts.append(f"dataset{'s' if len(st.datasets) > 1 else ''} {', '.join(sorted(st.datasets))}")
+    return (" and ".join(parts) or "the new matchers' tasks") + " (the other rows are kept)"
+
+
 def run(config: RunConfig, progress: bool | None = None, executor: Executor = execute_local,
         regenerate: bool = False, retry_errors: bool = False) -> Path:
     """Run (or resume) a benchmark; returns the run directory holding ``estimates.csv``.
@@ -217,10 +229,13 @@ def run(config: RunConfig, progress: bool | None = None, executor: Executor = ex
     Every matcher is built first, in this process (a bad parameter raises :class:`ConfigError`
     before anything is written). An existing ``estimates.csv`` is resumed when the run's
     fingerprint is the same: finished tasks are skipped; another configuration raises
-    :class:`ConfigError` saying what differs. With ``regenerate``, a *complete* previous run or
+    :class:`ConfigError` in one line saying what differs (which matchers' code changed, and
+    which files). With ``regenerate``, a *complete* previous run or
     one of another configuration is discarded and run again (an interrupted one is still
     resumed), so one command both reproduces a committed reference run and survives
-    interruptions. With ``retry_errors``, rows whose status is ``error:…`` or ``timeout`` are
+    interruptions. Where only some rows are stale (:func:`tfloc.harness.fingerprint.stale`: a
+    matcher's code or parameters changed, a dataset's files), ``regenerate`` drops those rows
+    and runs their tasks again, keeping the rest. With ``retry_errors``, rows whose status is ``error:…`` or ``timeout`` are
     removed (the file is rewritten atomically) and their tasks run again.
     """
     log = lambda line: print(line, file=sys.stderr)  # noqa: E731
@@ -236,20 +251,27 @@ def run(config: RunConfig, progress: bool | None = None, executor: Executor = ex
             raise
         rd.discard()
         done = set()
+    partial = False
     if done:
-        diff = differences(rd.recorded_fingerprint(), fp)
-        if diff and not regenerate:
-            more = f" (and {len(diff) - 3} more)" if len(diff) > 3 else ""
-            raise ConfigError(f"{rd.path} holds a run of another configuration: {'; '.join(diff[:3])}{more}; "
-                              "to start it over give --regenerate, to keep it choose another --out")
-        if diff:
-            rd.discard()
-            done = set()
-    elif rd.run_json.is_file() and differences(rd.recorded_fingerprint(), fp):
+        st = stale(rd.recorded_fingerprint(), fp)
+        if st and not regenerate:
+            raise ConfigError(f"{rd.path} holds a run of another configuration: {'; '.join(st.reasons[:3])}"
+                              + (f" (and {len(st.reasons) - 3} more)" if len(st.reasons) > 3 else "")
+                              + f"; give --regenerate to re-run {_what(st, done)}, or choose another --out")
+        if st:
+            keep = {k for k in done if st.keeps(k)}
+            if keep:
+                drop_rows(rd.estimates, keep)
+                log(f"{rd.path}: re-running {_what(st, done)}: {'; '.join(st.reasons[:3])}")
+                partial = True
+            else:
+                rd.discard()
+            done = keep
+    elif rd.run_json.is_file() and stale(rd.recorded_fingerprint(), fp):
         rd.discard()  # no rows, but the record of another configuration: its sessions are not this run's
     done = _drop_cut_sequences(rd, tasks, done)
     todo = [t for t in tasks if t.key not in done]
-    if regenerate and not todo and tasks:
+    if regenerate and not todo and tasks and not partial:
         rd.discard()
         todo = tasks
     elif retry_errors and done:

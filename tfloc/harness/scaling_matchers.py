@@ -1,8 +1,9 @@
 """Which matchers a scaling study runs, and what decides its rows (its fingerprint).
 
 :func:`study_matchers` builds the named matchers (default: every registered single-scan local
-matcher); :func:`study_fingerprint` is the tfloc code, the tile map's content hash, every matcher
-with its resolved parameters and code (:func:`tfloc.harness.preflight.matcher_record`), the
+matcher); :func:`study_fingerprint` is the tile map's content hash, every matcher with its resolved
+parameters and the code that decides its rows (:func:`tfloc.harness.preflight.matcher_record`
+with the study's own row code, :data:`ROW_CODE`), the
 success thresholds and the study's configuration (:class:`~tfloc.harness.scaling_config.StudyConfig`,
 all of it). :func:`study_differences` says what differs from a recorded one, one phrase each:
 :func:`tfloc.harness.fingerprint.differences` for the code, map and matchers, then the
@@ -25,9 +26,14 @@ from tfloc.errors import ConfigError, LibraryMissingError, ResultsError
 
 from .config import MatcherSpec
 from .fingerprint import differences
-from .identity import tfloc_code
+from .fingerprint import code_files
+from .identity import tfloc_version
 from .preflight import matcher_record
 from .scaling_config import THRESHOLDS, Log, StudyConfig
+
+#: the study's code that turns a matcher's answers into rows: a level's measurement (tiling, timing,
+#: scoring) and the rows' codec
+ROW_CODE = ("tfloc.harness.scaling_level", "tfloc.io.timing_rows")
 
 
 def study_matchers(names: Sequence[str] | None, log: Log) -> dict[str, Matcher]:
@@ -73,8 +79,9 @@ def study_fingerprint(cfg: StudyConfig, matchers: Sequence[str]) -> dict[str, An
     """What decides the study's rows (module notes); JSON-normalised. ``scaling`` holds the
     configuration's fields."""
     path = Path(cfg.map_path)
-    fp = {"tfloc": tfloc_code(), "datasets": {"map": {path.name: _sha256(path)}},
-          "matchers": {n: matcher_record(MatcherSpec.make(n)) for n in matchers},
+    records = {n: matcher_record(MatcherSpec.make(n), ROW_CODE) for n in matchers}
+    fp = {"tfloc": {"version": tfloc_version(), "files": code_files(records, ROW_CODE)},
+          "datasets": {"map": {path.name: _sha256(path)}}, "matchers": records,
           "success": THRESHOLDS.to_dict(), "scaling": asdict(cfg)}
     return jsonable(fp)
 

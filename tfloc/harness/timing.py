@@ -50,7 +50,7 @@ from tfloc.io.scenario import SEQUENCE
 
 from .contention import Probe
 from .fingerprint import differences
-from .identity import git_state, tfloc_code
+from .identity import derived_code, git_state
 from .pinning import pinned, rotated
 from .runner import load_average
 from .workspace import load_dataset, load_matcher, map_of, problem_of, timed_localize, warm
@@ -131,10 +131,11 @@ def sample_scans(df: pd.DataFrame, per_stratum: int, seed: int = SEED,
 
 def timing_fingerprint(run_fingerprint: dict | None, params: TimingParams, sample: pd.DataFrame) -> dict:
     """What decides a timing pass's rows: the run's fingerprint, the pass's parameters, the
-    sampled scans (SHA-256 of their keys: the run's rows decide the sample) and the code timed
-    (:func:`tfloc.harness.identity.tfloc_code`); JSON-normalised."""
+    sampled scans (SHA-256 of their keys: the run's rows decide the sample) and the code that
+    times (this module's import closure: the matchers' own code is in the run's fingerprint);
+    JSON-normalised."""
     keys = "\n".join(f"{d}\t{s}" for d, s in zip(sample["dataset"], sample["scan_id"], strict=True))
-    fp = {"run": run_fingerprint, "tfloc": tfloc_code(), **asdict(params),
+    fp = {"run": run_fingerprint, "tfloc": {"source": derived_code(__name__)}, **asdict(params),
           "sample": hashlib.sha256(keys.encode()).hexdigest()}
     return jsonable(fp)
 
@@ -154,7 +155,7 @@ def stale(rd: RunDir, record: TimingRecord | None, fp: dict) -> list[str]:
         why = differences(old.get("run"), fp["run"]) if isinstance(fp["run"], dict) else []
         out.append("the run changed" + (f" ({why[0]})" if why else ""))
     if (old.get("tfloc") or {}).get("source") != fp["tfloc"]["source"]:
-        out.append(f"tfloc's code changed (source {str((old.get('tfloc') or {}).get('source'))[:12]} → "
+        out.append(f"the timing code changed (source {str((old.get('tfloc') or {}).get('source'))[:12]} → "
                    f"{fp['tfloc']['source'][:12]})")
     if old.get("sample") != fp["sample"] and old.get("run") == fp["run"] and not params:
         out.append("the run's rows changed (another sample of scans)")

@@ -69,16 +69,26 @@ def header(run_dir: Path, run: dict, df: pd.DataFrame, thr: Thresholds, s2s: set
 
 
 def code_note(run: dict) -> str:
-    """The code that made the rows (its source hash, :mod:`tfloc.harness.identity`) and whether it
-    is this checkout's."""
-    from tfloc.harness.identity import tfloc_code
+    """The code that made each matcher's rows (its import closure's hash,
+    :mod:`tfloc.harness.identity`) and for how many it is this checkout's."""
+    from tfloc.core.matcher import factory_of
+    from tfloc.errors import TflocError
+    from tfloc.harness.identity import matcher_code
 
-    made = ((run.get("fingerprint") or {}).get("tfloc") or {})
-    if not isinstance(made, dict) or not made.get("source"):
-        return "- Code: not recorded (a run made before code identity was recorded)"
-    same = made["source"] == tfloc_code()["source"]
-    return (f"- Code: tfloc's answering source `{made['source'][:12]}`, "
-            + ("the same as this checkout's" if same else "**not this checkout's** (made by other code)"))
+    recorded = (run.get("fingerprint") or {}).get("matchers") or {}
+    if not recorded or not all(isinstance(r, dict) and r.get("source") for r in recorded.values()):
+        return "- Code: not recorded per matcher (a run made before per-matcher code identity)"
+    stale = []
+    for label, r in recorded.items():
+        try:
+            now = matcher_code(factory_of(r["name"]))
+        except TflocError:
+            now = {}
+        if now.get("source") != r.get("source"):
+            stale.append(label)
+    return ("- Code: recorded per matcher (its own code and the harness's row code); "
+            + (f"all {len(recorded)} are this checkout's" if not stale else
+               f"**{len(stale)} of {len(recorded)} not this checkout's** ({', '.join(stale)})"))
 
 
 def lock_note(run: dict) -> list[str]:
