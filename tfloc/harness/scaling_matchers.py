@@ -25,8 +25,7 @@ from tfloc.core.tracker import has_single_scan_mode
 from tfloc.errors import ConfigError, LibraryMissingError, ResultsError
 
 from .config import MatcherSpec
-from .fingerprint import differences
-from .fingerprint import code_files
+from .fingerprint import code_files, differences
 from .identity import tfloc_version
 from .preflight import matcher_record
 from .scaling_config import THRESHOLDS, Log, StudyConfig
