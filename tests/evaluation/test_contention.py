@@ -17,7 +17,7 @@ from tfloc.evaluation.contention import (
     describe,
     mark,
 )
-from tfloc.evaluation.timing import verify_ratios
+from tfloc.evaluation.timing import between_ratios, outside, verify_ratios
 from tfloc.harness.contention import parse_proc_stat
 
 
@@ -85,3 +85,26 @@ def test_verify_compares_medians_on_the_scans_both_passes_timed():
     v = verify_ratios(then, now).set_index("matcher")
     assert v.loc["a", "n"] == 4 and v.loc["a", "committed_ms"] == pytest.approx(5.0)
     assert v.loc["a", "ratio"] == pytest.approx(1.0) and v.loc["b", "ratio"] == pytest.approx(2.0)
+
+
+def test_between_matchers_a_uniform_slowdown_cancels_and_a_relative_one_does_not():
+    """On another CPU model the matchers' ratios to the reference are compared: a machine ×1.8
+    slower throughout leaves them as they were (the absolute ratios all fail), one matcher twice
+    as slow relative to the reference fails alone."""
+    then = pd.DataFrame([{"dataset": "d", "scan_id": f"s{i}", "matcher": m, "cpu_ms": c * (i + 1)}
+                         for i in range(5) for m, c in (("tf-plus", 2.0), ("b", 10.0), ("c", 1.0))])
+    uniform = verify_ratios(then, then.assign(cpu_ms=then["cpu_ms"] * 1.8))
+    assert outside(uniform, 1.3) == ["tf-plus", "b", "c"]
+    b = between_ratios(uniform, "tf-plus").set_index("matcher")
+    assert b.loc["b", "committed_to_ref"] == pytest.approx(5.0) and b.loc["b", "now_to_ref"] == pytest.approx(5.0)
+    assert b["ratio"].to_numpy() == pytest.approx([1.0, 1.0, 1.0]) and b.loc["c", "n"] == 5
+    assert outside(between_ratios(uniform, "tf-plus"), 1.3) == []
+    slow_b = then.assign(cpu_ms=then["cpu_ms"] * 1.8 * then["matcher"].map({"tf-plus": 1.0, "b": 2.0, "c": 1.0}))
+    b = between_ratios(verify_ratios(then, slow_b), "tf-plus")
+    assert outside(b, 1.3) == ["b"] and b.set_index("matcher").loc["b", "ratio"] == pytest.approx(2.0)
+    assert outside(between_ratios(uniform, "c"), 1.3) == []  # any reference: the same cancellation
+    apart = then.assign(scan_id=then["scan_id"].where(then["matcher"] != "tf-plus", "other"))
+    no_ref = between_ratios(verify_ratios(then, apart), "tf-plus")  # the reference timed on no common scan
+    assert no_ref["ratio"].isna().all() and outside(no_ref, 1.3) == ["tf-plus", "b", "c"]
+    with pytest.raises(ValueError, match="reference matcher 'x' is not in the re-timing"):
+        between_ratios(uniform, "x")

@@ -381,3 +381,93 @@ def test_verify_compares_only_passes_made_at_the_same_machine_speed(small_run, t
     assert verify_pass(run_dir, tolerance=1e9, allow_contended=True, log=logged.append)
     machine = next(s for s in logged if s.startswith("machine now / then: ×"))
     assert float(machine.split("×")[1].split()[0]) > 2 and "per_machine" in "\n".join(logged)
+
+
+def test_the_cpu_models_compared_and_where_the_committed_one_is_read():
+    from tfloc.core.run import Run, TimingRecord
+    from tfloc.report.timing_verify import committed_cpu, other_cpu
+
+    assert other_cpu("AMD EPYC", "Intel Xeon") == (
+        "timed on AMD EPYC, this is Intel Xeon: absolute CPU times are not comparable; "
+        "comparing the matchers' ratios to one another, measured side by side")
+    assert other_cpu("AMD  EPYC", " AMD EPYC") is None and other_cpu(None, "AMD EPYC") is None
+    assert other_cpu("AMD EPYC", "") is None
+    machine = {"machine": {"cpu": "AMD EPYC"}}
+    record = TimingRecord(sessions=({"cpu": "Intel Xeon"},))
+    assert committed_cpu(Run(machine, timing=record)) == ("Intel Xeon", "the timing pass's record")
+    assert committed_cpu(Run(machine, timing=TimingRecord(sessions=({},)))) == (
+        "AMD EPYC", "the run's machine.cpu: the timing record names none")
+    assert committed_cpu(Run()) == (None, "not recorded")
+
+
+def _retimed_as(run_dir: Path, monkeypatch, factors: dict[str, float], calls: list[int]) -> None:
+    """--verify's re-timing made the committed rows times ``factors`` (per matcher), quiet by its
+    own probe, its calibration's best round ×4 the committed pass's (far outside ×1.25)."""
+    from dataclasses import replace
+
+    from tfloc.evaluation.contention import Contention
+    from tfloc.io.timing_rows import read_rows
+
+    committed = read_rows(run_dir / "timing.csv", TimingRow)
+    quiet_far = Contention(16.0, 16.0, 16.8, 10, 0.0).to_record()
+
+    def retimed(*args, **kwargs):
+        calls.append(1)
+        return [replace(r, cpu_ms=r.cpu_ms * factors[r.matcher]) for r in committed], {"contention": quiet_far}
+
+    monkeypatch.setattr("tfloc.report.timing_verify.run_timing", retimed)
+
+
+def test_verify_on_another_cpu_model_compares_the_matchers_ratios_to_one_another(small_run, tmp_path,
+                                                                                monkeypatch, capsys):
+    """A pass committed on another CPU model: one line says so, the matchers' ratios to the
+    reference are compared side by side (a uniform ×1.8 passes, one matcher twice as slow
+    relative to it fails), the machine ratio is no reason to retry and nothing is called
+    contended; on the same model the same re-timing is retried and refused as today."""
+    from tfloc.evaluation.contention import Contention
+    from tfloc.harness.runner import cpu_model
+    from tfloc.io.timing_rows import write_rows
+    from tfloc.report.timing_pass import ContendedError
+    from tfloc.report.timing_verify import verify_pass
+
+    run_dir = _copy(small_run, tmp_path)
+    timing_pass(run_dir, 1, 1, allow_contended=True, log=lambda s: None)
+    doc = _doc(run_dir)
+    assert doc["timing"]["sessions"][-1]["cpu"] == cpu_model()  # the pass records the model it ran on
+    rows = pd.read_csv(run_dir / "timing.csv")
+    ms = {"tf-plus": 2.0, "o3d-icp": 6.0, "stay": 0.5}
+    write_rows(run_dir / "timing.csv", [TimingRow(r.dataset, str(r.scan_id), r.group, r.matcher, r.position,
+                                                  ms[r.matcher], ms[r.matcher]) for r in rows.itertuples()], TimingRow)
+    doc["timing"]["sessions"][-1].update(cpu="Fake CPU 9000", contention=Contention(4.0, 4.0, 4.2, 10, 0.0).to_record())
+    (run_dir / "run.json").write_text(json.dumps(doc))
+    line = (f"timed on Fake CPU 9000, this is {cpu_model()}: absolute CPU times are not comparable; "
+            "comparing the matchers' ratios to one another, measured side by side")
+
+    calls: list[int] = []
+    _retimed_as(run_dir, monkeypatch, {"tf-plus": 1.8, "o3d-icp": 1.8, "stay": 1.8}, calls)
+    assert main(["timing", str(run_dir), "--verify", "--wait", "0"]) == 0 and calls == [1]
+    out = capsys.readouterr().out
+    assert line in out.splitlines() and "contended" not in out.lower() and "machine now / then" not in out
+    assert "committed/tf-plus" in out and "now/tf-plus" in out and "now/committed" in out
+    assert out.strip().splitlines()[-1] == (f"{run_dir}: the committed timing pass agrees within ×1.3 for every "
+                                            "matcher's ratio to tf-plus (ratios 1.00–1.00)")
+
+    _retimed_as(run_dir, monkeypatch, {"tf-plus": 1.8, "o3d-icp": 3.6, "stay": 1.8}, calls)
+    logged: list[str] = []
+    assert not verify_pass(run_dir, retries=2, wait_s=0, log=logged.append)
+    assert logged[-1] == (f"{run_dir}: the committed timing pass does NOT agree within ×1.3 in the matchers' "
+                          "ratios to tf-plus: o3d-icp")
+
+    calls.clear()                             # the same model: the machine ratio refuses it, as before
+    _retimed_as(run_dir, monkeypatch, {"tf-plus": 1.8, "o3d-icp": 1.8, "stay": 1.8}, calls)
+    with pytest.raises(ContendedError, match=r"contended on each of 3 tries \(the calibration's best round is ×4\.00"):
+        verify_pass(run_dir, retries=2, wait_s=0, log=lambda s: None, cpu="Fake CPU 9000")
+    assert calls == [1, 1, 1]
+
+    del doc["timing"]["sessions"][-1]["cpu"]  # a record made before the pass named its CPU
+    doc["machine"]["cpu"] = "Fake CPU 9000"
+    (run_dir / "run.json").write_text(json.dumps(doc))
+    logged.clear()
+    assert verify_pass(run_dir, retries=0, log=logged.append)
+    assert logged[0] == (f"CPU model: committed pass Fake CPU 9000 (the run's machine.cpu: the timing record "
+                         f"names none), this machine {cpu_model()}") and logged[1] == line

@@ -18,7 +18,11 @@ written); with --allow-contended it is written at once and marked contended in t
 site and run.json. --verify re-times the committed pass's scans now (--per-stratum N: the first N
 of each stratum), writes nothing, prints the ratio now / committed per matcher and exits 1 if any
 lies outside ×1.3; a re-timing whose calibration runs outside ×1.25 of the committed pass's
-speed (the machine itself slower or faster) is retried and refused as a contended one is.
+speed (the machine itself slower or faster) is retried and refused as a contended one is. On
+another CPU model than the committed pass's (its record's, else the run's machine's) absolute
+CPU times do not compare: --verify says so in one line and compares each matcher's ratio to the
+reference matcher, timed side by side, now with the committed one (exit 1 outside ×1.3), with
+no machine-speed check; contention the re-timing's own probe finds is still retried and refused.
 
 Examples:
   tfloc timing results/paper-protocol
@@ -60,7 +64,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    "it is refused (default 2)")
     p.add_argument("--wait", type=float, default=None, help="seconds before each of those tries (default 60)")
     p.add_argument("--verify", action="store_true", help="re-time the committed pass's scans now and "
-                   "compare (exit 1 if a matcher's ratio lies outside ×1.3); writes nothing")
+                   "compare (exit 1 if a matcher's ratio lies outside ×1.3; on another CPU model, its ratio "
+                   "to the reference matcher); writes nothing")
 
 
 def run(args: argparse.Namespace) -> int:

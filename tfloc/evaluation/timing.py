@@ -5,6 +5,11 @@ median wall ms, the ratio of its median CPU time to the reference matcher's with
 bootstrap interval (resampling scans), and, when the run recorded CPU times, the run's median
 CPU ms on the same scans and its ratio to the quiet re-timing (how far the run's own CPU times
 were inflated by sharing the machine).
+
+Comparing a re-timing with a committed pass (``tfloc timing RUN --verify``): per matcher its
+median CPU ms then and now (:func:`verify_ratios`), and, where absolute CPU times do not compare
+(another CPU model), its ratio to the reference matcher then and now (:func:`between_ratios`):
+matchers timed side by side share the machine, so its speed cancels out of their ratios.
 """
 
 from __future__ import annotations
@@ -77,3 +82,35 @@ def verify_ratios(committed: pd.DataFrame, now: pd.DataFrame) -> pd.DataFrame:
         rows.append({"matcher": m, "n": len(g), "committed_ms": then, "now_ms": cur,
                      "ratio": cur / then if then > 0 else np.nan})
     return pd.DataFrame(rows, columns=VERIFY_COLUMNS)
+
+
+BETWEEN_COLUMNS = ["matcher", "n", "committed_to_ref", "now_to_ref", "ratio"]
+
+
+def between_ratios(verified: pd.DataFrame, reference: str) -> pd.DataFrame:
+    """The matchers' ratios to one another, committed and now, from :func:`verify_ratios`' table
+    ``verified``: per matcher (in its order) its median CPU ms over ``reference``'s, in the
+    committed pass (``committed_to_ref``) and now (``now_to_ref``), and ``ratio`` the one now over
+    the one committed (unitless; NaN where a median is missing); columns :data:`BETWEEN_COLUMNS`.
+    A machine uniformly ×f slower scales every median by f and leaves these ratios as they were.
+    A ``reference`` not in ``verified`` is a :class:`ValueError`."""
+    v = verified.set_index("matcher")
+    if reference not in v.index:
+        raise ValueError(f"reference matcher {reference!r} is not in the re-timing ({', '.join(v.index)})")
+    ref_then, ref_now = (float(v.loc[reference, c]) for c in ("committed_ms", "now_ms"))
+    out = pd.DataFrame({"matcher": v.index, "n": v["n"].to_numpy(),
+                        "committed_to_ref": (v["committed_ms"] / (ref_then if ref_then > 0 else np.nan)).to_numpy(),
+                        "now_to_ref": (v["now_ms"] / (ref_now if ref_now > 0 else np.nan)).to_numpy()})
+    out["ratio"] = (out["now_to_ref"] / out["committed_to_ref"]).where(out["committed_to_ref"] > 0)
+    return out[BETWEEN_COLUMNS]
+
+
+def within(ratio: float, limit: float) -> bool:
+    """Whether ``ratio`` lies within ×1/``limit``–×``limit`` (False for NaN)."""
+    return 1.0 / limit <= ratio <= limit
+
+
+def outside(table: pd.DataFrame, limit: float) -> list[str]:
+    """The matchers of ``table`` (:func:`verify_ratios`' or :func:`between_ratios`') whose
+    ``ratio`` lies outside ×1/``limit``–×``limit`` (or is NaN), in its order."""
+    return [str(m) for m, r in zip(table["matcher"], table["ratio"], strict=True) if not within(float(r), limit)]

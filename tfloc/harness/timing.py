@@ -52,7 +52,7 @@ from .contention import Probe
 from .fingerprint import differences
 from .identity import derived_code, git_state
 from .pinning import pinned, rotated
-from .runner import load_average
+from .runner import cpu_model, load_average
 from .workspace import load_dataset, load_matcher, map_of, problem_of, timed_localize, warm
 
 SEED = 20261130
@@ -169,9 +169,9 @@ def run_timing(run_dir: Path, per_stratum: int = PER_STRATUM, seed: int = SEED, 
     """Re-time a stratified sample of the run in ``run_dir`` (see the module docstring), pinned
     to ``cores`` (default: the last core this process may run on).
 
-    Returns the rows (times in ms) and a provenance dict (cores, load averages, sample size,
-    seed, ``contention``: the probe's figures as
-    :meth:`~tfloc.evaluation.contention.Contention.to_record` gives them). ``run``: the run's rows
+    Returns the rows (times in ms) and a provenance dict (cores, ``cpu``: the CPU's model name
+    (:func:`~tfloc.harness.runner.cpu_model`), load averages, sample size, seed, ``contention``:
+    the probe's figures as :meth:`~tfloc.evaluation.contention.Contention.to_record` gives them). ``run``: the run's rows
     and ``run.json`` if the caller has already read them
     (:func:`read_run`); ``sample``: the scans if it has drawn them (:func:`sample_scans`)."""
     df, info_run = read_run(run_dir) if run is None else run
@@ -190,7 +190,7 @@ def run_timing(run_dir: Path, per_stratum: int = PER_STRATUM, seed: int = SEED, 
         rows = _time_sample(single, specs, paths, warmup, progress, probe) if len(single) else []
         rows += _time_sequences(steps, specs, paths, progress, len(single), probe)
         contention = probe.finish()
-    info = {"cores": on, "per_stratum": per_stratum, "seed": seed, "warmup": warmup,
+    info = {"cores": on, "cpu": cpu_model(), "per_stratum": per_stratum, "seed": seed, "warmup": warmup,
             "contention": contention.to_record(),
             "scans": len(sample), "strata": int(sample.groupby(["dataset", "group"]).ngroups),
             "loadavg_start": load_start, "loadavg_end": load_average(), "started": started,

@@ -6,7 +6,9 @@ the one ``run.json`` records (:func:`tfloc.harness.timing.stale`): the same fing
 with its files: nothing is timed ("already complete: timing.md is current"); otherwise, or with
 ``regenerate``, the run is re-timed (:func:`tfloc.harness.timing.run_timing`), summarised
 (:func:`tfloc.evaluation.timing.timing_summary`, from the typed rows' table) and written
-(:func:`tfloc.report.timing.write_timing`), the record marked complete only once both files are.
+(:func:`tfloc.report.timing.write_timing`), the record marked complete only once both files are;
+its session records the cores and the CPU model it ran on (``cpu``: absolute CPU times compare
+only on one model, :mod:`tfloc.report.timing_verify`) and the probe's ``contention``.
 It lives in the report layer because it writes ``timing.md``; the measuring is the harness's.
 
 A pass the contention probe finds contended (:mod:`tfloc.evaluation.contention`) is timed again
@@ -91,7 +93,8 @@ def timing_pass(run_dir: Path, per_stratum: int | None = None, warmup: int | Non
                                log, allow_contended, retries, wait_s, str(rd.path))
     summary = timing_summary(rows_frame(rows, TimingRow), params.reference, df)
     csv_path, md_path = write_timing(rd.path, rows, summary, params.reference, meta, info.name or rd.path.name)
-    rd.close_timing(load_average(), cores=meta["cores"], scans=meta["scans"], contention=meta["contention"])
+    rd.close_timing(load_average(), cores=meta["cores"], cpu=meta["cpu"], scans=meta["scans"],
+                    contention=meta["contention"])
     log(summary[["matcher", "cpu_median_ms", "ratio_to_reference", "run_over_quiet"]].to_string(
         index=False, float_format=lambda v: f"{v:.2f}"))
     log(f"timing: {md_path} ({csv_path.name})")

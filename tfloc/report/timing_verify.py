@@ -14,6 +14,16 @@ the calibration at the same speed in both: its best round now over its best roun
 (:func:`machine_ratio`) within the probe's own limit (×1/1.25–×1.25, :data:`MAX_INFLATION`); a
 re-timing outside it is retried and refused as a contended one is (with ``allow_contended``,
 compared and said so). The table's ``per_machine`` column is each ratio over that machine ratio.
+
+Absolute CPU times compare only on one CPU model. The committed pass's model is its session's
+``cpu`` in the timing record, else (a record made before the pass recorded it) the run's
+``machine.cpu`` (:func:`committed_cpu`, which says which it read). When it is another model than
+this machine's (:func:`other_cpu`, one line saying so) the check compares the matchers' ratios to
+one another instead, measured side by side: per matcher its median over the reference matcher's
+(the record's ``reference``), committed and now, and the one now over the one committed
+(:func:`tfloc.evaluation.timing.between_ratios`), each within ×1/``tolerance``–×``tolerance``.
+The machine ratio is then no reason to retry or refuse (its calibration measures another
+processor); contention within the re-timing, by its own probe, still is.
 """
 
 from __future__ import annotations
@@ -24,11 +34,12 @@ from pathlib import Path
 
 import pandas as pd
 
-from tfloc.core.run import TimingRecord
+from tfloc.core.run import Run, TimingRecord
 from tfloc.core.timing_rows import TimingRow
 from tfloc.errors import ConfigError
 from tfloc.evaluation.contention import MAX_INFLATION, Contention, describe
-from tfloc.evaluation.timing import verify_ratios
+from tfloc.evaluation.timing import between_ratios, outside, reference_of, verify_ratios, within
+from tfloc.harness.runner import cpu_model
 from tfloc.harness.timing import WARMUP, read_run, run_timing
 from tfloc.io.rundir import RunDir
 from tfloc.io.scenario import SEQUENCE
@@ -52,11 +63,6 @@ def committed_sample(committed: pd.DataFrame, sequences: Sequence[str], per_stra
                       s[seq].groupby("dataset", sort=False).head(per_stratum)]).sort_index()
 
 
-def within(ratio: float, limit: float) -> bool:
-    """Whether ``ratio`` lies within ×1/``limit``–×``limit`` (False for NaN)."""
-    return 1.0 / limit <= ratio <= limit
-
-
 def machine_ratio(then: Contention | None, now: Contention | None) -> float:
     """The calibration's fastest round now over its fastest round in the committed pass (NaN where
     either pass was not measured): how much slower the machine itself runs the same work now."""
@@ -77,12 +83,48 @@ def apart_from(then: Contention | None, limit: float = MAX_INFLATION) -> Callabl
     return apart
 
 
+def committed_cpu(info: Run) -> tuple[str | None, str]:
+    """The CPU model the committed pass of the run ``info`` was timed on and where it was read:
+    the pass's last session (``timing``'s ``cpu``), else the run's machine (``machine.cpu``: a
+    pass recorded before it named its CPU), else ``(None, "not recorded")``."""
+    cpu = (info.timing or TimingRecord()).last_session.get("cpu")
+    if isinstance(cpu, str) and cpu.strip():
+        return cpu.strip(), "the timing pass's record"
+    cpu = (info.doc.get("machine") or {}).get("cpu")
+    if isinstance(cpu, str) and cpu.strip():
+        return cpu.strip(), "the run's machine.cpu: the timing record names none"
+    return None, "not recorded"
+
+
+def other_cpu(then: str | None, now: str | None) -> str | None:
+    """The one line saying the committed pass was timed on another CPU model (``then``) than this
+    one (``now``), or None: the same model (names compared with their spaces folded), or either
+    unknown (then compared as one model)."""
+    if not then or not now or " ".join(then.split()) == " ".join(now.split()):
+        return None
+    return (f"timed on {then}, this is {now}: absolute CPU times are not comparable; "
+            "comparing the matchers' ratios to one another, measured side by side")
+
+
+def _models(info: Run, here: str, log: Log) -> str | None:
+    """Log the committed pass's CPU model (and where it was read) and this machine's ``here``,
+    then, on another model, the line saying so (:func:`other_cpu`); returns that line or None."""
+    model, source = committed_cpu(info)
+    log(f"CPU model: committed pass {model or 'unknown'} ({source}), this machine {here or 'unknown'}")
+    other = other_cpu(model, here)
+    if other:
+        log(other)
+    return other
+
+
 def verify_pass(run_dir: Path, per_stratum: int | None = None, cores: Sequence[int] | None = None,
                 log: Log | None = None, tolerance: float = TOLERANCE, allow_contended: bool = False,
                 retries: int = RETRIES, wait_s: float = WAIT_S,
-                progress: Callable[[int, int], None] | None = None) -> bool:
+                progress: Callable[[int, int], None] | None = None, cpu: str | None = None) -> bool:
     """Re-time the committed pass of ``run_dir`` and log the comparison (module notes); True when
-    every matcher's ratio lies within ``tolerance``. A run without ``timing.csv`` is a
+    every matcher's ratio lies within ``tolerance`` (on another CPU model: its ratio to the
+    reference now over committed). ``cpu``: this machine's CPU model (default
+    :func:`~tfloc.harness.runner.cpu_model`). A run without ``timing.csv`` is a
     :class:`~tfloc.errors.ConfigError`."""
     log = log or _stderr
     rd = RunDir(run_dir)
@@ -96,23 +138,53 @@ def verify_pass(run_dir: Path, per_stratum: int | None = None, cores: Sequence[i
     sequences = sorted(info.datasets_in(list(df["dataset"].unique()), SEQUENCE))
     sample = committed_sample(committed, sequences, per_stratum)
     warmup = int(fp.get("warmup", WARMUP))
+    try:
+        reference = reference_of(list(dict.fromkeys(committed["matcher"])), fp.get("reference") or None)
+    except ValueError as exc:
+        raise ConfigError(f"{rd.path}: {exc}") from None
+    other = _models(info, cpu if cpu is not None else cpu_model(), log)
     rows, meta = timed_quietly(lambda: run_timing(rd.path, cores=cores, warmup=warmup, progress=progress,
                                                   run=(df, info), sample=sample),
                                log, allow_contended, retries, wait_s, f"{rd.path} (verify)",
-                               apart=apart_from(then))
+                               apart=None if other else apart_from(then))
     table = verify_ratios(committed, rows_frame(rows, TimingRow))
+    try:
+        between = between_ratios(table, reference)
+    except ValueError as exc:
+        raise ConfigError(f"{rd.path}: {exc}") from None
     now = Contention.from_record(meta["contention"])
-    machine = machine_ratio(then, now)
-    table["per_machine"] = table["ratio"] / machine
     log(f"committed pass: {describe(then)}")
     log(f"this re-timing ({len(sample)} scans): {describe(now)}")
+    if other:
+        log(side_by_side(between, reference))
+        return _verdict(rd.path, between, tolerance, log, reference)
+    machine = machine_ratio(then, now)
+    table["per_machine"] = table["ratio"] / machine
     if not math.isnan(machine):
         log(f"machine now / then: ×{machine:.2f} (the calibration's best round); per_machine = ratio over it")
     log(table.to_string(index=False, float_format=lambda v: f"{v:.2f}"))
-    bad = [r.matcher for r in table.itertuples() if not within(r.ratio, tolerance)]
+    log(f"each matcher's ratio to {reference}, committed and now (not judged on the same CPU model):\n"
+        f"{side_by_side(between, reference)}")
+    return _verdict(rd.path, table, tolerance, log)
+
+
+def side_by_side(between: pd.DataFrame, reference: str) -> str:
+    """:func:`~tfloc.evaluation.timing.between_ratios`' table as text: per matcher its median CPU
+    over ``reference``'s, committed and now, and the one now over the one committed."""
+    names = {"committed_to_ref": f"committed/{reference}", "now_to_ref": f"now/{reference}",
+             "ratio": "now/committed"}
+    return between.rename(columns=names).to_string(index=False, float_format=lambda v: f"{v:.2f}")
+
+
+def _verdict(path: Path, table: pd.DataFrame, tolerance: float, log: Log, reference: str | None = None) -> bool:
+    """Log whether every ``ratio`` of ``table`` lies within ×1/``tolerance``–×``tolerance`` and
+    return it; ``reference``: the ratios are the matchers' to it (another CPU model)."""
+    bad = outside(table, tolerance)
     if bad:
-        log(f"{rd.path}: the committed timing pass does NOT agree within ×{tolerance:g}: {', '.join(bad)}")
+        to = f" in the matchers' ratios to {reference}" if reference else ""
+        log(f"{path}: the committed timing pass does NOT agree within ×{tolerance:g}{to}: {', '.join(bad)}")
         return False
-    log(f"{rd.path}: the committed timing pass agrees within ×{tolerance:g} for every matcher "
+    every = f"every matcher's ratio to {reference}" if reference else "every matcher"
+    log(f"{path}: the committed timing pass agrees within ×{tolerance:g} for {every} "
         f"(ratios {table['ratio'].min():.2f}–{table['ratio'].max():.2f})")
     return True
