@@ -19,7 +19,7 @@ from _paths import ROOT
 from tfloc.cli import main
 from tfloc.core.laser import LaserSpec
 from tfloc.core.result import Status
-from tfloc.core.timing_rows import PrepRow, ScanRow, SkipRow
+from tfloc.core.rows.timing import PrepRow, ScanRow, SkipRow
 from tfloc.datasets.tiling import Tiling, tile_vector_map, tiling_for_area
 from tfloc.errors import ConfigError, ResultsError
 from tfloc.evaluation.scaling import fit_loglog, level_table, slope_table

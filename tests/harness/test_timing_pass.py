@@ -23,7 +23,7 @@ from tests._estimates import frame, row
 from tests.harness.test_runner import cfg, make_dataset
 from tfloc.cli import build_parser, main
 from tfloc.cli.bench import QUICK_PER_GROUP, config_from_args
-from tfloc.core.timing_rows import TimingRow
+from tfloc.core.rows.timing import TimingRow
 from tfloc.errors import ConfigError
 from tfloc.evaluation.contention import MAX_NEIGHBOUR_CORES
 from tfloc.evaluation.timing import reference_of, timing_summary

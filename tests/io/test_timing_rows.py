@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from tfloc.core.result import Status, StatusKind
-from tfloc.core.timing_rows import MAP, PrepRow, ScanRow, SkipRow, TimingRow
+from tfloc.core.rows.timing import MAP, PrepRow, ScanRow, SkipRow, TimingRow
 from tfloc.errors import ResultsError
 from tfloc.io.timing_rows import (
     FILES,

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from tfloc.core.timing_rows import PrepRow, ScanRow, SkipRow
+from tfloc.core.rows.timing import PrepRow, ScanRow, SkipRow
 from tfloc.io.timing_rows import columns
 
 #: A slope of log cost against log size above this counts as "grows".

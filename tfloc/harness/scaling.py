@@ -12,7 +12,7 @@ thread. ``run.json``: ``config`` (``kind: "scaling"``, ``name``, the matchers, t
 thresholds, the study's fields under ``scaling``), the environment
 (:func:`tfloc.harness.runner.environment`), the tile map as its one dataset, the fingerprint,
 the ``command``, the ``levels`` and the ones ``done``, and one session per start (load averages,
-cores, CPU and wall seconds). The typed rows (:mod:`tfloc.core.timing_rows`) go to
+cores, CPU and wall seconds). The typed rows (:mod:`tfloc.core.rows.timing`) go to
 ``scaling.csv``, ``prep.csv`` and ``skips.csv`` (:mod:`tfloc.io.timing_rows`), each rewritten
 atomically after every level before the level is recorded as done: a level cut off by a kill is
 run again, never mixed. A directory of another configuration is refused with one line naming
@@ -29,7 +29,7 @@ from pathlib import Path
 
 from tfloc.core.jsonable import jsonable
 from tfloc.core.matcher import Matcher
-from tfloc.core.timing_rows import MAP, PrepRow, ScanRow, SkipRow
+from tfloc.core.rows.timing import MAP, PrepRow, ScanRow, SkipRow
 from tfloc.errors import ConfigError, ResultsError
 from tfloc.evaluation.scaling import over_budget
 from tfloc.io.geojson import read_vector_map

@@ -7,7 +7,7 @@ process): each matcher's ``prepare`` timed (CPU and wall s) with the memory it k
 (:func:`~tfloc.harness.workspace.warm` and ``warmup`` calls), then scan by scan every matcher once
 in rotated order, timed by :func:`~tfloc.harness.workspace.timed_localize` with its system time
 apart. Each matcher prepares its own copy of the map (:func:`fresh_copy`), so that no matcher's
-preparation is paid for by another's cache. Rows are typed (:mod:`tfloc.core.timing_rows`);
+preparation is paid for by another's cache. Rows are typed (:mod:`tfloc.core.rows.timing`);
 success is :data:`~tfloc.harness.scaling_config.THRESHOLDS`'.
 """
 
@@ -23,7 +23,7 @@ import numpy as np
 from tfloc.core.matcher import Matcher
 from tfloc.core.problem import Problem
 from tfloc.core.result import Status, StatusKind
-from tfloc.core.timing_rows import MAP, PrepRow, ScanRow
+from tfloc.core.rows.timing import MAP, PrepRow, ScanRow
 from tfloc.datasets.tiling import TileScan, Tiling, scan_ranges, tile_vector_map
 from tfloc.maps.build import rasterize
 from tfloc.maps.grid import GridMap

@@ -18,7 +18,7 @@ conditions:
   the start and before each scan's (or step's) matchers, and the machine's busy time over the
   pass; :mod:`tfloc.evaluation.contention` says whether the pass ran contended.
 
-:func:`run_timing` returns one :class:`~tfloc.core.timing_rows.TimingRow` per (scan, matcher).
+:func:`run_timing` returns one :class:`~tfloc.core.rows.timing.TimingRow` per (scan, matcher).
 A pass is one configuration (:func:`timing_fingerprint`: the run's fingerprint, the pass's
 :class:`TimingParams`, the sample drawn and the code timed), recorded in the run's ``run.json``
 (:meth:`~tfloc.io.rundir.RunDir.start_timing`); :func:`stale` says why a recorded pass is not
@@ -42,7 +42,7 @@ import pandas as pd
 from tfloc.core.jsonable import jsonable
 from tfloc.core.matcher import get_matcher
 from tfloc.core.run import Run, RunMatcher, TimingRecord
-from tfloc.core.timing_rows import TimingRow
+from tfloc.core.rows.timing import TimingRow
 from tfloc.errors import ConfigError
 from tfloc.evaluation.timing import reference_of
 from tfloc.io.rundir import RunDir

@@ -1,4 +1,4 @@
-"""The timing measurements' files: where a typed row (:mod:`tfloc.core.timing_rows`) becomes text
+"""The timing measurements' files: where a typed row (:mod:`tfloc.core.rows.timing`) becomes text
 and back, beside :mod:`tfloc.io.estimates` for the result rows.
 
 ``timing.csv`` (:class:`TimingRow`, numbers as ``%.4f``), and the scaling study's ``scaling.csv``
@@ -23,7 +23,7 @@ from typing import Any, TypeVar, get_type_hints
 import pandas as pd
 
 from tfloc.core.result import Status
-from tfloc.core.timing_rows import PrepRow, ScanRow, SkipRow, TimingRow
+from tfloc.core.rows.timing import PrepRow, ScanRow, SkipRow, TimingRow
 from tfloc.errors import ResultsError
 
 from .atomic import replace_atomically

@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from tfloc.core.timing_rows import PrepRow, ScanRow, SkipRow
+from tfloc.core.rows.timing import PrepRow, ScanRow, SkipRow
 from tfloc.errors import ResultsError
 from tfloc.evaluation.scaling import GROWS_SLOPE, level_table, prep_slope_table, slope_table
 from tfloc.io.rundir import RunDir

@@ -8,7 +8,7 @@ from pathlib import Path
 import pandas as pd
 
 from tfloc.core.run import TimingRecord
-from tfloc.core.timing_rows import TimingRow
+from tfloc.core.rows.timing import TimingRow
 from tfloc.evaluation.contention import MAX_INFLATION, Contention, describe, mark
 from tfloc.evaluation.timing import timing_summary
 from tfloc.io.atomic import replace_atomically

@@ -24,7 +24,7 @@ import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from tfloc.core.timing_rows import TimingRow
+from tfloc.core.rows.timing import TimingRow
 from tfloc.errors import TflocError
 from tfloc.evaluation.contention import Contention, describe
 from tfloc.evaluation.timing import timing_summary

@@ -35,7 +35,7 @@ from pathlib import Path
 import pandas as pd
 
 from tfloc.core.run import Run, TimingRecord
-from tfloc.core.timing_rows import TimingRow
+from tfloc.core.rows.timing import TimingRow
 from tfloc.errors import ConfigError
 from tfloc.evaluation.contention import MAX_INFLATION, Contention, describe
 from tfloc.evaluation.timing import between_ratios, outside, reference_of, verify_ratios, within

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .result import Status
+from ..result import Status
 
 
 @dataclass(frozen=True)
