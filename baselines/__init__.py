@@ -1,1 +1,2 @@
-"""Baseline matchers, one module each, registered through the ``tfloc.matchers`` entry points."""
+"""Baseline matchers, one module each, each declared in its module's ``REGISTRY`` literal
+(:mod:`tfloc.core.registry`)."""

@@ -174,6 +174,16 @@ def probability_grid(map_: object, resolution: float, sigma: float, depth: int) 
     return cached(map_, key, lambda: build_probability_grid(map_, resolution, sigma, depth))
 
 
+REGISTRY = {"bnb-global": {
+    "class": "BranchAndBoundGlobalMatcher",
+    "summary": ("Cartographer's branch-and-bound scan matcher (Hess et al. 2016, Sec. V) over the "
+                "whole map and all headings: the reference for **global** problems (no initial "
+                "guess; [docs/global.md](global.md))"),
+    "docs": "baselines/bnb-global.md",
+    "files": ["baselines/_bnb_kernels.py"],
+}}
+
+
 class BranchAndBoundGlobalMatcher(Configured):
     """Cartographer's fast correlative scan matcher over the whole map (see the module docstring)."""
 

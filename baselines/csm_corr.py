@@ -72,6 +72,13 @@ class _Grid:
     block_starts: np.ndarray  # (B,) offsets of each block's first translation, in cells
 
 
+REGISTRY = {"csm-corr": {
+    "class": "CorrelativeMatcher",
+    "summary": "Olson's real-time correlative scan matching (±3.5 m, ±20°, multi-resolution)",
+    "docs": "baselines/csm-corr.md",
+}}
+
+
 class CorrelativeMatcher(Configured):
     """Olson's real-time correlative scan matcher over the protocol's window (see the module docstring)."""
 

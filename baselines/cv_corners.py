@@ -82,6 +82,14 @@ class _NoAnswer(Exception):
     """A step could not produce a transform (too few corners, hypotheses or inliers; bad scale)."""
 
 
+REGISTRY = {"cv-corners": {
+    "class": "CvCornersMatcher",
+    "summary": ("ShortStraw corners, fair rigid hypotheses, OpenCV `estimateAffinePartial2D` "
+                "(RANSAC)"),
+    "docs": "baselines/cv-corners.md",
+}}
+
+
 class CvCornersMatcher:
     """Corner matching with fair rigid hypotheses, refined by OpenCV (see the module docstring)."""
 

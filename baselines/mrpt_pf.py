@@ -141,6 +141,20 @@ def _program(config: Config) -> ExternalProgram:
     return ExternalProgram("pf-localization", PACKAGE, _version(), INI, render_ini(text, config.ini_values()))
 
 
+REGISTRY = {"mrpt-pf": {
+    "class": "MrptPfTracker",
+    "summary": ("a **tracker**, an **external program**: MRPT's own particle-filter localization, "
+                "Debian `mrpt-apps`' `pf-localization` (MRPT 2.5.8: KLD sampling, likelihood "
+                "field), run as it ships with `localization_demo.ini`'s filter options, headless; "
+                "presets `mrpt-pf-optimal` (the auxiliary PF with the optimal proposal) and "
+                "`mrpt-pf-lf-dense` (every 5th beam), each from MRPT's files "
+                "([docs/baselines/mrpt-pf.md](baselines/mrpt-pf.md)); missing program: one line, "
+                "`apt-get install mrpt-apps` (`make browser` installs it)"),
+    "docs": "baselines/mrpt-pf.md",
+    "files": ["baselines/_mrpt_files.py"],
+}}
+
+
 class MrptPfTracker:
     """MRPT's ``pf-localization`` along a sequence (module notes); external program."""
 

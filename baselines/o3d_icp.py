@@ -61,6 +61,13 @@ class Config:
     min_fitness: float = 0.5  #: converged needs this open3d fitness (0–1)
 
 
+REGISTRY = {"o3d-icp": {
+    "class": "Open3dIcpMatcher",
+    "summary": "open3d point-to-line ICP, coarse-to-fine gates 2 → 0.1 m",
+    "docs": "baselines/o3d-icp.md",
+}}
+
+
 class Open3dIcpMatcher(Configured):
     """open3d point-to-line ICP with a coarse-to-fine gate schedule (see the module docstring)."""
 

@@ -1,17 +1,16 @@
-"""The matchers of the registry, as the generic tests see them: every installed entry point of
-``tfloc.matchers`` (the project's own and any third party's), so that a new matcher is covered by
-the generic tests without editing a test file. A matcher whose optional library is missing is
+"""The matchers of the registry, as the generic tests see them: every matcher the project's modules
+declare (``REGISTRY``, :mod:`tfloc.core.registry`) and every installed entry point of
+``tfloc.matchers`` (a third party's), so that a new matcher is covered by the generic tests
+without editing a test file. A matcher whose optional library is missing is
 skipped with the registry's one-line reason."""
 
 from __future__ import annotations
 
-from importlib.metadata import entry_points
-
 import pytest
 
 from tfloc.core.matcher import (
-    GROUP,
     TRACKER,
+    _registry,
     available_matchers,
     get_matcher,
     kind_of,
@@ -24,8 +23,8 @@ NAMES = available_matchers()
 
 
 def target(name: str) -> str:
-    """The entry point's ``module:attr`` of a registered matcher."""
-    return next(ep.value for ep in entry_points(group=GROUP) if ep.name == name)
+    """The ``module:attr`` of a registered matcher (its declaration's or its entry point's)."""
+    return _registry()[name]
 
 
 #: the baselines: registered matchers whose module is one of ``baselines/``

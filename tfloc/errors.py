@@ -35,6 +35,10 @@ class LibraryMissingError(MatcherError):
     """A matcher's library is not installed (or fails to import); a run leaves that matcher out."""
 
 
+class RegistryError(MatcherError):
+    """A matcher's declaration is malformed (a module's ``REGISTRY``), or a name is declared twice."""
+
+
 class ParameterError(MatcherError):
     """A matcher parameter is unknown or has a bad value.
 

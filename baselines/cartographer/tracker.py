@@ -65,6 +65,18 @@ class _Sampler:
         return False
 
 
+REGISTRY = {"cartographer": {
+    "class": "CartographerTracker",
+    "summary": ("Cartographer's pure-localization loop (`backpack_2d_localization.lua`, wheel "
+                "odometry, online CSM): local SLAM on its own submaps, constraints to frozen "
+                "submaps of the map by branch and bound then Ceres, the sparse pose optimisation "
+                "every 20 nodes, the pure-localization trimmer; publishes the map-frame pose "
+                "([docs/baselines/cartographer.md](baselines/cartographer.md))"),
+    "docs": "baselines/cartographer.md",
+    "files": ["baselines/cartographer/"],
+}}
+
+
 class CartographerTracker:
     """Cartographer's pure-localization loop run scan by scan (module notes)."""
 

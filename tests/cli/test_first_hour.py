@@ -15,7 +15,7 @@ from _paths import ROOT
 
 from tfloc.cli import build_parser
 from tfloc.cli.bench import config_from_args
-from tfloc.core.matcher import default_matchers
+from tfloc.core.matcher import GLOBAL, default_matchers, factory_of, kind_of
 
 ENV = {**os.environ, "COLUMNS": "100", "PYTHONPATH": os.pathsep.join([str(ROOT / "tests"), str(ROOT)])}
 
@@ -94,7 +94,9 @@ def test_the_default_matchers_solve_the_datasets_mode() -> None:
     assert "csm-corr" in single and "tf" in single
     assert not {"amcl", "tf-plus-track", "odometry", "tf-global", "bnb-global"} & set(single)
     assert {"amcl", "tf-plus-track", "csm-corr"} <= set(default_matchers({"sequence"}))
-    assert set(default_matchers({"global"})) == {"tf-global", "bnb-global"}
+    globals_ = default_matchers({"global"})   # every global matcher, whatever is registered
+    assert {"tf-global", "bnb-global"} <= set(globals_)
+    assert all(kind_of(factory_of(m)) == GLOBAL for m in globals_)
     args = build_parser().parse_args(["bench", str(ROOT / "data/scenarios/detail-1")])
     assert [m.name for m in config_from_args(args).matchers] == single
 

@@ -1,5 +1,6 @@
 """The matcher contract, for every registered matcher (found in the registry: a new matcher is
-one module and one entry point, and these tests cover it without editing any test file).
+one module declaring it, or a third party's entry point, and these tests cover it without editing
+any test file).
 
 A single-scan matcher answers the test room's known 0.3 m / 5° offset with a finite pose that
 stays within a metre of the truth (a sanity bound, not an accuracy test: the paper's faithful

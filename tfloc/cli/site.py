@@ -5,13 +5,16 @@ figures). It opens from disk: no server, no network. Which runs each leaderboard
 declared once, in tfloc/site/pages.toml.
 
 --readme also renders the generated blocks (<!-- tfloc:begin NAME --> … <!-- tfloc:end NAME -->)
-of README.md and docs/*.md in the current directory from the same rows; --screenshots writes
+of README.md and docs/*.md in the current directory from the same rows; --only-registry renders
+only the blocks drawn from the matcher registry (docs/matchers.md's table: every matcher the
+project's modules declare), reading no run and writing no site; --screenshots writes
 OUT/screenshots/index-1280.png and index-390.png with headless Chromium (make browser).
 
 Examples:
   tfloc site
   tfloc site --readme --screenshots
   tfloc site --only-quick          # make quick's runs (results/*-quick) → results/site-quick/
+  tfloc site --only-registry       # docs/matchers.md's table after adding a matcher
 """
 
 from __future__ import annotations
@@ -32,6 +35,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="read make quick's runs (each run directory's -quick variant)")
     p.add_argument("--readme", action="store_true",
                    help="also refresh the generated blocks of README.md and docs/*.md here")
+    p.add_argument("--only-registry", action="store_true",
+                   help="only refresh the generated blocks drawn from the matcher registry "
+                        "(docs/matchers.md's table) here: no run read, no site written")
     p.add_argument("--screenshots", nargs="?", const=True, default=None, metavar="DIR",
                    help="also write index-1280.png and index-390.png (default DIR: OUT/screenshots)")
 
@@ -41,6 +47,11 @@ def run(args: argparse.Namespace) -> int:
     from tfloc.site.build import build_site, markdown_files, refresh_markdown
     from tfloc.site.shots import screenshots
 
+    if args.only_registry:
+        changed = refresh_markdown(markdown_files(Path.cwd()), None)
+        print(f"generated blocks: {', '.join(str(f) for f in changed) if changed else 'unchanged'}",
+              file=sys.stderr)
+        return 0
     if args.readme and args.only_quick:
         raise ConfigError("--readme renders the committed runs' blocks: not with --only-quick")
     if not args.results.is_dir():

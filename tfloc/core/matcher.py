@@ -1,4 +1,5 @@
-"""The matcher protocol and the registry (entry-point group ``tfloc.matchers``).
+"""The matcher protocol and the registry: the project's own matchers, declared in their modules
+(:mod:`tfloc.core.registry`), and third parties' (entry-point group ``tfloc.matchers``).
 
 A third party adds a matcher with one line in its own ``pyproject.toml``::
 
@@ -6,7 +7,9 @@ A third party adds a matcher with one line in its own ``pyproject.toml``::
     my-icp = "my_pkg.icp:MyIcpMatcher"
 
 The entry point names a class (or factory) that takes keyword overrides of its configuration
-and returns an object with ``name``, ``localize(problem)`` and ``score(problem, pose)``.
+and returns an object with ``name``, ``localize(problem)`` and ``score(problem, pose)``. A name
+registered twice (two modules, a module and an entry point, two entry points) is one line
+naming both places.
 
 Two optional declarations tell the harness which kinds of task a matcher takes:
 
@@ -23,11 +26,18 @@ from functools import cache
 from importlib.metadata import entry_points
 from typing import Any, Protocol, runtime_checkable
 
-from tfloc.errors import InvalidProblemError, LibraryMissingError, MatcherError, ParameterError
+from tfloc.errors import (
+    InvalidProblemError,
+    LibraryMissingError,
+    MatcherError,
+    ParameterError,
+    RegistryError,
+)
 
 from .pose import Pose
 from .presets import presets, resolve
 from .problem import Estimate, Problem
+from .registry import declarations
 
 GROUP = "tfloc.matchers"
 
@@ -61,9 +71,19 @@ def check_solvable(matcher: object, problem: Problem) -> None:
 
 @cache
 def _registry() -> dict[str, str]:
-    """Matcher name → ``module:attr``, from the installed entry points (the package's own
-    matchers are declared in its ``pyproject.toml`` like anyone else's)."""
-    return {ep.name: ep.value for ep in entry_points(group=GROUP)}
+    """Matcher name → ``module:attr``: the project's own declarations (read from its source, not
+    imported), then the installed entry points (read once per process)."""
+    where = {d.name: f"in {d.path}" for d in declarations()}
+    reg = {d.name: d.target for d in declarations()}
+    for ep in entry_points(group=GROUP):
+        dist = getattr(ep.dist, "name", None) or "an unknown distribution"
+        here = f"by the entry point {ep.name} = {ep.value!r} of {dist}"
+        if ep.name in reg:
+            stale = " (an install older than the source: make install)" if dist == "tfloc" else ""
+            raise RegistryError(f"matcher {ep.name!r} is declared twice: {where[ep.name]} and "
+                                f"{here}{stale}")
+        reg[ep.name], where[ep.name] = ep.value, here
+    return reg
 
 
 def available_matchers() -> list[str]:

@@ -174,6 +174,15 @@ class NoParameters:
     """The configuration of a matcher that takes none."""
 
 
+REGISTRY = {"odometry": {
+    "class": "DeadReckoning",
+    "summary": ("a **tracker**: dead reckoning, the prediction alone (the start pose composed with "
+                "the odometry); the floor of every tracking table; on a single scan it answers its "
+                "guess unchanged"),
+    "docs": "tracking.md",
+}}
+
+
 class DeadReckoning(Configured):
     """``odometry``: the prediction alone, the floor of every tracking table. Run along a
     sequence (:class:`LocalTracker`) it composes the odometry from the start pose (dead

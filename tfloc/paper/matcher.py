@@ -257,6 +257,17 @@ def simplex(cost: _Cost, start: Pose, size: float, rng: np.random.Generator) -> 
     return min(pts, key=f), it
 
 
+REGISTRY = {"tf": {
+    "class": "TurningFunctionMatcher",
+    "summary": ("the paper's method, as written; where the text is wrong or ambiguous the reading "
+                "that works is chosen and documented (Alg. 1's squared distance, Alg. 3's squared "
+                "path, Alg. 5's missing shrink step, W = worst, the seven orientations, the scan "
+                "polygon closed through the sensor, no-return beams)"),
+    "docs": "single-scan.md",
+    "files": ["tfloc/paper/corners.py", "tfloc/paper/turning.py"],
+}}
+
+
 class TurningFunctionMatcher(Configured):
     """The paper's method (``tf``): turning-function scan matching with a Nelder–Mead simplex."""
 

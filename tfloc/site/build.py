@@ -44,8 +44,16 @@ def markdown_files(repo: Path) -> list[Path]:
     return [f for f in files if f.is_file() and block_names(f.read_text(encoding="utf-8"))]
 
 
-def refresh_markdown(files: list[Path], data: SiteData) -> list[Path]:
-    """Render every generated block of ``files`` anew; returns the files that changed."""
+def stale_markdown(files: list[Path], data: SiteData | None) -> list[Path]:
+    """The ``files`` whose generated blocks are not what ``data`` gives (``None``: only the blocks
+    drawn from the matcher registry are checked, :func:`tfloc.site.markdown.refresh`)."""
+    texts = {f: f.read_text(encoding="utf-8") for f in files}
+    return [f for f, text in texts.items() if refresh(text, data) != text]
+
+
+def refresh_markdown(files: list[Path], data: SiteData | None) -> list[Path]:
+    """Render every generated block of ``files`` anew (``data`` None: only the registry's);
+    returns the files that changed."""
     changed = []
     for f in files:
         text = f.read_text(encoding="utf-8")

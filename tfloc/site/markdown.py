@@ -3,9 +3,10 @@ the text between ``<!-- tfloc:begin NAME -->`` and ``<!-- tfloc:end NAME -->`` i
 block NAME (a page key: its full board; ``KEY-short``: the README's short table; ``cost``,
 ``cost-slopes``; ``advice``: the statements; ``targets``: the tracking targets, checked;
 ``truth-free``, ``self-assessment``: :mod:`tfloc.site.truthfree`; ``peers.RUN.M1.M2…``:
-chosen matchers of one run side by side, :mod:`tfloc.site.peers`). The
-cells are the site's: the figure with its 95 % interval (bold where the paired test puts the
-column's first ahead of the next) and the CPU per scan."""
+chosen matchers of one run side by side, :mod:`tfloc.site.peers`; ``matchers``: the project's
+matchers from their declarations, :mod:`tfloc.site.matcher_table`, the one block that reads no
+run: :data:`REGISTRY_BLOCKS`). The cells are the site's: the figure with its 95 % interval (bold
+where the paired test puts the column's first ahead of the next) and the CPU per scan."""
 
 from __future__ import annotations
 
@@ -17,6 +18,7 @@ from tfloc.report.mdtable import table
 from .board import Board, Cell
 from .collect import SiteData, run_note
 from .cost import SLOPES, SLOPES_CSV
+from .matcher_table import matchers_markdown
 from .pages import COST
 from .peers import is_peers, peers_markdown
 
@@ -24,6 +26,8 @@ BLOCK = re.compile(r"(<!-- tfloc:begin (?P<name>[\w.-]+) -->\n)(?P<body>.*?)(<!-
 ADVICE = "advice"
 TARGETS = "targets"
 TRUTH_FREE, SELF_ASSESSMENT = "truth-free", "self-assessment"
+#: blocks drawn from the matcher registry, not from runs: rendered without a results root
+REGISTRY_BLOCKS = {"matchers": matchers_markdown}
 #: rows of a README table (``KEY-short``): the first matchers of its first column
 SHORT_ROWS = 4
 
@@ -65,6 +69,8 @@ def advice_markdown(data: SiteData) -> str:
 
 def block(name: str, data: SiteData) -> str:
     """The Markdown of block ``name``."""
+    if name in REGISTRY_BLOCKS:
+        return REGISTRY_BLOCKS[name]()
     if name == ADVICE:
         return advice_markdown(data)
     if name == TARGETS:
@@ -77,7 +83,7 @@ def block(name: str, data: SiteData) -> str:
         return board_markdown(data.boards[name], data, short=name.endswith("-short"))
     if is_peers(name):
         return peers_markdown(name, data.root)
-    raise ConfigError(f"unknown generated block {name!r}; known: {', '.join([ADVICE, TARGETS, TRUTH_FREE, SELF_ASSESSMENT, *data.boards])}")
+    raise ConfigError(f"unknown generated block {name!r}; known: {', '.join([ADVICE, TARGETS, TRUTH_FREE, SELF_ASSESSMENT, *REGISTRY_BLOCKS, *data.boards])}")
 
 
 def block_names(text: str) -> list[str]:
@@ -85,6 +91,12 @@ def block_names(text: str) -> list[str]:
     return [m.group("name") for m in BLOCK.finditer(text)]
 
 
-def refresh(text: str, data: SiteData) -> str:
-    """``text`` with every generated block rendered anew from ``data``."""
-    return BLOCK.sub(lambda m: m.group(1) + block(m.group("name"), data) + m.group(4), text)
+def refresh(text: str, data: SiteData | None) -> str:
+    """``text`` with every generated block rendered anew from ``data``; with ``data`` None only
+    the :data:`REGISTRY_BLOCKS` (no run read), the others kept as they are."""
+    def render(m: re.Match) -> str:
+        if data is None and m.group("name") not in REGISTRY_BLOCKS:
+            return m.group(0)
+        return m.group(1) + block(m.group("name"), data) + m.group(4)
+
+    return BLOCK.sub(render, text)
