@@ -34,7 +34,8 @@ def one_core() -> None:
 def sample(datasets: tuple[str, ...], per: int, per_real: int) -> list[tuple[str, str, object]]:
     """``(dataset, scan_id, Problem)`` triples: ``per`` scans per group of the paper datasets,
     ``per_real`` scans (evenly spread) of each real dataset."""
-    from tfloc.harness.task import load_dataset, problem_of
+    from tfloc.harness.workspace import problem_of
+    from tfloc.io.scenario import load_dataset
 
     out = []
     for name in datasets:

@@ -92,3 +92,20 @@ def write_run(path: Path, rows: list[dict], datasets: dict[str, str], declared: 
                          "loadavg_start": [3.5, 3.0, 2.5], "loadavg_end": [4.25, 3.5, 3.0]}]}
     (path / "run.json").write_text(json.dumps(run))
     return path
+
+
+def derive_tracking(run_dir, df, scenarios: dict):
+    """The tracking tables the derive step writes (``tracking.csv``, ``kidnap.csv``,
+    ``start.csv``) for rows ``df`` of sequence datasets, in the store of ``run_dir``; returns the
+    :class:`~tfloc.io.rundir.RunDir` the tracking section draws from."""
+    from tfloc.evaluation.sequences import kidnap_events, sequence_scores, start_scores
+    from tfloc.io.rundir import RunDir
+    from tfloc.io.tables import KIDNAP, START, TRACKING
+
+    rd = RunDir(run_dir)
+    extras = {n: sc.extra for n, sc in scenarios.items()}
+    for table, rows in ((TRACKING, sequence_scores(df, extras)), (KIDNAP, kidnap_events(df, extras)),
+                        (START, start_scores(df, extras))):
+        if rows:
+            rd.write(table, rows)
+    return rd

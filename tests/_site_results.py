@@ -1,7 +1,8 @@
 """A small results root for the site's tests: a single-scan run and a global run reported by
 ``tfloc report`` (so they have ``headline.csv``, ``report.md`` and, for the first, figures), a
-tracking run that has only ``tracking.csv`` (the site's provisional rows) and a scaling study's
-``slopes.csv``; every other run of ``pages.toml`` is missing ("not yet run")."""
+tracking run with ``tracking.csv`` and a ``headline.csv`` written through the store (its rows
+derived from the tracking scores below, no paired test) and a scaling study's ``slopes.csv``;
+every other run of ``pages.toml`` is missing ("not yet run")."""
 
 from __future__ import annotations
 
@@ -11,10 +12,11 @@ from pathlib import Path
 import numpy as np
 from _estimates import row, synthetic_run, write_run
 
-from tfloc.core.thresholds import Thresholds
-from tfloc.evaluation.metrics import prepare
-from tfloc.report.headline import headline_section
-from tfloc.report.report import load_run, write_report
+from tfloc.cli.report import make_report
+from tfloc.core.rows.headline import HeadlineRow
+from tfloc.evaluation.stats import wilson
+from tfloc.io.table import write
+from tfloc.io.tables import HEADLINE
 
 TRACKING_CSV = """dataset,matcher,condition,n_scans,n_truth,distance_m,tracked,n_tracked,losses,recoveries,unrecovered,longest_lost_m,ape_rmse_m,ape_mean_m,ape_max_m,ape_rot_rmse_deg,ape_rot_max_deg,rpe_trans_m_per_m,rpe_rot_deg_per_m,cpu_ms_median,max_jump_m,jumps
 real-a-native,tf-plus-track,real-native,100,50,10,0.98,49,0,0,0,0,0.03,0.02,0.1,0.5,1,0.04,0.5,0.7,0.5,0
@@ -50,17 +52,30 @@ def _global_run(path: Path, seed: int = 3) -> Path:
     return path
 
 
+def _native_headline(path: Path) -> None:
+    """``headline.csv`` of the tracking run: each dataset's tracked share (Wilson interval) from
+    :data:`TRACKING_CSV`, ranked, no paired test."""
+    rows = [ln.split(",") for ln in TRACKING_CSV.strip().splitlines()[1:]]
+    out = []
+    for scope in dict.fromkeys(r[0] for r in rows):
+        mine = sorted((r for r in rows if r[0] == scope), key=lambda r: -int(r[7]) / int(r[4]))
+        for rank, r in enumerate(mine, 1):
+            k, n = int(r[7]), int(r[4])
+            lo, hi = wilson(k, n)
+            out.append(HeadlineRow("sequence", scope, rank, r[1], "tracked", 100 * k / n, 100 * lo, 100 * hi, n,
+                                   100 * float(r[12]), "APE RMSE", float(r[19]), "", "", float("nan")))
+    write(path / HEADLINE.name, HEADLINE, out)
+
+
 def results_root(root: Path) -> Path:
     """The results root under ``root`` (created); returns it."""
     root.mkdir(parents=True, exist_ok=True)
-    write_report(synthetic_run(root / "paper-protocol"), None, with_figures=True)
-    glob = _global_run(root / "global-full")  # its report would need the datasets: the headline alone
-    section = headline_section(prepare(load_run(glob)[0], Thresholds(0.1, 2.0)),
-                               {"global-office-1": "global", "real-x-global": "global"}, Thresholds(0.1, 2.0), glob)
-    (glob / "report.md").write_text("# global-full\n\n" + section)
+    make_report(synthetic_run(root / "paper-protocol"), None, with_figures=True)
+    make_report(_global_run(root / "global-full"), None, with_figures=False)  # its datasets are not on disk
     native = root / "native"
     native.mkdir()
     (native / "tracking.csv").write_text(TRACKING_CSV)
+    _native_headline(native)
     (native / "report.md").write_text("# native\n\nSee [the timing](timing.md) and [a missing file](nothing.csv).\n")
     (native / "run.json").write_text(json.dumps({"git": {"commit": "abc", "dirty": False}, "sessions": []}))
     (root / "scaling").mkdir()

@@ -14,8 +14,8 @@ from tfloc.baselines.amcl import AmclTracker
 
 from tfloc.cli import main
 from tfloc.core.pose import Pose
+from tfloc.evaluation.belief import Snapshot, motion_noise, summarize
 from tfloc.io.scenario import Scan, read_scans, read_scenario, write_scenario
-from tfloc.report.belief import Snapshot, motion_noise, summarize
 
 QUICK = ROOT / "data" / "scenarios" / "seq-quick"
 

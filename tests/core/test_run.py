@@ -40,7 +40,7 @@ def test_run_json_is_one_typed_run(tmp_path: Path) -> None:
            "declared": {"seq": {"mode": "sequence"}},
            "fingerprint": {"matchers": {"t": {"matcher": "tf", "params": {"spacing": 0.5, "straw_t": 0.95}}}}}
     rd = RunDir(tmp_path)
-    rd.write(doc)
+    rd.write_doc(doc)
     run = rd.info(required=True)
     assert run.config is not None and run.config.name == "r" and run.labels == ["fast", "t"]
     fast, t = run.matchers
@@ -48,6 +48,6 @@ def test_run_json_is_one_typed_run(tmp_path: Path) -> None:
     assert t.base == "tf" and t.resolved["straw_t"] == 0.95 and t.params == {"spacing": 0.5}
     assert run.mode("seq") == "sequence" and run.mode("office-pool") == "single"   # on disk, else recorded
     assert run.datasets_in(["seq", "office-pool"], "sequence") == {"seq"}
-    rd.write({**doc, "config": {**doc["config"], "jobs": "two"}})
+    rd.write_doc({**doc, "config": {**doc["config"], "jobs": "two"}})
     with pytest.raises(ResultsError, match="run.json: config"):
         rd.info()

@@ -24,13 +24,9 @@ from tfloc.datasets.real_native import (
     native_scans,
 )
 from tfloc.errors import DatasetError, LogFormatError
-from tfloc.evaluation.relations import (
-    relations_path,
-    tracked_relation_errors,
-    tracked_relation_stats,
-)
+from tfloc.evaluation.relations import tracked_relation_errors, tracked_relation_stats
 from tfloc.io.carmen import read_carmen, read_flaser_no_timestamps
-from tfloc.io.relations import Relation, read_relations
+from tfloc.io.relations import Relation, read_relations, relations_path
 from tfloc.io.scenario import read_scans, read_scenario
 
 #: (key, scans in the dataset, truth-bearing scans, raw scans in the log)

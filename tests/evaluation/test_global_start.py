@@ -7,7 +7,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pandas as pd
 import pytest
 from _paths import SCEN
 
@@ -127,7 +126,10 @@ def _rows(name: str, label: str, poses: np.ndarray, scans, info0: dict) -> list:
 
 @pytest.mark.parametrize("global_label", [True, False])
 def test_report_start_table(tmp_path, global_label) -> None:
-    from tfloc.report.tracking import start_scores, tracking_section
+    from tfloc.evaluation.sequences import start_scores
+    from tfloc.io.rundir import RunDir
+    from tfloc.io.tables import START
+    from tfloc.report.tracking import tracking_section
 
     name = "seq-kidnap-b"
     sc = read_scenario(SCEN / name)
@@ -140,10 +142,13 @@ def test_report_start_table(tmp_path, global_label) -> None:
     rows = (_rows(name, "finds", found, scans, {"start": "global"} if global_label else {})
             + _rows(name, "given", true, scans, {}) + _rows(name, "never", never, scans, {}))
     df = rows_frame(rows)
-    text = tracking_section(df, {name: sc}, {}, tmp_path, figures=False)
+    rd = RunDir(tmp_path)
+    starts = start_scores(df, {name: sc.extra})
+    if starts:
+        rd.write(START, starts)
+    text = tracking_section(rd, df, {name: sc}, {}, figures=False)
     if not global_label:
-        assert "the start**" not in text and not (tmp_path / "start.csv").exists()
-        assert len(start_scores(df, {name: sc})) == 0
+        assert "the start**" not in text and not starts
         return
     assert f"**kidnap: the start** (1 sequence; start window in scans, to the first kidnap or the end: " \
            f"{name} {first_kidnap})" in text
@@ -153,6 +158,6 @@ def test_report_start_table(tmp_path, global_label) -> None:
     assert cells("finds") == ["none", "1/1", "20", "20", f"1/1 ({name})"]
     assert cells("given") == ["given", "1/1", "0", "0", "0/1"]
     assert cells("never") == ["given", "0/1", "never", "never", "1/1 (seq-kidnap-b)"]
-    st = pd.read_csv(tmp_path / "start.csv")
+    st = rd.frame(START)
     assert set(st["matcher"]) == {"finds", "given", "never"} and math.isnan(
         st.loc[st["matcher"] == "never", "scans_to_converge"].iloc[0])

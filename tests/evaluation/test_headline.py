@@ -8,11 +8,14 @@ import math
 import pytest
 from _estimates import frame, row, synthetic_run
 
+from tfloc.cli.report import make_report as write_report
+from tfloc.core.rows.headline import POOLED
 from tfloc.core.thresholds import Thresholds
-from tfloc.evaluation.headline import POOLED, headline, headline_frame, read_headline
+from tfloc.evaluation.headline import headline
 from tfloc.evaluation.metrics import prepare
 from tfloc.evaluation.stats import wilson
-from tfloc.report.report import write_report
+from tfloc.io.table import read_rows, write
+from tfloc.io.tables import HEADLINE
 
 THR = Thresholds()
 
@@ -75,8 +78,8 @@ def test_tracking_pools_over_sequences_with_a_bootstrap_interval() -> None:
 def test_headline_csv_round_trips(tmp_path) -> None:
     p = prepare(frame(_rows({"a": 20, "b": 38})), THR)
     rows = headline(p, {"d": "single"}, THR)
-    headline_frame(rows).to_csv(tmp_path / "h.csv", index=False)
-    back = read_headline(tmp_path / "h.csv")
+    write(tmp_path / "h.csv", HEADLINE, rows)
+    back = read_rows(tmp_path / "h.csv", HEADLINE)
     assert [r.matcher for r in back] == ["b", "a"] and back[0].verdict == rows[0].verdict
     assert back[1].verdict == "" and math.isnan(back[1].p_holm)
 

@@ -7,7 +7,6 @@ import json
 import math
 
 import numpy as np
-import pandas as pd
 import pytest
 from _committed import assert_same_file
 from _paths import SCEN
@@ -110,6 +109,9 @@ def test_kidnapped_sequences_regenerate(office_maps) -> None:
 
 # -- the report --------------------------------------------------------------------------------
 def test_report_kidnap_table(tmp_path) -> None:
+    from _estimates import derive_tracking
+
+    from tfloc.io.tables import KIDNAP
     from tfloc.report.tracking import tracking_section
 
     name = "seq-kidnap-b"
@@ -126,14 +128,15 @@ def test_report_kidnap_table(tmp_path) -> None:
             rows.append(result_row(name, label, s.scan_id, s.group, true=s.true, init=pose, est=pose,
                                    status="ok", wall_s=0.002, cpu_s=0.002, info={}))
     df = rows_frame(rows)
-    text = tracking_section(df, {name: sc}, {}, tmp_path, figures=False)
+    rd = derive_tracking(tmp_path, df, {name: sc})
+    text = tracking_section(rd, df, {name: sc}, {}, figures=False)
     assert "**kidnap: kidnap events** (1 sequence: seq-kidnap-b)" in text
     late = next(x for x in text.splitlines() if x.startswith("| late") and "/" in x).split("|")
     lost = next(x for x in text.splitlines() if x.startswith("| lost") and "/" in x).split("|")
     n = len(events)
     assert [c.strip() for c in late[2:6]] == [str(n), f"{n}/{n}", "5", "0"]
     assert [c.strip() for c in lost[2:5]] == [str(n), f"0/{n}", "never"]
-    ev = pd.read_csv(tmp_path / "kidnap.csv")
+    ev = rd.frame(KIDNAP)
     assert len(ev) == 2 * n and set(ev["kidnap_scan"]) == set(sc.extra["kidnaps"])
     assert json.loads((SCEN / name / "scenario.json").read_text())["kidnaps"] == sc.extra["kidnaps"]
 

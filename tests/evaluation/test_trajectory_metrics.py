@@ -69,7 +69,7 @@ def test_rows_without_truth_are_left_out():
     t = _line(21)
     rows = [{"est_x": x, "est_y": y, "est_theta": th, "true_x": x, "true_y": y, "true_theta": th, "cpu_s": 0.001}
             for x, y, th in t]
-    rows[5].update(true_x="", true_y="", true_theta="")
+    rows[5].update(true_x=None, true_y=None, true_theta=None)
     s = score_rows(rows)
     assert s.n_scans == 21 and s.n_truth == 20 and s.tracked == 1.0
 

@@ -200,8 +200,8 @@ def test_a_task_the_data_cannot_pose_is_invalid_not_an_error(tmp_path, test_room
     bad = df[df.scan_id == "s1"].iloc[0]
     assert bad.status.startswith("invalid:") and "scans.csv:3: initial pose (40.000, 3.000) lies outside the map" in bad.status
     assert bad.outcome == "no-answer"
+    from tfloc.cli.report import make_report as write_report
     from tfloc.evaluation.metrics import summarize
-    from tfloc.report.report import write_report
 
     m = summarize(df).iloc[0]
     assert m.n_invalid == 1 and m.n_error == 0 and m.n_no_answer == 1
@@ -298,9 +298,9 @@ def test_every_command_reads_a_damaged_estimates_csv_alike(tmp_path, test_room, 
                   matchers=(MatcherSpec.make("toy_matchers:Stay", label="stay"),))
     est = run(c, progress=False) / "estimates.csv"
     est.write_text("\n".join(damage(est.read_text().splitlines())) + "\n")
-    from tfloc.report.export import export_tum
+    from tfloc.cli.report import make_report as write_report
+    from tfloc.harness.export import export_tum
     from tfloc.report.relations_note import write_note
-    from tfloc.report.report import write_report
 
     for command in (lambda: write_report(tmp_path / "run", with_figures=False),
                     lambda: export_tum(tmp_path / "run", tmp_path / "tum"),

@@ -24,15 +24,25 @@ from tfloc.datasets.tiling import Tiling, tile_vector_map, tiling_for_area
 from tfloc.errors import ConfigError, ResultsError
 from tfloc.evaluation.scaling import fit_loglog, level_table, slope_table
 from tfloc.harness import workspace
-from tfloc.harness.scaling import scaling_study
+from tfloc.harness.scaling import derive_scaling, scaling_study
 from tfloc.harness.scaling_config import StudyConfig
 from tfloc.harness.scaling_matchers import study_matchers
 from tfloc.io.geojson import read_vector_map
 from tfloc.io.rundir import RunDir
-from tfloc.io.timing_rows import FILES, read_rows, rows_frame, write_rows
+from tfloc.io.table import read_rows, write
+from tfloc.io.tables import PREP, SCALING, SKIPS
 from tfloc.maps.build import rasterize
 from tfloc.maps.vector import VectorMap
-from tfloc.report.scaling import render_scaling
+from tfloc.report.scaling import render
+
+FILES = {ScanRow: SCALING, PrepRow: PREP, SkipRow: SKIPS}
+
+
+def render_scaling(run_dir: Path) -> pd.DataFrame:
+    """What ``tfloc scaling`` does after the study: its tables derived, then drawn; the slopes."""
+    rows, prep, skips, levels, slopes = derive_scaling(run_dir)
+    render(run_dir, rows, prep, skips, levels, slopes, RunDir(run_dir).info())
+    return slopes
 
 OFFICE = ROOT / "data" / "maps" / "office-1.geojson"
 #: The tiny study: 2 areas × 2 kinds, the 4 lasers, the 3 offset bins; 2 scans each; 2 cheap matchers.
@@ -42,7 +52,7 @@ TINY = ["--matchers", "tf-plus,cv-corners", "--areas", "300,1200", "--scans", "2
 
 def raw(out: Path) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
     """The study's tables of scan, preparation and skip rows, read as typed rows."""
-    return tuple(rows_frame(read_rows(out / FILES[c], c), c) for c in (ScanRow, PrepRow, SkipRow))
+    return tuple(RunDir(out).frame(FILES[c]) for c in (ScanRow, PrepRow, SkipRow))
 
 
 @pytest.fixture(scope="module")
@@ -180,27 +190,26 @@ def test_the_verb_end_to_end_on_a_tiny_configuration(study, tmp_path):
     assert "`run.json`: the configuration" in readme
     # typed rows: statuses are Status, and the files are the rows written again, byte for byte
     for cls in (ScanRow, PrepRow, SkipRow):
-        typed = read_rows(out / FILES[cls], cls)
+        name = FILES[cls].name
+        typed = read_rows(out / name, FILES[cls])
         assert cls is SkipRow or all(isinstance(r.status, Status) for r in typed)
-        write_rows(tmp_path / FILES[cls], typed, cls)
-        assert (tmp_path / FILES[cls]).read_text() == (out / FILES[cls]).read_text()
+        write(tmp_path / name, FILES[cls], typed)
+        assert (tmp_path / name).read_text() == (out / name).read_text()
     # run.json: a run directory's record of the code and configuration that made it
     info = RunDir(out).info(required=True)
-    doc = info.doc
     assert info.kind == "scaling" and info.labels == ["tf-plus", "cv-corners"]
-    assert doc["config"]["scaling"]["scans_per_level"] == 2 and doc["config"]["scaling"]["matchers"] == [
-        "tf-plus", "cv-corners"]
+    assert info.study["scans_per_level"] == 2 and info.study["matchers"] == ["tf-plus", "cv-corners"]
     assert info.paths == {"office-1": OFFICE} and info.thresholds.dist_m == 0.1
-    assert set(doc["fingerprint"]["matchers"]) == {"tf-plus", "cv-corners"}
-    assert doc["fingerprint"]["scaling"] == doc["config"]["scaling"]
-    assert "commit" in doc["git"] and "dirty" in doc["git"] and doc["versions"]["numpy"]
-    assert doc["machine"]["python"] and doc["machine"]["cpu"]
-    assert info.done == doc["levels"] and len(doc["levels"]) == 4 + 4 + 3
+    assert set(info.fingerprint["matchers"]) == {"tf-plus", "cv-corners"}
+    assert info.fingerprint["scaling"] == info.study
+    assert info.git.commit is not None and info.git.dirty is not None and info.versions["numpy"]
+    assert info.machine.python and info.machine.cpu
+    assert info.done == info.levels and len(info.levels) == 4 + 4 + 3
     (session,) = info.sessions
-    assert session["started"] <= session["ended"] and len(session["cores"]) == 1 and session["cpu_s"] > 0
-    assert session["loadavg_start"] and session["loadavg_end"] and session["tasks"] == 11 * 2 * 2
-    assert doc["command"].startswith("tfloc scaling --out ")
-    assert StudyConfig.from_dict(doc["config"]["scaling"]) == StudyConfig(
+    assert session.started <= session.ended and len(session.cores) == 1 and session.cpu_s > 0
+    assert session.loadavg_start and session.loadavg_end and session.tasks == 11 * 2 * 2
+    assert info.command.startswith("tfloc scaling --out ")
+    assert StudyConfig.from_dict(dict(info.study)) == StudyConfig(
         map_path=str(OFFICE), areas_m2=(300.0, 1200.0), scans_per_level=2, scans_per_offset_bin=2,
         matchers=("tf-plus", "cv-corners"))
 
@@ -279,7 +288,7 @@ def test_regenerate_starts_another_configuration_or_an_old_directory_over(tmp_pa
         scaling_study(bigger, out, log=lambda s: None)
     scaling_study(bigger, out, regenerate=True, log=lambda s: None)
     info = RunDir(out).info()
-    assert len(raw(out)[0]) == 6 and info.config_doc["scaling"]["scans_per_offset_bin"] == 2 and len(info.sessions) == 1
+    assert len(raw(out)[0]) == 6 and info.study["scans_per_offset_bin"] == 2 and len(info.sessions) == 1
     logged: list[str] = []
     scaling_study(bigger, out, regenerate=True, log=logged.append)   # complete: runs again
     assert not any("already complete" in s for s in logged) and len(RunDir(out).info().sessions) == 1
@@ -292,7 +301,7 @@ def test_a_matcher_over_budget_is_not_run_at_larger_levels(tmp_path):
     assert set(rows["level"]) == {"1x1"}
     assert list(skips["level"]) == ["2x2", "4x4"] and skips["why"].str.contains("> 1e-06 ms at 1x1").all()
     assert list(prep.loc[prep["matcher"] == "tf-plus", "status"]) == ["ok", "skipped", "skipped"]
-    assert [r.status for r in read_rows(tmp_path / "prep.csv", PrepRow) if r.matcher == "tf-plus"][1:] == [None, None]
+    assert [r.status for r in read_rows(tmp_path / "prep.csv", PREP) if r.matcher == "tf-plus"][1:] == [None, None]
 
 
 def test_tiling_needs_a_closed_tile():

@@ -9,11 +9,11 @@ import pytest
 from _paths import SCEN
 from test_runner import make_dataset
 
+from tfloc.cli.report import make_report as write_report
 from tfloc.errors import ConfigError
 from tfloc.harness.config import load_config
 from tfloc.harness.runner import run
 from tfloc.io.estimates import read_estimates
-from tfloc.report.report import write_report
 
 
 def write(tmp_path: Path, body: str) -> Path:

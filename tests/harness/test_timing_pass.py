@@ -30,7 +30,8 @@ from tfloc.evaluation.timing import reference_of, timing_summary
 from tfloc.harness.config import MatcherSpec
 from tfloc.harness.runner import run
 from tfloc.harness.timing import run_timing, sample_scans
-from tfloc.report.timing_pass import timing_pass
+from tfloc.harness.timing_pass import timing_pass
+from tfloc.report.timing import write_timing_md
 
 ENV = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "tests"), str(ROOT)])}
 
@@ -110,7 +111,7 @@ def test_timing_cli_writes_csv_and_markdown_and_the_report_links_it(small_run):
     record = json.loads((small_run / "run.json").read_text())["timing"]
     assert record["complete"] and record["fingerprint"]["reference"] == "o3d-icp"
     assert len(record["sessions"]) == 1 and record["sessions"][0]["ended"] >= record["sessions"][0]["started"]
-    from tfloc.report.report import write_report
+    from tfloc.cli.report import make_report as write_report
 
     assert "[timing.md](timing.md)" in write_report(small_run, with_figures=False).report.read_text()
     bad = subprocess.run([sys.executable, "-m", "tfloc.cli", "timing", str(small_run), "--reference", "nope"],
@@ -130,7 +131,7 @@ def _doc(run_dir: Path) -> dict:
 
 def test_a_complete_timing_pass_is_not_timed_again(small_run, tmp_path, monkeypatch, capsys):
     run_dir = _copy(small_run, tmp_path)
-    timing_pass(run_dir, 1, 1, allow_contended=True, log=lambda s: None)
+    timing_pass(run_dir, 1, 1, allow_contended=True, draw=write_timing_md, log=lambda s: None)
     record = _doc(run_dir)["timing"]
     assert record["complete"] and record["fingerprint"]["run"] == _doc(run_dir)["fingerprint"]
     assert {k: record["fingerprint"][k] for k in ("per_stratum", "warmup", "reference")} == {
@@ -140,9 +141,9 @@ def test_a_complete_timing_pass_is_not_timed_again(small_run, tmp_path, monkeypa
     def no_timing(*args, **kwargs):
         raise AssertionError("a current timing pass was timed again")
 
-    monkeypatch.setattr("tfloc.report.timing_pass.run_timing", no_timing)
+    monkeypatch.setattr("tfloc.harness.timing_pass.run_timing", no_timing)
     logged: list[str] = []
-    assert timing_pass(run_dir, 1, 1, allow_contended=True, log=logged.append) == run_dir
+    assert timing_pass(run_dir, 1, 1, allow_contended=True, draw=write_timing_md, log=logged.append) == run_dir
     assert logged == [f"{run_dir}: already complete: timing.md is current (--regenerate times it again)"]
     assert main(["timing", str(run_dir), "--per-stratum", "1", "--warmup", "1", "--allow-contended"]) == 0
     assert "already complete: timing.md is current" in capsys.readouterr().err
@@ -151,9 +152,9 @@ def test_a_complete_timing_pass_is_not_timed_again(small_run, tmp_path, monkeypa
 
 def test_another_configuration_or_a_changed_run_is_timed_again(small_run, tmp_path):
     run_dir = _copy(small_run, tmp_path)
-    timing_pass(run_dir, 1, 1, allow_contended=True, log=lambda s: None)
+    timing_pass(run_dir, 1, 1, allow_contended=True, draw=write_timing_md, log=lambda s: None)
     logged: list[str] = []
-    timing_pass(run_dir, 2, 1, allow_contended=True, log=logged.append)
+    timing_pass(run_dir, 2, 1, allow_contended=True, draw=write_timing_md, log=logged.append)
     assert logged[0] == f"{run_dir}: timing again: per_stratum 1 → 2"
     assert len(pd.read_csv(run_dir / "timing.csv")) == 2 * 2 * 3 and "2 scan(s) per dataset" in (
         run_dir / "timing.md").read_text()
@@ -163,28 +164,28 @@ def test_another_configuration_or_a_changed_run_is_timed_again(small_run, tmp_pa
     doc["fingerprint"]["success"]["dist_m"] = 0.2
     (run_dir / "run.json").write_text(json.dumps(doc))
     logged.clear()
-    timing_pass(run_dir, 2, 1, allow_contended=True, log=logged.append)
+    timing_pass(run_dir, 2, 1, allow_contended=True, draw=write_timing_md, log=logged.append)
     assert logged[0] == f"{run_dir}: timing again: the run changed (success dist_m 0.1 → 0.2)"
     doc = _doc(run_dir)                       # a pass cut off before it finished
     doc["timing"]["complete"] = False
     (run_dir / "run.json").write_text(json.dumps(doc))
     logged.clear()
-    timing_pass(run_dir, 2, 1, allow_contended=True, log=logged.append)
+    timing_pass(run_dir, 2, 1, allow_contended=True, draw=write_timing_md, log=logged.append)
     assert logged[0] == f"{run_dir}: timing again: the last timing pass did not finish"
     logged.clear()
-    timing_pass(run_dir, 2, 1, regenerate=True, allow_contended=True, log=logged.append)
+    timing_pass(run_dir, 2, 1, regenerate=True, allow_contended=True, draw=write_timing_md, log=logged.append)
     assert logged[0] == f"{run_dir}: timing again (--regenerate)"
     assert len(_doc(run_dir)["timing"]["sessions"]) == 1
 
 
 def test_bench_keeps_a_current_timing_pass_and_regenerate_removes_it(small_run, tmp_path):
     run_dir = _copy(small_run, tmp_path)
-    timing_pass(run_dir, 1, 1, allow_contended=True, log=lambda s: None)
+    timing_pass(run_dir, 1, 1, allow_contended=True, draw=write_timing_md, log=lambda s: None)
     ds = Path(next(iter(_doc(run_dir)["datasets"].values())))
     run(_config(ds, run_dir), progress=False)      # complete: nothing runs, a session is recorded
     assert _doc(run_dir)["timing"]["complete"] and len(_doc(run_dir)["sessions"]) == 2
     logged: list[str] = []
-    timing_pass(run_dir, 1, 1, allow_contended=True, log=logged.append)
+    timing_pass(run_dir, 1, 1, allow_contended=True, draw=write_timing_md, log=logged.append)
     assert logged == [f"{run_dir}: already complete: timing.md is current (--regenerate times it again)"]
     run(_config(ds, run_dir, MatcherSpec.make("toy_matchers:Stay", label="stay")), progress=False, regenerate=True)
     assert not (run_dir / "timing.csv").exists() and not (run_dir / "timing.md").exists()
@@ -232,12 +233,12 @@ def test_a_tracking_run_is_timed_step_by_step_side_by_side(tmp_path):
     answers: one row per (step, tracker), every position taken in turn, the run's own CPU beside."""
     from test_track import _copy
 
-    from tfloc.report.timing_pass import timing_pass
+    from tfloc.harness.timing_pass import timing_pass
 
     ds = _copy(tmp_path / "q", 30)
     out = run(cfg(ds, tmp_path / "run", MatcherSpec.make("tf-plus-track"), MatcherSpec.make("odometry"),
                   jobs=1, timeout_s=60.0), progress=False)
-    timing_pass(out, per_stratum=1, warmup=0, allow_contended=True, log=lambda s: None)
+    timing_pass(out, per_stratum=1, warmup=0, allow_contended=True, draw=write_timing_md, log=lambda s: None)
     rows = pd.read_csv(out / "timing.csv")
     assert len(rows) == 30 * 2 and set(rows["matcher"]) == {"tf-plus-track", "odometry"}
     assert rows["scan_id"].nunique() == 30
@@ -297,7 +298,7 @@ def test_a_pass_beside_a_cpu_hog_is_refused_or_kept_marked_contended(small_run, 
         assert "timing again in 0 s (try 2 of 2)" in err
         assert err.strip().splitlines()[-1].startswith(f"tfloc timing: error: {run_dir}: contended on each of 2 tries (")
         assert not (run_dir / "timing.md").exists() and not _doc(run_dir)["timing"]["complete"]
-        timing_pass(run_dir, 1, 0, cores=[core], allow_contended=True, log=lambda s: None)
+        timing_pass(run_dir, 1, 0, cores=[core], allow_contended=True, draw=write_timing_md, log=lambda s: None)
     md = (run_dir / "timing.md").read_text()
     assert md.splitlines()[0].startswith("# Timing pass: t (contended (×") and "**This pass ran contended" in md
     record = _doc(run_dir)["timing"]
@@ -311,14 +312,14 @@ def test_a_pass_beside_a_cpu_hog_is_refused_or_kept_marked_contended(small_run, 
 def test_a_pass_made_before_the_probe_reads_as_not_measured(small_run, tmp_path, monkeypatch):
     """An older record (no ``contention``) is read, said not measured, never a crash: timing.md,
     the report's line, the site's mark, --verify; a contended try is not retried when quiet."""
-    from tfloc.report.report import write_report
+    from tfloc.cli.report import make_report as write_report
+    from tfloc.harness.timing_pass import timed_quietly
+    from tfloc.harness.timing_verify import verify_pass
     from tfloc.report.timing import timing_markdown
-    from tfloc.report.timing_pass import timed_quietly
-    from tfloc.report.timing_verify import verify_pass
     from tfloc.site.collect import timing_mark
 
     run_dir = _copy(small_run, tmp_path)
-    timing_pass(run_dir, 1, 1, allow_contended=True, log=lambda s: None)
+    timing_pass(run_dir, 1, 1, allow_contended=True, draw=write_timing_md, log=lambda s: None)
     doc = _doc(run_dir)
     for s in doc["timing"]["sessions"]:
         s.pop("contention")
@@ -341,7 +342,7 @@ def test_a_pass_made_before_the_probe_reads_as_not_measured(small_run, tmp_path,
 
 def test_verify_fails_where_a_committed_time_is_off_by_more_than_the_tolerance(small_run, tmp_path, capsys):
     run_dir = _copy(small_run, tmp_path)
-    timing_pass(run_dir, 1, 1, allow_contended=True, log=lambda s: None)
+    timing_pass(run_dir, 1, 1, allow_contended=True, draw=write_timing_md, log=lambda s: None)
     t = pd.read_csv(run_dir / "timing.csv")
     t.loc[t["matcher"] == "o3d-icp", "cpu_ms"] *= 1000.0
     t.to_csv(run_dir / "timing.csv", index=False)
@@ -359,8 +360,8 @@ def test_verify_compares_only_passes_made_at_the_same_machine_speed(small_run, t
     import math
 
     from tfloc.evaluation.contention import Contention
-    from tfloc.report.timing_pass import ContendedError
-    from tfloc.report.timing_verify import apart_from, machine_ratio, verify_pass
+    from tfloc.harness.timing_pass import ContendedError
+    from tfloc.harness.timing_verify import apart_from, machine_ratio, verify_pass
 
     then = Contention(4.0, 4.0, 4.4, 10, 0.0)
     assert machine_ratio(then, Contention(5.2, 5.2, 5.6, 10, 0.0)) == pytest.approx(1.3)
@@ -371,7 +372,7 @@ def test_verify_compares_only_passes_made_at_the_same_machine_speed(small_run, t
     assert "×0.75" in apart_from(then)(Contention(3.0, 3.0, 3.1, 10, 0.0))
 
     run_dir = _copy(small_run, tmp_path)
-    timing_pass(run_dir, 1, 1, allow_contended=True, log=lambda s: None)
+    timing_pass(run_dir, 1, 1, allow_contended=True, draw=write_timing_md, log=lambda s: None)
     doc = _doc(run_dir)
     doc["timing"]["sessions"][-1]["contention"]["calib_min_ms"] /= 4.0  # the pass was made on a machine 4× faster
     (run_dir / "run.json").write_text(json.dumps(doc))
@@ -384,20 +385,20 @@ def test_verify_compares_only_passes_made_at_the_same_machine_speed(small_run, t
 
 
 def test_the_cpu_models_compared_and_where_the_committed_one_is_read():
-    from tfloc.core.run import Run, TimingRecord
-    from tfloc.report.timing_verify import committed_cpu, other_cpu
+    from tfloc.core.run import Machine, RunRecord, Session, TimingRecord
+    from tfloc.harness.timing_verify import committed_cpu, other_cpu
 
     assert other_cpu("AMD EPYC", "Intel Xeon") == (
         "timed on AMD EPYC, this is Intel Xeon: absolute CPU times are not comparable; "
         "comparing the matchers' ratios to one another, measured side by side")
     assert other_cpu("AMD  EPYC", " AMD EPYC") is None and other_cpu(None, "AMD EPYC") is None
     assert other_cpu("AMD EPYC", "") is None
-    machine = {"machine": {"cpu": "AMD EPYC"}}
-    record = TimingRecord(sessions=({"cpu": "Intel Xeon"},))
-    assert committed_cpu(Run(machine, timing=record)) == ("Intel Xeon", "the timing pass's record")
-    assert committed_cpu(Run(machine, timing=TimingRecord(sessions=({},)))) == (
+    machine = Machine(cpu="AMD EPYC")
+    record = TimingRecord(sessions=(Session(cpu="Intel Xeon"),))
+    assert committed_cpu(RunRecord(machine=machine, timing=record)) == ("Intel Xeon", "the timing pass's record")
+    assert committed_cpu(RunRecord(machine=machine, timing=TimingRecord(sessions=(Session(),)))) == (
         "AMD EPYC", "the run's machine.cpu: the timing record names none")
-    assert committed_cpu(Run()) == (None, "not recorded")
+    assert committed_cpu(RunRecord()) == (None, "not recorded")
 
 
 def _retimed_as(run_dir: Path, monkeypatch, factors: dict[str, float], calls: list[int]) -> None:
@@ -405,17 +406,19 @@ def _retimed_as(run_dir: Path, monkeypatch, factors: dict[str, float], calls: li
     own probe, its calibration's best round ×4 the committed pass's (far outside ×1.25)."""
     from dataclasses import replace
 
-    from tfloc.evaluation.contention import Contention
-    from tfloc.io.timing_rows import read_rows
+    from tfloc.io.table import read_rows
+    from tfloc.io.tables import TIMING
 
-    committed = read_rows(run_dir / "timing.csv", TimingRow)
+    from tfloc.evaluation.contention import Contention
+
+    committed = read_rows(run_dir / "timing.csv", TIMING)
     quiet_far = Contention(16.0, 16.0, 16.8, 10, 0.0).to_record()
 
     def retimed(*args, **kwargs):
         calls.append(1)
         return [replace(r, cpu_ms=r.cpu_ms * factors[r.matcher]) for r in committed], {"contention": quiet_far}
 
-    monkeypatch.setattr("tfloc.report.timing_verify.run_timing", retimed)
+    monkeypatch.setattr("tfloc.harness.timing_verify.run_timing", retimed)
 
 
 def test_verify_on_another_cpu_model_compares_the_matchers_ratios_to_one_another(small_run, tmp_path,
@@ -424,20 +427,22 @@ def test_verify_on_another_cpu_model_compares_the_matchers_ratios_to_one_another
     reference are compared side by side (a uniform ×1.8 passes, one matcher twice as slow
     relative to it fails), the machine ratio is no reason to retry and nothing is called
     contended; on the same model the same re-timing is retried and refused as today."""
+    from tfloc.io.table import write
+    from tfloc.io.tables import TIMING
+
     from tfloc.evaluation.contention import Contention
     from tfloc.harness.runner import cpu_model
-    from tfloc.io.timing_rows import write_rows
-    from tfloc.report.timing_pass import ContendedError
-    from tfloc.report.timing_verify import verify_pass
+    from tfloc.harness.timing_pass import ContendedError
+    from tfloc.harness.timing_verify import verify_pass
 
     run_dir = _copy(small_run, tmp_path)
-    timing_pass(run_dir, 1, 1, allow_contended=True, log=lambda s: None)
+    timing_pass(run_dir, 1, 1, allow_contended=True, draw=write_timing_md, log=lambda s: None)
     doc = _doc(run_dir)
     assert doc["timing"]["sessions"][-1]["cpu"] == cpu_model()  # the pass records the model it ran on
     rows = pd.read_csv(run_dir / "timing.csv")
     ms = {"tf-plus": 2.0, "o3d-icp": 6.0, "stay": 0.5}
-    write_rows(run_dir / "timing.csv", [TimingRow(r.dataset, str(r.scan_id), r.group, r.matcher, r.position,
-                                                  ms[r.matcher], ms[r.matcher]) for r in rows.itertuples()], TimingRow)
+    write(run_dir / "timing.csv", TIMING, [TimingRow(r.dataset, str(r.scan_id), r.group, r.matcher, r.position,
+                                                  ms[r.matcher], ms[r.matcher]) for r in rows.itertuples()])
     doc["timing"]["sessions"][-1].update(cpu="Fake CPU 9000", contention=Contention(4.0, 4.0, 4.2, 10, 0.0).to_record())
     (run_dir / "run.json").write_text(json.dumps(doc))
     line = (f"timed on Fake CPU 9000, this is {cpu_model()}: absolute CPU times are not comparable; "

@@ -208,7 +208,7 @@ def test_estimates_through_the_reader(tmp_path_factory) -> None:
 def test_estimates_through_report(tmp_path_factory) -> None:
     """The same damage through the whole report (a few cases in make test, all in make fuzz: each
     case writes a report)."""
-    from tfloc.report.report import write_report
+    from tfloc.cli.report import make_report as write_report
 
     _estimates_cases(tmp_path_factory, "estimates.csv via tfloc report",
                      lambda d: write_report(d, with_figures=False), REPORT_SETTINGS)

@@ -1,5 +1,6 @@
-"""RunDir: a study's run.json checked like a run's, the timing pass's record kept across sessions,
-and discard removing the timing pass with the run."""
+"""RunDir: a study's run.json checked like a run's and read as one typed record, the timing
+pass's record kept across sessions, the verdict's and the derived tables' records, and discard
+removing the timing pass with the run."""
 
 from __future__ import annotations
 
@@ -20,9 +21,11 @@ SCALING = {**BENCH, "config": {**BENCH["config"], "kind": "scaling", "scaling": 
 
 def test_a_scaling_studys_run_json_is_a_run_json(tmp_path):
     rd = RunDir(tmp_path)
-    rd.write(SCALING)
+    rd.write_doc(SCALING)
     info = rd.info(required=True)
-    assert info.kind == "scaling" and info.done == [] and list(info.paths) == ["office-1"] and info.config is None
+    assert info.kind == "scaling" and info.done == () and list(info.paths) == ["office-1"] and info.config is None
+    assert info.study == {"scans_per_level": 2} and info.command == "tfloc scaling" and info.exists
+    assert info.sessions[0].cores == (1,) and info.sessions[0].loadavg_start == (0.5, 0.5, 0.5)
     assert RunDir(tmp_path / "none").info().kind == "bench"
     for bad in ({**SCALING, "done": "all"}, {**SCALING, "levels": [1]}, {**SCALING, "timing": []},
                 {**SCALING, "timing": {"sessions": [{"loadavg_start": "high"}]}},
@@ -40,7 +43,7 @@ def test_the_timing_record_survives_a_new_session_and_goes_with_discard(tmp_path
     assert rd.info().timing.complete is False
     rd.close_timing([0.2, 0.2, 0.2], cores=[1])
     record = rd.info().timing
-    assert record.complete and record.fingerprint == fp and record.last_session["cores"] == [1]
+    assert record.complete and record.fingerprint == fp and record.last_session.cores == (1,)
     rd.start_session(BENCH, 4, 4, None)          # tfloc bench again on the complete run
     info = rd.info()
     assert info.timing == record and len(info.sessions) == 2
@@ -55,10 +58,26 @@ def test_the_timing_record_survives_a_new_session_and_goes_with_discard(tmp_path
     assert rd.info().timing is None
 
 
-def test_update_records_progress_in_the_last_session(tmp_path):
+def test_levels_record_progress_in_the_last_session(tmp_path):
     rd = RunDir(tmp_path)
     rd.start_session(SCALING, 10, 0, None, cores=[1])
-    rd.update({"done": ["area/vector/1x1"]}, cpu_s=1.5)
+    rd.record_levels(["area/vector/1x1"], cpu_s=1.5)
     doc = json.loads(rd.run_json.read_text())
     assert doc["done"] == ["area/vector/1x1"] and doc["sessions"][-1]["cpu_s"] == 1.5
     assert doc["sessions"][-1]["cores"] == [1] and len(doc["sessions"]) == 1  # the previous run.json's, none
+
+
+def test_the_verdict_and_the_derived_tables_record_what_they_were_made_from(tmp_path):
+    from tfloc.core.run import DerivedRecord, VerdictRecord
+
+    rd = RunDir(tmp_path)
+    rd.start_session(BENCH, 4, 0, None)
+    rd.record_verdict(VerdictRecord({"fit_tol_m": 0.05}, True, "abc", "code1"))
+    rd.record_derived("tables", DerivedRecord("code2", "abc", None))
+    rd.record_derived("report", DerivedRecord("code3", "abc"))
+    info = rd.info()
+    assert info.verdict == VerdictRecord({"fit_tol_m": 0.05}, True, "abc", "code1")
+    assert info.derived == {"tables": DerivedRecord("code2", "abc", None), "report": DerivedRecord("code3", "abc")}
+    assert rd.rows_sha256() is None
+    (tmp_path / "estimates.csv").write_text("x\n")
+    assert len(rd.rows_sha256()) == 64

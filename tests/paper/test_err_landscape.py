@@ -40,9 +40,9 @@ def test_local_minima_on_a_hand_made_grid():
 
 def test_report_draws_tf_objective_around_the_truth(tmp_path):
     """A run with tf gets the landscape section: a figure and one row per drawn scan."""
+    from tfloc.cli.report import make_report as write_report
     from tfloc.harness.config import MatcherSpec, RunConfig
     from tfloc.harness.runner import run
-    from tfloc.report.report import write_report
 
     root = __import__("pathlib").Path(__file__).resolve().parents[2]
     cfg = RunConfig("t", tmp_path / "run", (root / "data" / "scenarios" / "office-pool",),

@@ -13,7 +13,8 @@ from _tf_cases import TRUE, noisy_scan
 from _tf_oracles import step_by_step_tf
 
 from tfloc.core.pose import Pose
-from tfloc.harness.task import load_dataset, problem_of
+from tfloc.harness.workspace import problem_of
+from tfloc.io.scenario import load_dataset
 
 
 def _office_problems(count: int):

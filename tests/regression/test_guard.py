@@ -12,21 +12,24 @@ import os
 import pytest
 from _paths import ROOT
 
+from tfloc.cli import guard as verb
 from tfloc.cli.guard import run_subset
 from tfloc.evaluation import guard
 from tfloc.harness.config import load_config
+from tfloc.io.table import read_frame
+from tfloc.io.tables import GUARD, GUARD_TRACKING
 
 
 @pytest.fixture(scope="module")
 def config(tmp_path_factory):
     os.chdir(ROOT)  # the run configuration's paths are relative to the project root
-    cfg = load_config(ROOT / guard.CONFIG)
+    cfg = load_config(ROOT / verb.CONFIG)
     return cfg.with_overrides(out=tmp_path_factory.mktemp("guard") / "run")
 
 
 @pytest.fixture(scope="module")
 def reference():
-    return guard.read_reference(ROOT / guard.REFERENCE)
+    return read_frame(ROOT / verb.REFERENCE, GUARD)
 
 
 def test_reference_covers_every_guarded_matcher(config, reference):
@@ -45,9 +48,9 @@ def test_no_accuracy_regression(config, reference):
 def test_no_tracking_regression(tmp_path_factory):
     """The tracking guard: seq-quick's tracked share, APE RMSE and unrecovered losses per matcher."""
     os.chdir(ROOT)
-    cfg = load_config(ROOT / guard.TRACKING_CONFIG)
+    cfg = load_config(ROOT / verb.TRACKING_CONFIG)
     cfg = cfg.with_overrides(out=tmp_path_factory.mktemp("guard-tracking") / "run")
-    reference = guard.read_reference(ROOT / guard.TRACKING_REFERENCE)
+    reference = read_frame(ROOT / verb.TRACKING_REFERENCE, GUARD_TRACKING)
     assert {m.label for m in cfg.matchers} <= set(reference.matcher)
     current = run_subset(cfg, progress=False, summarise=guard.tracking_summary)
     diff = guard.compare(current, reference, guard.TRACK_RULES)

@@ -8,19 +8,22 @@ import numpy as np
 import pandas as pd
 from _paths import ROOT
 
+from tfloc.cli import guard as verb
 from tfloc.cli.guard import run_subset
 from tfloc.evaluation import guard
 from tfloc.harness.config import MatcherSpec, load_config
+from tfloc.io.table import read_frame
+from tfloc.io.tables import GUARD
 
 
 def test_degraded_tf_is_caught(tmp_path):
     os.chdir(ROOT)
     # a straw threshold of 0 finds no corner candidates: only the scan's end points remain
     broken = MatcherSpec.make("tf", {"straw_t": 0.0}, label="tf")
-    cfg = load_config(ROOT / guard.CONFIG).with_overrides(
+    cfg = load_config(ROOT / verb.CONFIG).with_overrides(
         out=tmp_path / "run", matchers=(broken,), limit_per_group=3)
     current = run_subset(cfg, progress=False)
-    diff = guard.compare(current, guard.read_reference(ROOT / guard.REFERENCE))
+    diff = guard.compare(current, read_frame(ROOT / verb.REFERENCE, GUARD))
     worse = diff[diff.worse]
     assert len(worse), "the guard did not notice a tf that finds no corners"
     assert set(worse.matcher) == {"tf"}

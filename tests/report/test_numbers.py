@@ -11,6 +11,7 @@ import pytest
 
 from tests._estimates import frame, row, synthetic_run
 from tests.harness.test_runner import cfg, make_dataset
+from tfloc.cli.report import make_report as write_report
 from tfloc.core.thresholds import Thresholds
 from tfloc.evaluation.metrics import prepare
 from tfloc.evaluation.paired import paired_comparisons
@@ -18,7 +19,6 @@ from tfloc.evaluation.stats import mcnemar_exact, wilson
 from tfloc.harness.config import MatcherSpec
 from tfloc.harness.runner import run
 from tfloc.io.estimates import read_estimates
-from tfloc.report.report import write_report
 
 
 @pytest.fixture(scope="module")

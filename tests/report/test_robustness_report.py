@@ -7,15 +7,16 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from tfloc.report.robustness import (
-    Axis,
-    axes_of,
-    paired_changes,
-    robustness_cells,
-    robustness_figure,
-    robustness_markdown,
-    robustness_table,
-)
+from tfloc.core.rows.robustness import RobustnessRow
+from tfloc.evaluation.robustness import Axis, axes_of, paired_changes
+from tfloc.evaluation.robustness import robustness_cells as cell_rows
+from tfloc.io.table import frame_of
+from tfloc.report.robustness import robustness_figure, robustness_markdown, robustness_table
+
+
+def robustness_cells(p: pd.DataFrame, axes: dict) -> pd.DataFrame:
+    """The cells as ``robustness.csv`` holds them (typed rows as a table)."""
+    return frame_of(cell_rows(p, axes), RobustnessRow)
 
 
 def _prepared() -> pd.DataFrame:

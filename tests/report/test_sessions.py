@@ -1,10 +1,9 @@
-"""A report counts the sessions of the run its rows come from, not an older record's."""
+from tfloc.core.run import Session
+from tfloc.report.provenance import this_run
 
-from tfloc.report.sessions import this_run
 
-
-def test_sessions_from_the_last_start_from_nothing():
-    old, fresh, resumed = {"already_done": 0, "started": "a"}, {"already_done": 0, "started": "b"}, {"already_done": 5}
-    assert this_run([old, fresh, resumed]) == [fresh, resumed]
-    assert this_run([old]) == [old] and this_run([]) == []
-    assert this_run([{"started": "x"}, resumed]) == [{"started": "x"}, resumed]  # no count recorded: a start
+def test_a_report_counts_the_sessions_of_the_run_its_rows_come_from() -> None:
+    old, fresh, resumed = Session("a", already_done=0), Session("b", already_done=0), Session("c", already_done=5)
+    assert this_run((old, fresh, resumed)) == (fresh, resumed)
+    assert this_run((old,)) == (old,) and this_run(()) == ()
+    assert this_run((Session("x"), resumed)) == (Session("x"), resumed)  # no count: started fresh

@@ -5,13 +5,17 @@ from __future__ import annotations
 
 import dataclasses
 
+from _estimates import derive_tracking
 from _paths import ROOT, SCEN
 
+from tfloc.core.rows.tracking import TrackingRow
+from tfloc.evaluation.sequences import sequence_scores
 from tfloc.harness.track import dead_reckoning
 from tfloc.io.estimates import result_row, rows_frame
 from tfloc.io.maps import load_map
 from tfloc.io.scenario import read_scans, read_scenario
-from tfloc.report.tracking import _own_odometry_rules, sequence_scores, tracking_section
+from tfloc.io.table import frame_of
+from tfloc.report.tracking import _cpu_ms, _own_odometry_rules, tracking_section
 
 
 def _rows(name: str, n: int, lost_from: int | None = None) -> list:
@@ -29,9 +33,10 @@ def test_tables_and_figures(tmp_path):
     df = rows_frame(_rows("seq-rate-1hz-a", 40) + _rows("seq-rate-1hz-b", 40, lost_from=30) + _rows("seq-quick", 30))
     names = df["dataset"].unique()
     ds = {n: read_scenario(ROOT / "data" / "scenarios" / n) for n in names}
-    s = sequence_scores(df, ds)
+    s = frame_of(sequence_scores(df, {n: sc.extra for n, sc in ds.items()}), TrackingRow)
     assert set(s["condition"]) == {"rate-1hz", "quick"}
-    text = tracking_section(df, ds, {n: load_map(ds[n].map_path) for n in names}, tmp_path)
+    rd = derive_tracking(tmp_path, df, ds)
+    text = tracking_section(rd, df, ds, {n: load_map(ds[n].map_path) for n in names})
     assert "**rate-1hz** (2 sequences" in text and "**quick** (1 sequence" in text
     line = next(x for x in text.splitlines() if x.startswith("| perfect") and "[" in x)
     # pooled over the two sequences: 70 of 80 scans tracked, with a bootstrap interval
@@ -44,7 +49,7 @@ def test_tables_and_figures(tmp_path):
 
 def test_a_sequence_with_relations_gets_the_relation_errors_and_a_set_of_buildings_per_log_tables():
     from tfloc.io.scenario import read_scans, read_scenario
-    from tfloc.report.tracking import relations_tables, sequence_scores, tracking_tables
+    from tfloc.report.tracking import relations_tables, tracking_tables
 
     root = SCEN
     rows, datasets = [], {}
@@ -59,8 +64,8 @@ def test_a_sequence_with_relations_gets_the_relation_errors_and_a_set_of_buildin
     text = relations_tables(df, datasets)
     assert "real-csail-native: relation errors" in text and "Cartographer (Hess et al. 2016" in text
     assert "real-aces-native: relation" not in text                      # no relations file named
-    s = sequence_scores(df, datasets)
-    t = tracking_tables(s, datasets)
+    s = frame_of(sequence_scores(df, {n: sc.extra for n, sc in datasets.items()}), TrackingRow)
+    t = tracking_tables(s, _cpu_ms(df), datasets)
     assert "**real-native: real-csail-native**" in t and "**real-native**" in t   # two buildings: per log too
 
 

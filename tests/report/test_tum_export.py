@@ -16,9 +16,9 @@ from tfloc.cli import main
 from tfloc.core.laser import LaserSpec
 from tfloc.core.pose import Pose, angdiff
 from tfloc.errors import DatasetError, LogFormatError, ResultsError
+from tfloc.harness.export import export_tum
 from tfloc.io.scenario import Scan, read_scans, read_scenario, write_scenario
 from tfloc.io.tum import read_tum, write_tum
-from tfloc.report.export import export_tum
 
 file_interface = pytest.importorskip("evo.tools.file_interface")
 COLS = ["dataset", "scan_id", "group", "matcher", "true_x", "true_y", "true_theta", "init_x", "init_y",

@@ -69,17 +69,17 @@ def test_a_dataset_the_run_did_not_record_is_looked_for_under_the_checkout(tmp_p
 
 def test_a_malformed_run_json_reads_as_an_empty_record(tmp_path: Path) -> None:
     (tmp_path / "run.json").write_text("{not json")
-    assert run_info(tmp_path).doc == {}
+    assert not run_info(tmp_path).exists and run_info(tmp_path).datasets == ()
     (tmp_path / "run.json").write_text(json.dumps({"datasets": {"a": 3}}))
-    assert run_info(tmp_path).doc == {}
+    assert not run_info(tmp_path).exists
     shutil.rmtree(tmp_path)
-    assert run_info(tmp_path).doc == {}
+    assert not run_info(tmp_path).exists
 
 
 def test_the_advice_reads_the_kind_the_run_records(tmp_path: Path) -> None:
     """A run of a simulated dataset named real-…: its rows carry the kind, and the real-robot
     advice does not read it (the same run with the dataset recorded as real does)."""
-    from _site_results import TRACKING_CSV
+    from _site_results import TRACKING_CSV, _native_headline
 
     from tfloc.site.advice import first_run_columns
     from tfloc.site.board import headline_board
@@ -91,6 +91,7 @@ def test_the_advice_reads_the_kind_the_run_records(tmp_path: Path) -> None:
         root = tmp_path / kind
         (root / "run").mkdir(parents=True)
         (root / "run" / "tracking.csv").write_text(TRACKING_CSV)
+        _native_headline(root / "run")
         sets = {n: str(_copy(src, tmp_path / kind / "sets" / n)) for n in ("real-a-native", "real-b-native")}
         (root / "run" / "run.json").write_text(json.dumps({"datasets": sets}))
         rr = run_rows(root, "run")

@@ -94,7 +94,7 @@ def test_the_site_in_a_browser(site, tmp_path: Path) -> None:
                 assert c["best"] == (r.rank == 1 and r.verdict == "ahead"), (bid, c, r)
         assert seen == set(expected)
         assert any(c["best"] for c in boards["board-single-scan"]), "the fixture's best is marked"
-        assert not any(c["best"] for c in boards["board-tracking"]), "provisional rows are never marked"
+        assert not any(c["best"] for c in boards["board-tracking"]), "rows without a paired test are never marked"
         # a click on a header sorts its table: best first, then the other way
         b.click(b.find("#board-single-scan thead th:nth-child(3) button"))
         col = [float(v) for v in b.execute(COLUMN, "board-single-scan", 2) if v not in ("", "—")]

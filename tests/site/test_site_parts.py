@@ -1,11 +1,10 @@
-"""The site's pure parts on hand-made rows: the page → run mapping, provisional rows from a run's
-older tables, the best mark only where the paired test says *ahead*, statements that say "not
+"""The site's pure parts on hand-made rows: the page → run mapping, a run's rows only from its
+``headline.csv`` (a run with other tables alone has no headline yet), the best mark only where the paired test says *ahead*, statements that say "not
 yet" when the data cannot answer, generated blocks replaced between their markers, and a run
 page whose links go only where something is."""
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import pytest
@@ -52,16 +51,14 @@ def test_a_bad_pages_file_is_one_line(tmp_path: Path) -> None:
         load_pages(f)
 
 
-def test_provisional_rows_from_tracking_csv(tmp_path: Path) -> None:
+def test_a_run_without_a_headline_has_no_rows_yet(tmp_path: Path) -> None:
+    """The headline is computed once (``tfloc report``): a run whose other tables are there but
+    whose ``headline.csv`` is not shows none, never rows remade from those tables."""
     (tmp_path / "run").mkdir()
     (tmp_path / "run" / "tracking.csv").write_text(TRACKING_CSV)
     rr = run_rows(tmp_path, "run")
-    assert rr.provisional and rr.source == "tracking.csv"
-    a = {(r.scope, r.matcher): r for r in rr.rows}
-    r = a[("real-a-native", "tf-plus-track")]
-    assert r.rank == 1 and r.value_pct == pytest.approx(98.0) and r.lo_pct < 98 < r.hi_pct and r.verdict == ""
-    pooled = a[("all", "tf-plus-track")]
-    assert pooled.value_pct == pytest.approx(100 * 89 / 90) and math.isnan(pooled.cpu_ms)
+    assert rr.exists and not rr.reported and rr.rows == []
+    assert run_note(rr, "run").startswith("`results/run/`: no headline yet")
     assert not run_rows(tmp_path, "missing").exists
 
 

@@ -12,7 +12,8 @@ from _tfplus_oracles import step_by_step_tfplus
 from shapely.geometry import box
 
 from tfloc import Pose, Problem, VectorMap
-from tfloc.harness.task import load_dataset, problem_of
+from tfloc.harness.workspace import problem_of
+from tfloc.io.scenario import load_dataset
 from tfloc.maps.build import rasterize
 from tfloc.tfplus import pipeline
 from tfloc.tfplus.matcher import TurningFunctionPlusMatcher

@@ -17,7 +17,8 @@ from tfloc import Pose, VectorMap
 from tfloc.core.laser import LaserSpec
 from tfloc.core.presets import resolve
 from tfloc.harness.config import load_config
-from tfloc.harness.task import load_dataset, problem_of
+from tfloc.harness.workspace import problem_of
+from tfloc.io.scenario import load_dataset
 from tfloc.maps.build import rasterize
 from tfloc.tfplus.config import CHANGED_WORLD, TfPlusConfig, coarse_view
 from tfloc.tfplus.cost import (

@@ -13,8 +13,8 @@ import tfloc
 from tfloc.core.pose import Pose
 from tfloc.core.problem import Estimate, Problem
 from tfloc.harness.track import odom_deltas, track
-from tfloc.harness.workspace import load_dataset, map_of
-from tfloc.io.scenario import map_for, read_scans, read_scenario
+from tfloc.harness.workspace import map_of
+from tfloc.io.scenario import load_dataset, map_for, read_scans, read_scenario
 from tfloc.tfplus import pipeline
 from tfloc.tfplus.matcher import TurningFunctionPlusMatcher
 from tfloc.tfplus.tracker import TfPlusTracker, window_config

@@ -41,10 +41,12 @@ def test_a_malformed_lock_line_is_named(tmp_path) -> None:
 
 def test_the_report_says_when_a_run_used_other_versions() -> None:
     lock = read_lock(ROOT / LOCK_NAME, "3.11.7")
-    same = {"versions": {"numpy": lock["numpy"], "tfloc": "0.1.0"}, "machine": {"python": "3.11.7"}}
+    from tfloc.core.run import Machine, RunRecord
+
+    same = RunRecord(versions={"numpy": lock["numpy"], "tfloc": "0.1.0"}, machine=Machine(python="3.11.7"))
     assert lock_note(same) == [f"- Versions: those of `{LOCK_NAME}`"]
-    other = {"versions": {"numpy": "1.26.0", "numba": lock["numba"]}, "machine": {"python": "3.11.7"}}
+    other = RunRecord(versions={"numpy": "1.26.0", "numba": lock["numba"]}, machine=Machine(python="3.11.7"))
     (line,) = lock_note(other)
     assert "other than" in line and f"numpy 1.26.0 (lock {lock['numpy']})" in line and "numba" not in line
     assert lock_differences({"karto-scanmatcher": None}, lock) == {"karto-scanmatcher": (None, "1.0.0")}
-    assert lock_note({}) == []
+    assert lock_note(RunRecord()) == []

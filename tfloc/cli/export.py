@@ -24,7 +24,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from tfloc.report.export import export_tum
+    from tfloc.harness.export import export_tum
 
     run_dir = args.run
     if not (run_dir / "estimates.csv").is_file() and (Path("results") / run_dir / "estimates.csv").is_file():

@@ -26,11 +26,13 @@ if TYPE_CHECKING:
     from tfloc.harness.config import RunConfig
 
 HELP = "accuracy regression guard: rerun a fixed subset and compare with the reference"
+CONFIG = Path("benchmarks/regression.toml")
+REFERENCE = Path("results/reference/summary.csv")
+TRACKING_CONFIG = Path("benchmarks/regression-tracking.toml")
+TRACKING_REFERENCE = Path("results/reference/tracking.csv")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    from tfloc.evaluation.guard import CONFIG, REFERENCE, TRACKING_CONFIG, TRACKING_REFERENCE
-
     p.add_argument("--config", type=Path, default=CONFIG, help=f"subset run configuration ({CONFIG})")
     p.add_argument("--reference", type=Path, default=REFERENCE, help=f"reference metrics ({REFERENCE})")
     p.add_argument("--tracking-config", type=Path, default=TRACKING_CONFIG,
@@ -47,26 +49,29 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from tfloc.evaluation import guard
+    from tfloc.io.tables import GUARD, GUARD_TRACKING
 
-    parts = [(args.config, args.reference, guard.guard_summary, guard.RULES)]
+    parts = [(args.config, args.reference, guard.guard_summary, guard.RULES, GUARD)]
     if not args.no_tracking and args.tracking_config.exists():
-        parts.append((args.tracking_config, args.tracking_reference, guard.tracking_summary, guard.TRACK_RULES))
+        parts.append((args.tracking_config, args.tracking_reference, guard.tracking_summary, guard.TRACK_RULES,
+                      GUARD_TRACKING))
     worse = 0
-    for config, reference, summarise, rules in parts:
-        status = _one(args, config, reference, summarise, rules)
+    for config, reference, summarise, rules, table in parts:
+        status = _one(args, config, reference, summarise, rules, table)
         if status is None:
             continue
         worse += status
     return 1 if worse else 0
 
 
-def _one(args: argparse.Namespace, config: Path, reference: Path, summarise, rules) -> int | None:
-    """One guard (a subset and its reference): None after ``--update``, else the number of
-    metrics worse than the reference allows."""
+def _one(args: argparse.Namespace, config: Path, reference: Path, summarise, rules, table) -> int | None:
+    """One guard (a subset and its reference, a file of ``table``): None after ``--update``,
+    else the number of metrics worse than the reference allows."""
     import pandas as pd
 
     from tfloc.evaluation import guard
     from tfloc.harness.config import load_config, parse_matchers
+    from tfloc.io.table import read_frame, write
 
     cfg = load_config(config)
     if args.matchers:
@@ -74,18 +79,18 @@ def _one(args: argparse.Namespace, config: Path, reference: Path, summarise, rul
     cfg = cfg.with_overrides(jobs=args.jobs)
     current = run_subset(cfg, fresh=not args.resume, summarise=summarise)
     if args.update:
-        old = guard.read_reference(reference) if reference.exists() else current.iloc[:0]
+        old = read_frame(reference, table)
         if args.matchers and reference.exists():  # keep the other matchers' reference rows
             keep = old[~old.matcher.isin(current.matcher.unique())]
             current = pd.concat([keep, current]).sort_values(list(guard.KEY), ignore_index=True)
-        guard.write_reference(current, reference)
+        write(reference, table, current)
         record = reference.with_suffix(".run.json")  # the code and configuration that made it
         shutil.copyfile(Path(cfg.out) / "run.json", record)
         print(f"updated {reference} (made as {record} records):\n{guard.format_changes(old, current)}")
         return None
     if not reference.exists():
         raise ConfigError(f"{reference}: no reference yet; create it with 'tfloc guard --update'")
-    diff = guard.compare(current, guard.read_reference(reference), rules)
+    diff = guard.compare(current, read_frame(reference, table), rules)
     print(guard.format_table(diff, only_worse=not args.all))
     n = int(diff.worse.sum())
     if n:

@@ -28,27 +28,14 @@ def run(args: argparse.Namespace) -> int:
 
 
 def robustness(run: Path, figures: bool = True) -> int:
-    """The robustness section of the run directory ``run`` (the study step ``robustness`` calls it)."""
-    from tfloc.evaluation.metrics import prepare
-    from tfloc.io.rundir import RunDir
-    from tfloc.io.scenario import read_scenario
-    from tfloc.report.robustness import (
-        axes_of,
-        paired_changes,
-        robustness_cells,
-        robustness_figure,
-        robustness_markdown,
-    )
+    """The robustness section of the run directory ``run`` (the study step ``robustness`` calls
+    it): its tables derived (:func:`tfloc.harness.derive.derive_robustness`), then drawn."""
+    from tfloc.harness.derive import derive_robustness
+    from tfloc.report.robustness import robustness_figure, robustness_markdown
 
-    rd = RunDir(run)
-    info = rd.info(required=True)
-    scenarios = [read_scenario(d) for d in info.paths.values()]
-    axes = axes_of((s.name, s.extra) for s in scenarios)
-    prepared = prepare(rd.results(), info.thresholds)
-    cells, changes = robustness_cells(prepared, axes), paired_changes(prepared, axes)
+    cells, changes = derive_robustness(run)
     fig = robustness_figure(cells, run / "figures" / "robustness.png") if figures else None
     out = run / "robustness.md"
     out.write_text(robustness_markdown(cells, changes, fig.relative_to(run).as_posix() if fig else None))
-    cells.to_csv(run / "robustness.csv", index=False, float_format="%.4g")
     print(f"robustness: {out}", file=sys.stderr)
     return 0

@@ -115,8 +115,8 @@ def run_config(table: dict, quick: bool, out: Path, regenerate: bool = False, pr
     (``tfloc scaling`` and a study file of kind scaling alike)."""
     from tqdm import tqdm
 
-    from tfloc.harness.scaling import StudyConfig, scaling_study
-    from tfloc.report.scaling import render_scaling
+    from tfloc.harness.scaling import StudyConfig, derive_scaling, scaling_study
+    from tfloc.report.scaling import render
 
     cfg = StudyConfig.from_dict(table, StudyConfig.quick() if quick else StudyConfig())
     bar = tqdm(unit="scan", desc="scaling", disable=None if progress is None else not progress,
@@ -131,7 +131,8 @@ def run_config(table: dict, quick: bool, out: Path, regenerate: bool = False, pr
                            log=lambda s: tqdm.write(s, file=sys.stderr), command=command)
     finally:
         bar.close()
-    slopes = render_scaling(rd.path)
+    rows, prep, skips, levels, slopes = derive_scaling(rd.path)
+    render(rd.path, rows, prep, skips, levels, slopes, rd.info())
     if len(slopes):
         print(slopes[["axis", "kind", "matcher", "slope", "first_ms", "last_ms"]].to_string(
             index=False, float_format=lambda v: f"{v:.2f}"), file=sys.stderr)

@@ -60,9 +60,9 @@ def run(args: argparse.Namespace) -> int:
     data = build_site(args.results, out, quick=args.only_quick)
     shown = sum(1 for r in data.runs.values() if r.rows)
     missing = [n for n, r in data.runs.items() if not r.exists]
-    provisional = [n for n, r in data.runs.items() if r.provisional]
+    unreported = [n for n, r in data.runs.items() if r.exists and not r.reported]
     print(f"site: {out / 'index.html'} ({shown} runs{'; not yet run: ' + ', '.join(missing) if missing else ''}"
-          f"{'; provisional (no headline.csv): ' + ', '.join(provisional) if provisional else ''})",
+          f"{'; no headline.csv yet (tfloc report RUN): ' + ', '.join(unreported) if unreported else ''})",
           file=sys.stderr)
     if args.readme:
         changed = refresh_markdown(markdown_files(Path.cwd()), data)

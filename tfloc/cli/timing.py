@@ -83,8 +83,9 @@ def time_run(run: Path, per_stratum: int | None = None, warmup: int | None = Non
     from tqdm import tqdm
 
     from tfloc.errors import ConfigError
-    from tfloc.report.timing_pass import RETRIES, WAIT_S, timing_pass
-    from tfloc.report.timing_verify import verify_pass
+    from tfloc.harness.timing_pass import RETRIES, WAIT_S, timing_pass
+    from tfloc.harness.timing_verify import verify_pass
+    from tfloc.report.timing import write_timing_md
 
     bars: list[tqdm] = []  # made at the first scan timed (none when the pass is current)
 
@@ -102,7 +103,7 @@ def time_run(run: Path, per_stratum: int | None = None, warmup: int | None = Non
             return 0 if verify_pass(run, per_stratum, cores, log=print, allow_contended=allow_contended,
                                     retries=retries, wait_s=wait_s, progress=progress) else 1
         timing_pass(run, per_stratum, warmup, reference, regenerate, progress, seed=seed, cores=cores,
-                    log=lambda s: tqdm.write(s, file=sys.stderr), allow_contended=allow_contended,
+                    log=lambda s: tqdm.write(s, file=sys.stderr), allow_contended=allow_contended, draw=write_timing_md,
                     retries=retries, wait_s=wait_s)
     finally:
         for bar in bars:

@@ -17,7 +17,7 @@ truth (within 10 cm and 2 deg), APE, losses, jumps > 1 m and the median CPU per 
 the robot, the truth (if known), the prediction, the estimate and the tracker's belief if it
 exposes one (AMCL's particles, coloured by weight); --explain prints the step's info and the
 belief's weights (effective sample size, the sensor factor at the truth, the estimate and half a
-metre off, the spread the motion model added). Drawing and summary: tfloc/report/belief.py.
+metre off, the spread the motion model added). The snapshot: tfloc/harness/belief.py; its summary: tfloc/evaluation/belief.py; the drawing: tfloc/report/belief.py.
 
 Example:
   tfloc track --dataset data/scenarios/seq-quick --matcher tf-plus --out est.csv
@@ -60,10 +60,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from tfloc.core.tracker import as_tracker
+    from tfloc.harness.belief import Watch
     from tfloc.harness.threads import limit_threads
     from tfloc.harness.track import check_sequence, track
     from tfloc.io.scenario import read_scans, read_scenario
-    from tfloc.report.belief import Watch
 
     from ._matcher import matcher_from_args
 
@@ -123,8 +123,8 @@ def check_draw_options(args: argparse.Namespace) -> None:
 
 
 def draw_target(draw_at: str | None, scans: list, where: Path) -> int | str | None:
-    """The scan index ``--draw-at`` names, :data:`~tfloc.report.belief.FIRST_LOSS`, or ``None``."""
-    from tfloc.report.belief import FIRST_LOSS
+    """The scan index ``--draw-at`` names, :data:`~tfloc.harness.belief.FIRST_LOSS`, or ``None``."""
+    from tfloc.harness.belief import FIRST_LOSS
 
     if draw_at is None:
         return None

@@ -35,7 +35,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from tfloc.report.verdict_sweep import parse_sweep, sweep
+    from tfloc.harness.verdict_sweep import parse_sweep, sweep
 
     if args.sweep:
         configs = parse_sweep(args.sweep)
@@ -48,7 +48,7 @@ def run(args: argparse.Namespace) -> int:
 def judge(run: Path, restarts: bool = True) -> int:
     """The verdict of the run directory ``run``, written, with one line per recording against
     the truth (the study step ``verdict`` calls it)."""
-    from tfloc.report.verdict import write_verdict
+    from tfloc.harness.verdict import write_verdict
 
     v = write_verdict(run, restarts=restarts)
     print(f"verdict: {run / 'verdict.csv'} ({len(v.rows)} rows)")

@@ -22,7 +22,6 @@ elsewhere); they are far below any change worth making to a matcher.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -31,10 +30,6 @@ from tfloc.core.thresholds import Thresholds
 
 from .metrics import prepare, summarize
 
-CONFIG = Path("benchmarks/regression.toml")
-REFERENCE = Path("results/reference/summary.csv")
-TRACKING_CONFIG = Path("benchmarks/regression-tracking.toml")
-TRACKING_REFERENCE = Path("results/reference/tracking.csv")
 KEY = ("matcher", "group")
 
 
@@ -138,12 +133,3 @@ def format_changes(old: pd.DataFrame, new: pd.DataFrame) -> str:
             if not (np.isclose(a, b, equal_nan=True)):
                 lines.append(f"{r.matcher:12s} {r.group:6s} {k:18s} {a:10.3f} -> {b:10.3f}")
     return "\n".join(lines) if lines else "no change"
-
-
-def read_reference(path: Path = REFERENCE) -> pd.DataFrame:
-    return pd.read_csv(path, dtype={"matcher": str, "group": str})
-
-
-def write_reference(summary: pd.DataFrame, path: Path = REFERENCE) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    summary.to_csv(path, index=False, float_format="%.6g")

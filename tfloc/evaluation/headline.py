@@ -17,19 +17,20 @@ truthfree`, its per-scan beliefs taking the place of the truth in the interval a
 test; no error). Every tracking row also carries ``truth_free_score`` (the verdict on that scope,
 made with the truth hidden: where there is truth, to compare) and ``self_auc`` (the tracker's own
 confidence as a lost-detector, :mod:`tfloc.evaluation.selfassess`); NaN where not computed.
-:func:`headline_frame` is what ``report.md``, ``headline.csv``, the site and the README read.
+Its rows (:class:`~tfloc.core.rows.headline.HeadlineRow`) are computed once, by the derive step
+(:mod:`tfloc.harness.derive`), into ``headline.csv``: what ``report.md``, the site and the README read.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, fields
 
 import numpy as np
 import pandas as pd
 
-from tfloc.core.modes import MODES, mode_of
+from tfloc.core.modes import MODES, SEQUENCE, SINGLE, mode_of
 from tfloc.core.modes import TRUTH_FREE as FREE_MODE
+from tfloc.core.rows.headline import POOLED, HeadlineRow
 from tfloc.core.thresholds import Thresholds
 
 from .metrics import tracked
@@ -39,40 +40,11 @@ from .trajectory import pooled_share
 
 #: the measure of a sequence dataset without truth
 TRUTH_FREE = FREE_MODE.key
-POOLED = "all"
-
-
-@dataclass(frozen=True)
-class HeadlineRow:
-    """One matcher's line of a headline table (percentages in %, errors in cm, CPU in ms)."""
-
-    mode: str
-    scope: str
-    rank: int
-    matcher: str
-    measure: str
-    value_pct: float
-    lo_pct: float
-    hi_pct: float
-    n: int
-    error_cm: float
-    error: str
-    cpu_ms: float
-    verdict: str
-    next_matcher: str
-    p_holm: float
-    truth_free_score: float = math.nan
-    self_auc: float = math.nan
-
 
 #: per (scope, matcher): a figure a headline row carries beside its measure
 Extras = dict[tuple[str, str], float]
 #: per (scope, matcher): the truth-free verdict's share and its interval (%), (score, lo, hi)
 Verdicts = dict[tuple[str, str], tuple[float, float, float]]
-
-HEADLINE_COLUMNS = [f.name for f in fields(HeadlineRow)]
-#: columns a ``headline.csv`` written before they existed may lack (read as NaN)
-OPTIONAL = ("truth_free_score", "self_auc")
 
 
 def _hits(g: pd.DataFrame, mode: str, thr: Thresholds) -> pd.Series:
@@ -82,18 +54,18 @@ def _hits(g: pd.DataFrame, mode: str, thr: Thresholds) -> pd.Series:
     if mode == TRUTH_FREE:
         return g["believed"].astype(bool)
     t = g[g["truth"]]
-    if mode == "sequence":
+    if mode == SEQUENCE.key:
         return pd.Series(tracked(t, thr), index=t.index)
     return t["outcome_eval"] == "success"
 
 
 def _ape_cm(g: pd.DataFrame) -> float:
-    d = pd.to_numeric(g.loc[g["truth"], "dist_err_m"], errors="coerce").dropna().to_numpy(float)
+    d = g.loc[g["truth"], "dist_err_m"].dropna().to_numpy(float)
     return 100.0 * math.sqrt(float(np.mean(d ** 2))) if d.size else math.nan
 
 
 def _median(s: pd.Series) -> float:
-    v = pd.to_numeric(s, errors="coerce").dropna()
+    v = s.dropna()
     return float(v.median()) if len(v) else math.nan
 
 
@@ -109,13 +81,13 @@ def _table(p: pd.DataFrame, mode: str, scope: str, thr: Thresholds, free: Verdic
         k, n = int(h.sum()), int(len(h))
         if mode == TRUTH_FREE and scope != POOLED and (scope, m) in free:  # the verdict's own (block bootstrap)
             share, lo, hi = (x / 100 for x in free[(scope, m)])
-        elif mode in ("sequence", TRUTH_FREE) and g["dataset"].nunique() > 1:
+        elif mode in (SEQUENCE.key, TRUTH_FREE) and g["dataset"].nunique() > 1:
             per = [(int(x.sum()), len(x)) for _, x in h.groupby(g.loc[h.index, "dataset"])]
             share, lo, hi = pooled_share([a for a, _ in per], [b for _, b in per])
         else:
             share = k / n if n else math.nan
             lo, hi = wilson(k, n)
-        err = math.nan if mode == TRUTH_FREE else _ape_cm(g) if mode == "sequence" else \
+        err = math.nan if mode == TRUTH_FREE else _ape_cm(g) if mode == SEQUENCE.key else \
             _median(g.loc[g["truth"], "dist_err_cm"])
         stats.append((m, 100 * share, 100 * lo, 100 * hi, n, err, _median(g["cpu_ms"])))
     stats.sort(key=lambda s: (-np.nan_to_num(s[1], nan=-1.0), np.nan_to_num(s[5], nan=np.inf),
@@ -127,12 +99,13 @@ def _table(p: pd.DataFrame, mode: str, scope: str, thr: Thresholds, free: Verdic
         pvals.append(mcnemar_exact(int((sa & ~sb).sum()), int((~sa & sb).sum())) if len(both) else math.nan)
     adj = holm(np.array(pvals, dtype=float)) if pvals else np.array([])
     out = []
-    measure, error = mode_of(mode).measure, mode_of(mode).error
+    named = mode_of(mode)
+    measure, error = named.measure, named.error
     for i, (m, v, lo, hi, n, err, cpu) in enumerate(stats):
         nxt = stats[i + 1][0] if i + 1 < len(stats) else ""
         p_adj = float(adj[i]) if i < len(adj) else math.nan
         verdict = "" if not nxt or math.isnan(p_adj) else "ahead" if p_adj < ALPHA else "tied"
-        out.append(HeadlineRow("sequence" if mode == TRUTH_FREE else mode, scope, i + 1, m, measure, v, lo, hi,
+        out.append(HeadlineRow(SEQUENCE.key if mode == TRUTH_FREE else mode, scope, i + 1, m, measure, v, lo, hi,
                                n, err, error, cpu, verdict, nxt, p_adj,
                                v if mode == TRUTH_FREE else free.get((scope, m), (math.nan,))[0],
                                auc.get((scope, m), math.nan)))
@@ -152,14 +125,14 @@ def headline(p: pd.DataFrame, modes: dict[str, str], thr: Thresholds, beliefs: p
     with_truth = set(p.loc[p["truth"], "dataset"])
     t = p[p["truth"]]
     for mode in MODES:
-        names = [d for d in t["dataset"].unique() if modes.get(d, "single") == mode]
+        names = [d for d in t["dataset"].unique() if modes.get(d, SINGLE.key) == mode]
         if not names:
             continue
         if len(names) > 1:
             out += _table(t[t["dataset"].isin(names)], mode, POOLED, thr, free, auc)
         for d in names:
             out += _table(t[t["dataset"] == d], mode, d, thr, free, auc)
-    blind = [d for d in p["dataset"].unique() if modes.get(d) == "sequence" and d not in with_truth]
+    blind = [d for d in p["dataset"].unique() if modes.get(d) == SEQUENCE.key and d not in with_truth]
     if beliefs is not None and blind:
         b = p[p["dataset"].isin(blind)].merge(beliefs[["dataset", "scan_id", "matcher", "believed"]],
                                              on=["dataset", "scan_id", "matcher"], how="inner")
@@ -169,31 +142,3 @@ def headline(p: pd.DataFrame, modes: dict[str, str], thr: Thresholds, beliefs: p
         for d in names:
             out += _table(b[b["dataset"] == d], TRUTH_FREE, d, thr, free, auc)
     return out
-
-
-def headline_frame(rows: list[HeadlineRow]) -> pd.DataFrame:
-    """``rows`` as a table in :data:`HEADLINE_COLUMNS` (``headline.csv``)."""
-    return pd.DataFrame([asdict(r) for r in rows], columns=HEADLINE_COLUMNS)
-
-
-def read_headline(path) -> list[HeadlineRow]:
-    """The rows of a ``headline.csv`` (as :func:`headline_frame` wrote them)."""
-    df = pd.read_csv(path, keep_default_na=False, na_values=[""])
-    missing = [c for c in HEADLINE_COLUMNS if c not in df.columns and c not in OPTIONAL]
-    if missing:
-        from tfloc.errors import ResultsError
-
-        raise ResultsError(f"{path}: not a headline table (no column(s) {', '.join(missing)})")
-    out = []
-    for r in df.to_dict("records"):
-        out.append(HeadlineRow(**{f.name: _cast(f.type, r[f.name]) for f in fields(HeadlineRow)
-                                  if f.name in r}))
-    return out
-
-
-def _cast(kind: str, v):
-    if kind == "int":
-        return int(v)
-    if kind == "float":
-        return float("nan") if v is None or (isinstance(v, float) and math.isnan(v)) else float(v)
-    return "" if v is None or (isinstance(v, float) and math.isnan(v)) else str(v)

@@ -1,7 +1,7 @@
 """Accuracy, success, failure-outcome and runtime metrics over a run's estimates (pure functions).
 
-Input is the ``estimates.csv`` DataFrame (:func:`tfloc.io.estimates.read_estimates`); errors
-there are in metres and radians, the metrics here are reported in cm, degrees, ms and percent.
+Input is the ``estimates.csv`` table as the store reads it (:meth:`tfloc.io.rundir.RunDir.results`:
+numbers as numbers, text as text); errors there are in metres and radians, the metrics here are reported in cm, degrees, ms and percent.
 
 Which rows count where (stated in every report):
 
@@ -34,9 +34,10 @@ import itertools
 import numpy as np
 import pandas as pd
 
+from tfloc.core.result import kind_of_status
+from tfloc.core.rows.summary import METRICS
 from tfloc.core.thresholds import Thresholds
 from tfloc.datasets.protocol import ANGLE_BINS_DEG, DIST_BINS_M
-from tfloc.io.estimates import status_kinds
 
 from .outcome import (
     DIVERGED,
@@ -60,19 +61,8 @@ def _labels(edges: tuple[float, ...]) -> tuple[str, ...]:
 
 DIST_BINS = _labels(DIST_EDGES_CM)
 ANGLE_BINS = _labels(ANGLE_EDGES_DEG)
-METRIC_COLUMNS = (
-    "n", "n_truth", "n_est", "n_excluded", "n_timeout", "n_error", "n_invalid",
-    "dist_mean_cm", "dist_std_cm", "dist_median_cm", "dist_median_lo_cm", "dist_median_hi_cm",
-    "dist_p90_cm", "dist_max_cm",
-    "orient_mean_deg", "orient_std_deg", "orient_median_deg", "orient_p90_deg", "orient_max_deg",
-    "dist_impr_mean_pct", "dist_impr_median_pct", "dist_impr_min_pct",
-    "orient_impr_mean_pct", "orient_impr_median_pct", "orient_impr_min_pct",
-    "success_rate_pct", "success_lo_pct", "success_hi_pct",
-    *(f"n_{o.replace('-', '_')}" for o in (*OUTCOMES, UNSCORED)),
-    *(f"share_{o.replace('-', '_')}_pct" for o in OUTCOMES),
-    "n_near", "n_diverged",
-    "runtime_median_ms", "runtime_p95_ms", "n_timed",
-    "cpu_median_ms", "cpu_median_lo_ms", "cpu_median_hi_ms", "cpu_p95_ms", "n_cpu", "wall_per_cpu_median")
+#: the metrics of a summary row, in column order (:class:`~tfloc.core.rows.summary.SummaryRow`)
+METRIC_COLUMNS = METRICS
 
 
 def _bin(values: pd.Series, edges: tuple[float, ...], labels: tuple[str, ...]) -> pd.Series:
@@ -85,32 +75,36 @@ def _bin(values: pd.Series, edges: tuple[float, ...], labels: tuple[str, ...]) -
 
 def dist_bin(init_dist_err_m: pd.Series) -> pd.Series:
     """Initial distance offset bins (labels :data:`DIST_BINS`, cm) of metres; NaN → missing."""
-    return _bin(pd.to_numeric(init_dist_err_m, errors="coerce") * 100.0, DIST_EDGES_CM, DIST_BINS)
+    return _bin(init_dist_err_m.astype(float) * 100.0, DIST_EDGES_CM, DIST_BINS)
 
 
 def angle_bin(init_orient_err_rad: pd.Series) -> pd.Series:
     """Initial angle offset bins (labels :data:`ANGLE_BINS`, degrees) of radians; NaN → missing."""
-    deg = np.degrees(pd.to_numeric(init_orient_err_rad, errors="coerce").abs())
+    deg = np.degrees(init_orient_err_rad.astype(float).abs())
     return _bin(deg, ANGLE_EDGES_DEG, ANGLE_BINS)
 
 
 def has_truth(df: pd.DataFrame) -> pd.Series:
     """Rows whose true pose is known."""
-    return pd.to_numeric(df["true_x"], errors="coerce").notna()
+    return df["true_x"].astype(float).notna()
+
+
+def status_kinds(status: pd.Series) -> pd.Series:
+    """The kind (``ok``, ``failed``, ``invalid``, ``timeout``, ``error``) of each row's status."""
+    return status.astype(str).map(kind_of_status)
 
 
 def tracked(df: pd.DataFrame, thr: Thresholds) -> np.ndarray:
     """Per row, whether its errors lie within the tracked thresholds (NaN errors: not tracked);
     the tracking tables' rule, one copy for every reader of rows."""
-    d = pd.to_numeric(df["dist_err_m"], errors="coerce").to_numpy(float)
-    o = pd.to_numeric(df["orient_err_rad"], errors="coerce").to_numpy(float)
+    d = df["dist_err_m"].to_numpy(float)
+    o = df["orient_err_rad"].to_numpy(float)
     return np.asarray(thr.success(d, o), dtype=bool).reshape(-1)
 
 
 def has_estimate(df: pd.DataFrame) -> pd.Series:
     """Rows with status ok/failed and finite errors (the rows of the error statistics)."""
-    d = pd.to_numeric(df["dist_err_m"], errors="coerce")
-    o = pd.to_numeric(df["orient_err_rad"], errors="coerce")
+    d, o = df["dist_err_m"].astype(float), df["orient_err_rad"].astype(float)
     return df["status"].isin(["ok", "failed"]) & np.isfinite(d) & np.isfinite(o)
 
 
@@ -120,8 +114,7 @@ def classify(df: pd.DataFrame, thr: Thresholds) -> pd.Series:
     A row that failed only under stricter thresholds than the run's has no recorded scores: it
     keeps a recorded failure outcome, else it is ``unscored``."""
     nan = pd.Series(np.nan, index=df.index)
-    num = {c: pd.to_numeric(df.get(c, nan), errors="coerce")
-           for c in ("dist_err_m", "orient_err_rad", "score_est", "score_true")}
+    num = {c: df.get(c, nan).astype(float) for c in ("dist_err_m", "orient_err_rad", "score_est", "score_true")}
     recorded = df.get("outcome", pd.Series("", index=df.index)).fillna("").astype(str)
     out = outcome(df["status"] == "ok", num["dist_err_m"], num["orient_err_rad"], num["score_est"],
                   num["score_true"], thr, recorded.to_numpy(dtype=object))
@@ -131,9 +124,9 @@ def classify(df: pd.DataFrame, thr: Thresholds) -> pd.Series:
 def prepare(df: pd.DataFrame, thr: Thresholds) -> pd.DataFrame:
     """``df`` plus derived columns: bins, errors in cm/deg, improvements (%), outcome, runtime (ms)."""
     out = df.copy()
-    num = {c: pd.to_numeric(out[c], errors="coerce") for c in
+    num = {c: out[c].astype(float) for c in
            ("dist_err_m", "orient_err_rad", "init_dist_err_m", "init_orient_err_rad", "runtime_s")}
-    num["cpu_s"] = pd.to_numeric(out.get("cpu_s", pd.Series(np.nan, index=out.index)), errors="coerce")
+    num["cpu_s"] = out.get("cpu_s", pd.Series(np.nan, index=out.index)).astype(float)
     est = has_estimate(out)
     out["dist_bin"] = dist_bin(num["init_dist_err_m"])
     out["angle_bin"] = angle_bin(num["init_orient_err_rad"])

@@ -25,6 +25,11 @@ ALPHA = 0.05
 PAIRED_COLUMNS = ["a", "b", "n", "success_a_pct", "success_b_pct", "only_a", "only_b",
                   "diff_pct", "diff_lo_pct", "diff_hi_pct", "p_mcnemar", "p_holm", "significant"]
 
+#: A run of more than this many matcher labels is a parameter sweep: each label is paired with the
+#: run's first only; its report draws the first label's failures only, its line figures a few
+#: labels, its bar and box figures one row per label.
+MANY_MATCHERS = 12
+
 
 def success_matrix(p: pd.DataFrame) -> pd.DataFrame:
     """Success (bool, or missing) per scan ``(dataset, scan_id)`` × matcher of prepared rows."""

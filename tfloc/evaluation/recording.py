@@ -38,7 +38,7 @@ import numpy as np
 
 from tfloc.core.laser import LaserSpec
 from tfloc.core.pose import Pose, wrap_angle
-from tfloc.io.scenario import Scan
+from tfloc.core.scan import Scan
 from tfloc.maps.fields import distance_field
 from tfloc.maps.known import in_known_area
 

@@ -13,14 +13,11 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from tfloc.core.pose import wrap_angle
-from tfloc.errors import DatasetError
-from tfloc.io.relations import Relation
-from tfloc.io.scenario import Scenario
+from tfloc.core.relation import Relation
 
 
 def sample_std(values: np.ndarray) -> float:
@@ -110,13 +107,3 @@ def tracked_relation_stats(stamps_s: np.ndarray, poses: np.ndarray, relations: S
     return {**out, "n_relations": len(relations), "n_skipped": e.skipped}
 
 
-def relations_path(scenario: Scenario) -> Path | None:
-    """The relations file a dataset names in ``scenario.json`` (``"relations"``, relative to the
-    dataset directory), or ``None``."""
-    rel = scenario.extra.get("relations")
-    if rel is None:
-        return None
-    if not isinstance(rel, str) or not rel.strip():
-        raise DatasetError(f"{scenario.root / 'scenario.json'}: field 'relations' must be a path (a string), "
-                           f"got {rel!r:.60}")
-    return scenario.root / rel

@@ -34,6 +34,7 @@ import numpy as np
 
 from tfloc.core.pose import Pose, angdiff
 from tfloc.core.result import kind_of_status
+from tfloc.core.rows.relocalization import GlobalSummary
 from tfloc.core.thresholds import Thresholds
 from tfloc.errors import ResultsError
 
@@ -164,33 +165,6 @@ def result_from_row(row: Mapping[str, Any], thresholds: Thresholds, where: str =
                     hypotheses_from_info(row.get("info"), where), thresholds,
                     _num(row, "score_est"), _num(row, "score_true"), _num(row, "cpu_s"))
     return dataclasses.replace(r, place_rank=place_rank(_proposed(row.get("info")), truth))
-
-
-@dataclass(frozen=True)
-class GlobalSummary:
-    """Global localization of one matcher on one dataset.
-
-    Rates are fractions in [0, 1] with Wilson 95 % intervals; ``ambiguous`` is the share of the
-    scans whose (wrong) answer the matcher's own score prefers to the truth; ``cpu_ms_median`` is
-    CPU milliseconds per scan; ``ms_per_100m2`` the median cost per 100 m² of free area."""
-
-    dataset: str
-    matcher: str
-    n: int
-    top1: float
-    top1_lo: float
-    top1_hi: float
-    top5: float
-    top5_lo: float
-    top5_hi: float
-    ambiguous: float
-    no_answer: float
-    cpu_ms_median: float
-    free_area_m2: float
-    ms_per_100m2: float
-    place_recall1: float = math.nan  # NaN: the matcher records no places
-    place_recall5: float = math.nan
-    place_recall_all: float = math.nan
 
 
 def summarize(results: Iterable[ScanResult],

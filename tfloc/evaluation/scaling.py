@@ -12,23 +12,22 @@ the study's budgets at a level (:func:`over_budget`) is not run at the larger le
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 import pandas as pd
 
 from tfloc.core.rows.timing import PrepRow, ScanRow, SkipRow
-from tfloc.io.timing_rows import columns
 
 #: A slope of log cost against log size above this counts as "grows".
 GROWS_SLOPE = 0.2
 
 #: Columns of the study's tables: the fields of its typed rows (``scaling.csv``, ``prep.csv``
 #: with matcher ``(map)`` for the map itself, ``skips.csv``), whose tables
-#: (:func:`tfloc.io.timing_rows.rows_frame`) the functions below read.
-SCAN_COLUMNS = columns(ScanRow)
-PREP_COLUMNS = columns(PrepRow)
-SKIP_COLUMNS = columns(SkipRow)
+#: (:func:`tfloc.io.table.frame_of`) the functions below read.
+SCAN_COLUMNS = [f.name for f in fields(ScanRow)]
+PREP_COLUMNS = [f.name for f in fields(PrepRow)]
+SKIP_COLUMNS = [f.name for f in fields(SkipRow)]
 
 
 @dataclass(frozen=True)

@@ -18,33 +18,18 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 from scipy.stats import rankdata
 
+from tfloc.core.rows.tracking import SelfAssessment
 from tfloc.core.traits import Confidence, confidence_of
 
 from .metrics import tracked
 
 #: the false-alarm rate of the "caught" figure
 FALSE_ALARM = 0.01
-
-
-@dataclass(frozen=True)
-class SelfAssessment:
-    """One tracker's lost-detector on one scope (a dataset, or ``all`` pooled): its confidence's
-    ``key``, scans with truth and with a value, lost scans among them, AUC and the share caught
-    at 1 % false alarms (fractions)."""
-
-    scope: str
-    matcher: str
-    key: str
-    scans: int
-    lost: int
-    auc: float
-    caught: float
 
 
 def values(info: pd.Series, conf: Confidence) -> np.ndarray:
@@ -86,8 +71,8 @@ POOLED = "all"
 
 def _scan_order(g: pd.DataFrame) -> pd.DataFrame:
     """A tracker's rows of one dataset in scan order (by stamp where there is one)."""
-    if "stamp" in g.columns and pd.to_numeric(g["stamp"], errors="coerce").notna().all():
-        return g.assign(_t=pd.to_numeric(g["stamp"])).sort_values("_t", kind="stable")
+    if "stamp" in g.columns and g["stamp"].notna().all():
+        return g.assign(_t=g["stamp"].astype(float)).sort_values("_t", kind="stable")
     return g
 
 

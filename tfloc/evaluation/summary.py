@@ -12,7 +12,6 @@ scan-to-scan dataset's offsets are odometry, not bins).
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
-from pathlib import Path
 
 import pandas as pd
 
@@ -90,10 +89,3 @@ def summary_table(p: pd.DataFrame, scan_to_scan: Iterable[str] = (), paper: Pape
         parts.append(summarize(s2m, ["matcher"]).assign(grouping="overall-scan-to-map", dataset="all", bin="all"))
     out = pd.concat([x.astype({"bin": object}) for x in parts if len(x)], ignore_index=True)
     return out[SUMMARY_KEYS + list(METRIC_COLUMNS)]
-
-
-def write_summary(table: pd.DataFrame, path: str | Path) -> Path:
-    """Write the summary table as CSV (floats with 6 significant digits)."""
-    path = Path(path)
-    table.to_csv(path, index=False, float_format="%.6g")
-    return path

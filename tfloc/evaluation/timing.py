@@ -42,8 +42,8 @@ def timing_summary(t: pd.DataFrame, reference: str, run: pd.DataFrame | None = N
     cpu = t.pivot_table(index=["dataset", "scan_id"], columns="matcher", values="cpu_ms", aggfunc="first")
     ref = cpu[reference]
     run_cpu = None
-    if run is not None and "cpu_s" in run and pd.to_numeric(run["cpu_s"], errors="coerce").notna().any():
-        r = run.assign(cpu_ms=1000.0 * pd.to_numeric(run["cpu_s"], errors="coerce"))
+    if run is not None and "cpu_s" in run and run["cpu_s"].notna().any():
+        r = run.assign(cpu_ms=1000.0 * run["cpu_s"].astype(float))
         run_cpu = r.pivot_table(index=["dataset", "scan_id"], columns="matcher", values="cpu_ms", aggfunc="first")
     rows = []
     for m in dict.fromkeys(t["matcher"]):

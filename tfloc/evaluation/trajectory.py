@@ -29,44 +29,16 @@ localizer must be right in the map's frame.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
 
 import numpy as np
 
 from tfloc.core.pose import angdiff
+from tfloc.core.rows.tracking import TrackScore
 from tfloc.core.thresholds import Thresholds
 
 LOST_DIST_M, LOST_ORIENT_DEG = 0.5, 10.0
 JUMP_M = 1.0
 DEFAULT = Thresholds()
-
-
-@dataclass(frozen=True)
-class TrackScore:
-    """The scores of one tracked sequence (module notes; metres, degrees, milliseconds)."""
-
-    n_scans: int
-    n_truth: int
-    distance_m: float
-    tracked: float
-    n_tracked: int
-    losses: int
-    recoveries: int
-    unrecovered: int
-    longest_lost_m: float
-    ape_rmse_m: float
-    ape_mean_m: float
-    ape_max_m: float
-    ape_rot_rmse_deg: float
-    ape_rot_max_deg: float
-    rpe_trans_m_per_m: float
-    rpe_rot_deg_per_m: float
-    cpu_ms_median: float
-    max_jump_m: float = math.nan
-    jumps: int = 0
-
-    def to_dict(self) -> dict[str, float]:
-        return asdict(self)
 
 
 def _traj(poses: np.ndarray, stamps: np.ndarray):
@@ -194,15 +166,18 @@ def score_track(est: np.ndarray, true: np.ndarray, cpu_s: np.ndarray | None = No
 
 def score_rows(rows, thresholds: Thresholds = DEFAULT) -> TrackScore:
     """:func:`score_track` of one (sequence, matcher)'s result rows (dicts or a DataFrame, in
-    scan order, columns ``est_*``, ``true_*``, ``cpu_s``; empty truth = NaN)."""
+    scan order, columns ``est_*``, ``true_*``, ``cpu_s`` as numbers; no truth = None or NaN)."""
     import pandas as pd
 
     from tfloc.core.result import ResultRow
-    from tfloc.io.estimates import rows_frame
 
-    df = rows_frame(rows) if isinstance(rows, list) and rows and isinstance(rows[0], ResultRow) else pd.DataFrame(rows)
-    num = lambda cols: df[cols].apply(pd.to_numeric, errors="coerce").to_numpy(float)  # noqa: E731
-    cpu = pd.to_numeric(df["cpu_s"], errors="coerce").dropna().to_numpy(float)
+    if isinstance(rows, list) and rows and isinstance(rows[0], ResultRow):
+        cols = ("est_x", "est_y", "est_theta", "true_x", "true_y", "true_theta", "init_x", "init_y", "init_theta",
+                "cpu_s")
+        rows = [{c: getattr(r, c) for c in cols} for r in rows]
+    df = pd.DataFrame(rows)
+    num = lambda cols: df[cols].to_numpy(float)  # noqa: E731
+    cpu = df["cpu_s"].dropna().to_numpy(float)
     pred = num(["init_x", "init_y", "init_theta"]) if "init_x" in df else None
     return score_track(num(["est_x", "est_y", "est_theta"]), num(["true_x", "true_y", "true_theta"]),
                        cpu, thresholds, pred)

@@ -115,9 +115,9 @@ def _plugin_changes(label: str, a: dict, b: dict) -> list[str]:
         out.append(f"{label}: {a.get('distribution') or '(no distribution)'} {_show(a.get('version'))} → "
                    f"{b.get('distribution') or '(no distribution)'} {_show(b.get('version'))}")
     if a.get("program") != b.get("program"):
-        changed = [k for k in dict.fromkeys([*(b.get("program") or {}), *(a.get("program") or {})])
-                   if (a.get("program") or {}).get(k) != (b.get("program") or {}).get(k)]
-        out.append(f"{label}: its program's {', '.join(changed) or 'identity'} changed")
+        pa, pb = a.get("program") or {}, b.get("program") or {}
+        out += [f"{label}: program.{k} {_show(pa.get(k))} → {_show(pb.get(k))}"
+                for k in dict.fromkeys([*pb, *pa]) if pa.get(k) != pb.get(k)]
     if a.get("code") == "plugin" and a.get("source") != b.get("source"):
         out.append(f"{label}: source changed")
     return out

@@ -126,6 +126,27 @@ def matcher_code(factory: Any, row_code: tuple[str, ...] = ROW_CODE) -> dict[str
             "source": module_source(module), "rows": code_identity(row_code)}
 
 
+def stale_matchers(fingerprint: Any) -> list[str] | None:
+    """The labels of a recorded fingerprint whose rows this checkout's code would not make (their
+    code identity differs, or their matcher is gone); ``None`` where the fingerprint records no
+    per-matcher identity."""
+    from tfloc.core.matcher import factory_of
+    from tfloc.errors import TflocError
+
+    recorded = (fingerprint or {}).get("matchers") if isinstance(fingerprint, dict) else None
+    if not recorded or not all(isinstance(r, dict) and r.get("source") for r in recorded.values()):
+        return None
+    out = []
+    for label, r in recorded.items():
+        try:
+            now = matcher_code(factory_of(r["name"]))
+        except TflocError:
+            now = {}
+        if any(now.get(k) != r.get(k) for k in ("code", "source", "rows")):
+            out.append(label)
+    return out
+
+
 @cache
 def derived_code(*roots: str) -> str:
     """The identity of the code that derives a table from rows (the modules ``roots`` and their

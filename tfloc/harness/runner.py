@@ -262,6 +262,7 @@ def run(config: RunConfig, progress: bool | None = None, executor: Executor = ex
             keep = {k for k in done if st.keeps(k)}
             if keep:
                 drop_rows(rd.estimates, keep)
+                rd.discard_products()
                 log(f"{rd.path}: re-running {_what(st, done)}: {'; '.join(st.reasons[:3])}")
                 partial = True
             else:

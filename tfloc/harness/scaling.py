@@ -13,7 +13,7 @@ thresholds, the study's fields under ``scaling``), the environment
 (:func:`tfloc.harness.runner.environment`), the tile map as its one dataset, the fingerprint,
 the ``command``, the ``levels`` and the ones ``done``, and one session per start (load averages,
 cores, CPU and wall seconds). The typed rows (:mod:`tfloc.core.rows.timing`) go to
-``scaling.csv``, ``prep.csv`` and ``skips.csv`` (:mod:`tfloc.io.timing_rows`), each rewritten
+``scaling.csv``, ``prep.csv`` and ``skips.csv`` (through the store, :mod:`tfloc.io.tables`), each rewritten
 atomically after every level before the level is recorded as done: a level cut off by a kill is
 run again, never mixed. A directory of another configuration is refused with one line naming
 what differs; ``regenerate`` starts it over, and also a complete study of the same one.
@@ -27,14 +27,17 @@ import gc
 import time
 from pathlib import Path
 
+import pandas as pd
+
 from tfloc.core.jsonable import jsonable
 from tfloc.core.matcher import Matcher
 from tfloc.core.rows.timing import MAP, PrepRow, ScanRow, SkipRow
 from tfloc.errors import ConfigError, ResultsError
-from tfloc.evaluation.scaling import over_budget
+from tfloc.evaluation.scaling import level_table, over_budget, slope_table
 from tfloc.io.geojson import read_vector_map
 from tfloc.io.rundir import RunDir
-from tfloc.io.timing_rows import FILES, read_rows, rows_frame, write_rows
+from tfloc.io.table import frame_of
+from tfloc.io.tables import LEVELS, PREP, SCALING, SKIPS, SLOPES
 from tfloc.maps.vector import VectorMap
 
 from .pinning import pinned
@@ -46,7 +49,7 @@ from .scaling_matchers import study_differences, study_fingerprint, study_matche
 
 KIND = "scaling"
 #: the study's raw rows, and the record an older tfloc kept (removed when a study starts over)
-RAW_FILES = tuple(FILES[c] for c in (ScanRow, PrepRow, SkipRow))
+RAW_FILES = tuple(t.name for t in (SCALING, PREP, SKIPS))
 LEGACY = ("study.json",)
 Rows = tuple[list[ScanRow], list[PrepRow], list[PrepRow], list[SkipRow]]  # scans, maps, preparations, skips
 
@@ -86,7 +89,7 @@ def _open(rd: RunDir, fp: dict, levels: list[Level], regenerate: bool) -> set[st
         if not regenerate:
             raise
         info = None
-    if info is not None and info.doc and info.kind != KIND:
+    if info is not None and info.exists and info.kind != KIND:
         raise ConfigError(f"{rd.path} holds a run of tfloc {info.kind}, not a scaling study: choose another --out")
     diff = study_differences(info.fingerprint if info is not None else None, fp)
     if diff and not regenerate:
@@ -105,7 +108,7 @@ def _done_rows(levels: list[Level], done: set[str], rd: RunDir) -> Rows:
     of a level cut off before ``run.json`` recorded it are dropped."""
     if not done:
         return [], [], [], []
-    rows, prep, skips = (read_rows(rd.path / FILES[c], c) for c in (ScanRow, PrepRow, SkipRow))
+    rows, prep, skips = (rd.read(t) for t in (SCALING, PREP, SKIPS))
     area = {(lv.kind, lv.tiling.tiles): lv.key for lv in levels if lv.axis == "area"}
     prep = [p for p in prep if area.get((p.kind, p.tiles)) in done]
     return ([r for r in rows if r.level_key in done], [p for p in prep if p.matcher == MAP],
@@ -187,10 +190,10 @@ def _run_levels(cfg: StudyConfig, tile: VectorMap, matchers: dict[str, Matcher],
                 log(f"{lv.axis:6s} {lv.kind:6s} {lv.level:18s} {len(lv.scans)} scans × {len(active)} matchers: "
                     f"{time.process_time() - c1:6.1f} s CPU; median ms "
                     + ", ".join(f"{n} {v:.1f}" for n, v in med.items()))
-            for cls, data in ((ScanRow, rows), (PrepRow, map_prep + prep), (SkipRow, skips)):
-                write_rows(rd.path / FILES[cls], data, cls)
+            for table, data in ((SCALING, rows), (PREP, map_prep + prep), (SKIPS, skips)):
+                rd.write(table, data)
             done.add(lv.key)
-            rd.update({"done": [x.key for x in levels if x.key in done]}, **spent())
+            rd.record_levels([x.key for x in levels if x.key in done], **spent())
     finally:
         rd.close_session(load_average(), **spent())
 
@@ -198,7 +201,23 @@ def _run_levels(cfg: StudyConfig, tile: VectorMap, matchers: dict[str, Matcher],
 def _budgets(cfg: StudyConfig, lv: Level, rows: list[ScanRow], prep: list[PrepRow],
              out_of_budget: dict[tuple[str, str, str], str]) -> dict[str, float]:
     """Record the level's matchers over budget in ``out_of_budget``; returns their median CPU ms."""
-    r, p = rows_frame(rows, ScanRow), rows_frame(prep, PrepRow)
+    r, p = frame_of(rows, ScanRow), frame_of(prep, PrepRow)
     over = over_budget(r, p, lv.level, cfg.budget_ms, cfg.prep_budget_s if lv.axis == "area" else None)
     out_of_budget.update({(lv.axis, lv.kind, n): why for n, why in over.items()})
     return {n: float(v) for n, v in r.groupby("matcher", sort=False)["cpu_ms"].median().items()} if len(r) else {}
+
+
+def derive_scaling(run_dir: Path) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame, pd.DataFrame, pd.DataFrame]:
+    """The scaling study's tables from its run directory alone: its rows (``scaling.csv``,
+    ``prep.csv``, ``skips.csv``) and, derived from them and written, ``levels.csv`` and
+    ``slopes.csv`` (:mod:`tfloc.evaluation.scaling`). A directory that holds no scaling study's
+    ``run.json`` is a :class:`ResultsError`."""
+    rd = RunDir(run_dir)
+    if rd.info().kind != KIND:
+        raise ResultsError(f"{rd.path}: no scaling study here (its run.json is missing or not of kind "
+                           "'scaling'; run 'tfloc scaling' first)")
+    rows, prep, skips = (rd.frame(t) for t in (SCALING, PREP, SKIPS))
+    levels = level_table(rows)
+    rd.write(LEVELS, levels)
+    rd.write(SLOPES, slope_table(levels))
+    return rows, prep, skips, rd.frame(LEVELS), rd.frame(SLOPES)

@@ -32,7 +32,7 @@ from .scaling_config import THRESHOLDS, Log, StudyConfig
 
 #: the study's code that turns a matcher's answers into rows: a level's measurement (tiling, timing,
 #: scoring) and the rows' codec
-ROW_CODE = ("tfloc.harness.scaling_level", "tfloc.io.timing_rows")
+ROW_CODE = ("tfloc.harness.scaling_level", "tfloc.io.table")
 
 
 def study_matchers(names: Sequence[str] | None, log: Log) -> dict[str, Matcher]:

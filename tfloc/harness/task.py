@@ -29,9 +29,9 @@ from tfloc.errors import InvalidProblemError
 from tfloc.evaluation.outcome import AMBIGUOUS, NO_ANSWER, outcome
 from tfloc.evaluation.relocalization import HYPOTHESES_KEY, hypotheses_info
 from tfloc.io.estimates import result_row
-from tfloc.io.scenario import Scan
+from tfloc.io.scenario import Scan, load_dataset
 
-from .workspace import load_dataset, load_matcher, problem_of, status_of, timed_localize, warm
+from .workspace import load_matcher, problem_of, status_of, timed_localize, warm
 
 
 @dataclass(frozen=True)

@@ -22,7 +22,7 @@ conditions:
 A pass is one configuration (:func:`timing_fingerprint`: the run's fingerprint, the pass's
 :class:`TimingParams`, the sample drawn and the code timed), recorded in the run's ``run.json``
 (:meth:`~tfloc.io.rundir.RunDir.start_timing`); :func:`stale` says why a recorded pass is not
-current. :func:`tfloc.report.timing_pass.timing_pass` runs it end to end (``tfloc timing``):
+current. :func:`tfloc.harness.timing_pass.timing_pass` runs it end to end (``tfloc timing``):
 ``RUN/timing.csv``, ``RUN/timing.md``. A pass is short and runs whole: an interrupted one is
 timed again from the start, never resumed.
 """
@@ -41,19 +41,19 @@ import pandas as pd
 
 from tfloc.core.jsonable import jsonable
 from tfloc.core.matcher import get_matcher
-from tfloc.core.run import Run, RunMatcher, TimingRecord
 from tfloc.core.rows.timing import TimingRow
+from tfloc.core.run import RunMatcher, RunRecord, TimingRecord
 from tfloc.errors import ConfigError
 from tfloc.evaluation.timing import reference_of
 from tfloc.io.rundir import RunDir
-from tfloc.io.scenario import SEQUENCE
+from tfloc.io.scenario import SEQUENCE, load_dataset
 
 from .contention import Probe
 from .fingerprint import differences
 from .identity import derived_code, git_state
 from .pinning import pinned, rotated
 from .runner import cpu_model, load_average
-from .workspace import load_dataset, load_matcher, map_of, problem_of, timed_localize, warm
+from .workspace import load_matcher, map_of, problem_of, timed_localize, warm
 
 SEED = 20261130
 PER_STRATUM = 4  # scans per dataset × group, by default
@@ -90,7 +90,7 @@ class TimingParams:
         return p
 
 
-def read_run(run_dir: Path) -> tuple[pd.DataFrame, Run]:
+def read_run(run_dir: Path) -> tuple[pd.DataFrame, RunRecord]:
     """The rows and ``run.json`` of a run (:class:`~tfloc.io.rundir.RunDir`; both required)."""
     rd = RunDir(run_dir)
     info = rd.info(required=True)
@@ -164,7 +164,7 @@ def stale(rd: RunDir, record: TimingRecord | None, fp: dict) -> list[str]:
 
 def run_timing(run_dir: Path, per_stratum: int = PER_STRATUM, seed: int = SEED, cores: Sequence[int] | None = None,
                warmup: int = WARMUP, progress: Callable[[int, int], None] | None = None,
-               run: tuple[pd.DataFrame, Run] | None = None,
+               run: tuple[pd.DataFrame, RunRecord] | None = None,
                sample: pd.DataFrame | None = None) -> tuple[list[TimingRow], dict]:
     """Re-time a stratified sample of the run in ``run_dir`` (see the module docstring), pinned
     to ``cores`` (default: the last core this process may run on).
@@ -194,7 +194,7 @@ def run_timing(run_dir: Path, per_stratum: int = PER_STRATUM, seed: int = SEED, 
             "contention": contention.to_record(),
             "scans": len(sample), "strata": int(sample.groupby(["dataset", "group"]).ngroups),
             "loadavg_start": load_start, "loadavg_end": load_average(), "started": started,
-            "git": git_state(), "run_git": dict(info_run.git)}
+            "git": git_state(), "run_git": info_run.git.to_dict()}
     return rows, info
 
 

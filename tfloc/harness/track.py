@@ -183,7 +183,9 @@ def run_sequence(dataset: str, label: str, matcher: str, params_json: str = "{}"
     sequence tracked; the rows carry ``label`` as their matcher. Dataset errors raise
     :class:`DatasetError`; a tracker that raises on a scan is that scan's ``error:`` row, the
     run goes on."""
-    from .workspace import load_dataset, load_matcher, map_of
+    from tfloc.io.scenario import load_dataset
+
+    from .workspace import load_matcher, map_of
 
     scenario, by_id = load_dataset(dataset)
     scans = list(by_id.values())

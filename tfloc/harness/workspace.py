@@ -1,7 +1,7 @@
 """The per-process workspace: what a worker (or any command that runs matchers) loads once and
 how it runs one matcher on one problem.
 
-* :func:`load_dataset` — a dataset's metadata and scans by id, read once per process;
+* :func:`~tfloc.io.scenario.load_dataset` — a dataset's metadata and scans by id, read once per process;
 * :func:`load_matcher` — a matcher built once per process and configuration
   (:func:`tfloc.core.matcher.get_matcher`, registered names and ``module:Class`` alike);
 * :func:`problem_of` — the :class:`~tfloc.core.problem.Problem` of a scan (the dataset's map,
@@ -27,16 +27,9 @@ from tfloc.core.matcher import Matcher, get_matcher
 from tfloc.core.problem import Estimate, Problem
 from tfloc.core.result import OK, Status, StatusKind
 from tfloc.core.tracker import Tracker, kept_prediction
-from tfloc.io.scenario import Scan, Scenario, map_for, read_scans, read_scenario
+from tfloc.io.scenario import Scan, Scenario, map_for
 
 _MAPS: dict = {}
-
-
-@lru_cache(maxsize=16)
-def load_dataset(path: str) -> tuple[Scenario, dict[str, Scan]]:
-    """A dataset's metadata and scans by id, loaded once per process."""
-    scenario = read_scenario(path)
-    return scenario, {s.scan_id: s for s in read_scans(scenario)}
 
 
 @lru_cache(maxsize=32)

@@ -9,28 +9,18 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from tfloc.core.pose import Pose
-from tfloc.errors import LogFormatError
+from tfloc.core.relation import Relation
+from tfloc.errors import DatasetError, LogFormatError
 
 from .carmen import LaserRecord
 from .text import read_text
 
 _FIELDS = ("t1", "t2", "dx", "dy", "dz", "droll", "dpitch", "dyaw")
-
-
-@dataclass(frozen=True)
-class Relation:
-    """One relation: ``delta`` is the pose at ``t2`` seen from the pose at ``t1`` (m, rad)."""
-
-    t1: float
-    t2: float
-    delta: Pose
-    line: int
 
 
 def read_relations(path: str | Path) -> tuple[Relation, ...]:
@@ -82,3 +72,15 @@ def join_relations(relations: Sequence[Relation], scans: Sequence[LaserRecord], 
                                      f"(nearest {sorted_ts[best]:.5f})")
             out[k, j] = order[best]
     return out
+
+
+def relations_path(scenario) -> Path | None:
+    """The relations file a dataset names in ``scenario.json`` (``"relations"``, relative to the
+    dataset directory), or ``None``."""
+    rel = scenario.extra.get("relations")
+    if rel is None:
+        return None
+    if not isinstance(rel, str) or not rel.strip():
+        raise DatasetError(f"{scenario.root / 'scenario.json'}: field 'relations' must be a path (a string), "
+                           f"got {rel!r:.60}")
+    return scenario.root / rel

@@ -1,11 +1,13 @@
-"""A run directory: the one owner of ``run.json`` and of where a run's files are.
+"""A run directory as one typed store: the one owner of ``run.json``, of every table file and of
+where a run's files are.
 
-``tfloc bench`` writes a run directory, and so does the scaling study (``tfloc scaling``);
-``timing``, ``report``, ``export``, ``real-note`` and the guard read it. All of them go through
-:class:`RunDir`: it knows the paths (``estimates.csv``, ``run.json``, ``timing.*``, ``report.md``,
-``figures/``), reads and checks ``run.json`` once (:meth:`RunDir.info`, a :class:`~tfloc.core.run.Run`:
-configuration, matchers, datasets with their modes, thresholds, sessions, fingerprint, timing record), and
-writes it atomically (a kill leaves the old or the new file, never half of one). A malformed
+``tfloc bench`` writes a run directory, and so does the scaling study (``tfloc scaling``); every
+verb and the site read it, all through :class:`RunDir`: it knows the paths (``estimates.csv``,
+``run.json``, each table of :mod:`tfloc.io.tables`, ``timing.md``, ``report.md``,
+``figures/``), reads and writes each table through the one codec (:meth:`RunDir.read`,
+:meth:`RunDir.frame`, :meth:`RunDir.write`; the rows: :meth:`RunDir.results`), reads and checks
+``run.json`` once (:meth:`RunDir.info`, a typed :class:`~tfloc.core.run.RunRecord`), and writes
+it atomically (a kill leaves the old or the new file, never half of one). A malformed
 ``run.json`` is one :class:`ResultsError` naming the file and the field.
 
 ``run.json`` holds ``config`` (the configuration: ``name``, ``matchers`` as ``{label, name,
@@ -16,11 +18,13 @@ started, ended, load averages) and ``fingerprint`` (what decides the rows). A st
 steps records ``levels`` and the ones ``done``. ``timing`` is the timing pass's record
 (:meth:`RunDir.start_timing`): its ``fingerprint`` (the run's, the pass's parameters), its
 ``sessions`` and whether it is ``complete``; :meth:`RunDir.discard` removes it with the pass's
-files.
+files. ``verdict`` records the truth-free verdict (:meth:`RunDir.record_verdict`) and ``derived``
+what each producer of tables derived them from (:meth:`RunDir.record_derived`).
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import time
 from dataclasses import dataclass
@@ -30,7 +34,17 @@ from typing import Any
 import pandas as pd
 
 from tfloc.core.presets import resolve
-from tfloc.core.run import Run, RunDataset, RunMatcher, TimingRecord
+from tfloc.core.run import (
+    DerivedRecord,
+    GitState,
+    Machine,
+    RunDataset,
+    RunMatcher,
+    RunRecord,
+    Session,
+    TimingRecord,
+    VerdictRecord,
+)
 from tfloc.core.runconfig import RunConfig
 from tfloc.core.thresholds import Thresholds
 from tfloc.errors import ConfigError, ResultsError, TflocError
@@ -38,6 +52,8 @@ from tfloc.errors import ConfigError, ResultsError, TflocError
 from .atomic import replace_atomically
 from .estimates import REQUIRED, read_estimates
 from .scenario import SINGLE, read_scenario
+from .table import Table, read_frame, read_rows, write
+from .tables import VERDICT_FILES
 from .text import parse_text
 
 RUN_JSON = "run.json"
@@ -45,7 +61,7 @@ ESTIMATES = "estimates.csv"
 
 #: the run.json fields a reader relies on, and what each must be
 _FIELDS = {"config": dict, "git": dict, "machine": dict, "versions": dict, "datasets": dict, "sessions": list,
-           "declared": dict, "timing": dict, "verdict": dict, "levels": list, "done": list,
+           "declared": dict, "timing": dict, "verdict": dict, "derived": dict, "levels": list, "done": list,
            "config.kind": str, "config.scaling": dict, "timing.sessions": list, "timing.complete": bool,
            "config.success": dict, "config.matchers": list, "git.commit": (str, type(None)),
            "git.dirty": (bool, type(None)), "config.name": str}
@@ -107,10 +123,10 @@ def _declared(doc: dict, name: str, path: Path) -> dict:
         return dict(doc.get("declared", {}).get(name, {}))
 
 
-def run_of(doc: dict, path: Path) -> Run:
-    """The :class:`~tfloc.core.run.Run` of a checked ``run.json`` document (``path`` names the
-    file in errors): the configuration read back, each matcher's base name and resolved
-    parameters, each dataset's mode read once."""
+def run_of(doc: dict, path: Path) -> RunRecord:
+    """The :class:`~tfloc.core.run.RunRecord` of a checked ``run.json`` document (``path`` names
+    the file in errors): the configuration read back, each matcher's base name and resolved
+    parameters, each dataset's mode read once, every record typed."""
     cfg = doc.get("config", {})
     config = None
     if cfg.get("kind", "bench") == "bench" and "datasets" in cfg and "matchers" in cfg:
@@ -131,7 +147,13 @@ def run_of(doc: dict, path: Path) -> Run:
         datasets.append(RunDataset(name, Path(where), str(declared.get("mode", SINGLE)),
                                    tuple(declared.get("paper_scenarios", ()))))
     timing = TimingRecord.from_dict(doc["timing"]) if isinstance(doc.get("timing"), dict) else None
-    return Run(doc, config, tuple(matchers), tuple(datasets), Thresholds.from_run(doc), timing)
+    verdict = VerdictRecord.from_dict(doc["verdict"]) if isinstance(doc.get("verdict"), dict) else None
+    return RunRecord(config, cfg.get("name"), str(cfg.get("kind", "bench")), dict(cfg.get("scaling") or {}),
+                     tuple(matchers), tuple(datasets), Thresholds.from_run(doc), dict(doc.get("versions") or {}),
+                     GitState.from_dict(doc.get("git")), Machine.from_dict(doc.get("machine")),
+                     tuple(Session.from_dict(x) for x in doc.get("sessions", [])), doc.get("fingerprint"),
+                     timing, verdict, {k: DerivedRecord.from_dict(v) for k, v in (doc.get("derived") or {}).items()},
+                     tuple(doc.get("levels", [])), tuple(doc.get("done", [])), doc.get("command"), True)
 
 
 def _file(name: str, what: str) -> property:
@@ -150,17 +172,34 @@ class RunDir:
 
     estimates = _file(ESTIMATES, "the rows")
     run_json = _file(RUN_JSON, "the run's record")
-    timing_csv = _file("timing.csv", "the timing pass's rows")
     timing_md = _file("timing.md", "the timing pass's summary")
     report = _file("report.md", "the report")
     figures = _file("figures", "the report's figures")
-    verdict = _file("verdict.csv", "the truth-free verdict per tracker")
-    verdict_scans = _file("verdict_scans.csv.gz", "the truth-free verdict's per-scan signals and beliefs")
-    verdict_checks = _file("verdict_checks.csv", "the verdict against the truth, per tracker (recordings with truth)")
-    verdict_agreement = _file("verdict_agreement.csv", "the verdict's ranking against the truth's, per recording")
-    verdict_flags = _file("verdict_flags.csv", "the recordings' flagged stretches the verdict judged across")
-    VERDICT_FILES = ("verdict.csv", "verdict_scans.csv.gz", "verdict_checks.csv", "verdict_agreement.csv",
-                     "verdict_flags.csv")
+
+    def file(self, table: Table) -> Path:
+        """Where the run keeps ``table``."""
+        return self.path / table.name
+
+    def has(self, table: Table) -> bool:
+        """Whether the run has ``table``'s file."""
+        return self.file(table).is_file()
+
+    def read(self, table: Table) -> list:
+        """``table``'s rows (its row type; none when the file is missing): :mod:`tfloc.io.table`."""
+        return read_rows(self.file(table), table)
+
+    def frame(self, table: Table):
+        """``table`` as a typed table (empty when the file is missing): :mod:`tfloc.io.table`."""
+        return read_frame(self.file(table), table)
+
+    def write(self, table: Table, rows) -> Path:
+        """``rows`` (``table``'s row type, or a table of its columns) into its file, atomically."""
+        return write(self.file(table), table, rows)
+
+    def remove(self, *tables: Table) -> None:
+        """Remove the files of ``tables`` (those missing are fine)."""
+        for t in tables:
+            self.file(t).unlink(missing_ok=True)
 
     def has_rows(self) -> bool:
         """Whether the run has an ``estimates.csv`` with anything in it."""
@@ -180,11 +219,34 @@ class RunDir:
             raise ResultsError(f"{self.estimates}: no results yet (no task of the run has finished)")
         return df
 
-    def info(self, required: bool = False) -> Run:
+    def info(self, required: bool = False) -> RunRecord:
         """``run.json``, read and checked once (:func:`run_of`); without one, an empty
-        :class:`~tfloc.core.run.Run` (or, if ``required``, a :class:`ResultsError`)."""
+        :class:`~tfloc.core.run.RunRecord` (or, if ``required``, a :class:`ResultsError`)."""
         doc = self._doc(required)
-        return run_of(doc, self.run_json) if doc else Run()
+        return run_of(doc, self.run_json) if doc else RunRecord()
+
+    def rows_sha256(self) -> str | None:
+        """SHA-256 of ``estimates.csv`` (``None`` without one): what derived tables record they
+        were made from."""
+        return _sha256(self.estimates)
+
+    def table_sha256(self, table: Table) -> str | None:
+        """SHA-256 of ``table``'s file (``None`` without one)."""
+        return _sha256(self.file(table))
+
+    def record_verdict(self, record: VerdictRecord) -> None:
+        """Record in ``run.json`` the truth-free verdict just written."""
+        self._set({"verdict": record.to_dict()})
+
+    def record_derived(self, producer: str, record: DerivedRecord) -> None:
+        """Record in ``run.json`` what ``producer``'s tables were derived from."""
+        doc = self._doc()
+        self._set({"derived": {**doc.get("derived", {}), producer: record.to_dict()}})
+
+    def record_levels(self, done: list[str], **session: Any) -> None:
+        """Record the levels a stepped study has done, and update its last session with
+        ``session`` (e.g. its CPU seconds so far)."""
+        self._set({"done": list(done)}, **session)
 
     def recorded_fingerprint(self) -> dict | None:
         """The fingerprint ``run.json`` records, or None if there is none or it is unreadable
@@ -207,7 +269,7 @@ class RunDir:
             raise ResultsError(f"{self.run_json}: no 'config.matchers' or 'datasets' (not written by tfloc bench?)")
         return doc
 
-    def write(self, doc: dict[str, Any]) -> None:
+    def write_doc(self, doc: dict[str, Any]) -> None:
         """Write ``run.json`` atomically (a temporary file, fsynced, renamed)."""
         replace_atomically(self.run_json, lambda fh: fh.write(json.dumps(doc, indent=2) + "\n"))
 
@@ -224,16 +286,18 @@ class RunDir:
         session = {"started": _now(), "tasks": n_tasks, "already_done": n_done, "loadavg_start": loadavg,
                    **extra}
         kept = {"timing": old["timing"]} if "timing" in old and "timing" not in doc else {}
-        self.write({**doc, **kept, "sessions": list(old.get("sessions", [])) + [session]})
+        self.write_doc({**doc, **kept, "sessions": list(old.get("sessions", [])) + [session]})
 
-    def update(self, fields: dict[str, Any], **session: Any) -> None:
-        """Replace top-level ``fields`` of ``run.json`` (e.g. the steps ``done``) and update the
-        last session with ``session`` (e.g. its CPU seconds so far)."""
+    def _set(self, fields: dict[str, Any], **session: Any) -> None:
+        """Replace top-level ``fields`` of ``run.json`` and update the last session with
+        ``session`` (a run without ``run.json`` has no record to keep them in)."""
         doc = self._doc()
+        if not doc:
+            return
         doc.update(fields)
         if session and doc.get("sessions"):
             doc["sessions"][-1].update(session)
-        self.write(doc)
+        self.write_doc(doc)
 
     def close_session(self, loadavg: list | None, **extra: Any) -> None:
         """Record the end time and load average of the last session (and ``extra`` fields)."""
@@ -243,7 +307,7 @@ class RunDir:
             return
         if doc.get("sessions"):
             doc["sessions"][-1].update(ended=_now(), loadavg_end=loadavg, **extra)
-            self.write(doc)
+            self.write_doc(doc)
 
     def start_timing(self, fingerprint: dict[str, Any], loadavg: list | None, fresh: bool) -> None:
         """Record in ``run.json`` that a timing pass of ``fingerprint`` starts (not complete until
@@ -254,7 +318,7 @@ class RunDir:
         previous = [] if fresh or old.get("fingerprint") != fingerprint else list(old.get("sessions", []))
         session = {"started": _now(), "loadavg_start": loadavg}
         doc["timing"] = {"fingerprint": fingerprint, "complete": False, "sessions": previous + [session]}
-        self.write(doc)
+        self.write_doc(doc)
 
     def close_timing(self, loadavg: list | None, **extra: Any) -> None:
         """Record that the timing pass started last is complete (``timing.csv`` and ``timing.md``
@@ -263,14 +327,27 @@ class RunDir:
         record = doc.get("timing") or {"sessions": [{}]}
         record["sessions"][-1].update(ended=_now(), loadavg_end=loadavg, **extra)
         doc["timing"] = {**record, "complete": True}
-        self.write(doc)
+        self.write_doc(doc)
+
+    def discard_products(self) -> None:
+        """Remove what was made from the rows that a change of rows makes stale: the timing pass
+        (``timing.csv``, ``timing.md`` and its record) and the truth-free verdict's files."""
+        from .tables import TIMING
+
+        for f in (self.file(TIMING), self.timing_md, *(self.file(t) for t in VERDICT_FILES)):
+            f.unlink(missing_ok=True)
+        try:
+            doc = self._doc()
+        except ResultsError:  # a damaged record: discard removes it whole
+            return
+        if doc.pop("timing", None) is not None:
+            self.write_doc(doc)
 
     def discard(self, also: tuple[str, ...] = ()) -> None:
-        """Remove the run's results, its timing pass (``timing.csv``, ``timing.md`` and the record
-        in ``run.json``), its truth-free verdict, ``run.json`` and the files named ``also``
-        (``--regenerate``)."""
-        for f in (self.estimates, self.timing_csv, self.timing_md, *(self.path / n for n in self.VERDICT_FILES),
-                  *(self.path / n for n in also), self.run_json):
+        """Remove the run's results, its timing pass and truth-free verdict
+        (:meth:`discard_products`), ``run.json`` and the files named ``also`` (``--regenerate``)."""
+        self.discard_products()
+        for f in (self.estimates, *(self.path / n for n in also), self.run_json):
             f.unlink(missing_ok=True)
 
     def make(self) -> None:
@@ -279,6 +356,16 @@ class RunDir:
             self.path.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
             raise ResultsError(f"{self.path}: cannot create the run directory ({exc.strerror or exc})") from None
+
+
+def _sha256(path: Path) -> str | None:
+    if not path.is_file():
+        return None
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
 
 
 def _now() -> str:

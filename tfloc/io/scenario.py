@@ -30,7 +30,7 @@ import math
 import os
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
-from functools import cached_property
+from functools import cached_property, lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -39,6 +39,7 @@ from tfloc.core.laser import LaserSpec
 from tfloc.core.modes import MODES as ALL_MODES
 from tfloc.core.pose import Pose
 from tfloc.core.problem import check_ranges
+from tfloc.core.scan import Scan
 from tfloc.errors import DatasetError
 
 from .text import csv_rows, parse_text
@@ -49,21 +50,6 @@ COLUMNS = ["scan_id", "group", "true_x", "true_y", "true_theta", "init_x", "init
 ODOM_COLUMNS = ["odom_x", "odom_y", "odom_theta"]
 SINGLE, SCAN_TO_SCAN, SEQUENCE, GLOBAL = (m.key for m in ALL_MODES.values())
 MODES = tuple(ALL_MODES)
-
-
-@dataclass(frozen=True, eq=False)
-class Scan:
-    """One row of ``scans.csv``: the real scan, its initial guess and (maybe) its true pose."""
-
-    scan_id: str
-    group: str
-    ranges: np.ndarray
-    initial: Pose | None  # None: a global problem, or a sequence row after the first
-    true: Pose | None = None
-    line: int = 0  # 1-based line in scans.csv, for messages
-    ref_ranges: np.ndarray | None = None  # scan-to-scan datasets: the reference scan (see map_for)
-    stamp: float | None = None  # seconds (optional ``stamp`` column), e.g. the ROS header stamp
-    odom: Pose | None = None  # sequences: the raw odometry pose at this scan (odometry frame)
 
 
 @dataclass(frozen=True, eq=False)
@@ -363,3 +349,11 @@ def write_scenario(root: str | Path, name: str, map_path: str | Path, laser: Las
             w.writerow([s.scan_id, s.group, *_pose_text(s.true), *_pose_text(s.initial),
                         " ".join(_fmt(v) for v in s.ranges), *stamp, *odom, *ref])
     return root
+
+
+@lru_cache(maxsize=16)
+def load_dataset(path: str) -> tuple[Scenario, dict[str, Scan]]:
+    """A dataset's metadata and scans by id, read once per process (:func:`read_scenario`,
+    :func:`read_scans`)."""
+    scenario = read_scenario(path)
+    return scenario, {s.scan_id: s for s in read_scans(scenario)}

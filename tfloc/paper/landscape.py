@@ -36,6 +36,37 @@ class Landscape:
         return np.hypot(self.xs[None, :] - x, self.ys[:, None] - y)
 
 
+#: the grid the report draws: ±3 m at 5 cm around the truth
+HALF_WIDTH_M = 3.0
+GRID = 121
+
+
+@dataclass(frozen=True)
+class LandscapeStats:
+    """What one scan's landscape shows (distances in metres): the initial guess's and the
+    answer's distance from the truth, the grid's global minimum's, its local minima, and the rank
+    correlation of Err with the distance to the truth beyond 1 m."""
+
+    dataset: str
+    scan_id: str
+    init_dist_m: float
+    answer_dist_m: float
+    global_min_dist_m: float
+    minima: int
+    far_rank_correlation: float
+
+
+@dataclass(frozen=True, eq=False)
+class LandscapePanel:
+    """One scan's landscape with the poses drawn on it (the truth, the guess, ``tf``'s answer)."""
+
+    land: Landscape
+    truth: Pose
+    initial: Pose
+    answer: Pose
+    stats: LandscapeStats
+
+
 def err_landscape(problem: Problem, centre: Pose, half_width_m: float = 1.0, n: int = 41,
                   config: TfConfig | None = None) -> Landscape:
     """Err of ``tf`` (under ``config``) on an ``n × n`` grid of positions spanning ±``half_width_m``

@@ -22,8 +22,7 @@ from matplotlib.figure import Figure
 from tfloc.core.pose import Pose
 from tfloc.errors import TflocError
 from tfloc.evaluation.outcome import OUTCOMES
-from tfloc.harness.workspace import load_dataset
-from tfloc.io.scenario import Scan, Scenario, map_for
+from tfloc.io.scenario import Scan, Scenario, load_dataset, map_for
 
 FAILURES = tuple(OUTCOMES[1:])  # local-optimum, ambiguous, no-answer
 WINDOW_MARGIN_M = 1.0

@@ -16,6 +16,7 @@ from matplotlib.figure import Figure
 
 from tfloc.core.thresholds import Thresholds
 from tfloc.evaluation.outcome import OUTCOMES
+from tfloc.evaluation.paired import MANY_MATCHERS
 from tfloc.evaluation.paper import PAPER_TF
 
 OUTCOME_COLOURS = {"success": "#2ca02c", "local-optimum": "#ff7f0e", "ambiguous": "#d62728",
@@ -24,18 +25,8 @@ SCENARIO_TITLES = {"I": "Scenario I: detail level", "II": "Scenario II: initial 
                    "III": "Scenario III: initial distance offset"}
 SCENARIO_X = {"I": "dataset", "II": "initial angle offset bin (°)", "III": "initial distance offset bin (cm)"}
 DPI = 120
-#: A run of more than this many matcher labels is a parameter sweep: its report compares each
-#: label with the first only and draws the first label's failures only; its line figures show a
-#: few labels, its bar and box figures turn horizontal (one row per label).
-MANY_MATCHERS = 12
 #: Metres between the map points drawn under a trajectory or a belief (the tracking figures).
 MAP_SPACING_M = 0.05
-
-
-def pose_columns(g: pd.DataFrame, prefix: str) -> np.ndarray:
-    """The ``(N, 3)`` poses ``<prefix>_x/_y/_theta`` of estimate rows (metres, radians; NaN where
-    empty)."""
-    return g[[f"{prefix}_x", f"{prefix}_y", f"{prefix}_theta"]].apply(pd.to_numeric, errors="coerce").to_numpy(float)
 
 
 def colours(matchers: list[str]) -> dict[str, tuple]:

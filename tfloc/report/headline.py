@@ -1,19 +1,20 @@
-"""The headline section that opens every ``report.md`` (and ``headline.csv`` beside it): one
-ranked table per mode of the run, pooled over its datasets of that mode (or its one dataset),
-from :mod:`tfloc.evaluation.headline`. The README and the site print the same rows."""
+"""The headline section that opens every ``report.md``: one ranked table per mode of the run,
+pooled over its datasets of that mode (or its one dataset), from the rows of ``headline.csv``
+(computed once by :func:`tfloc.evaluation.headline.headline` in the derive step). The README and
+the site print the same rows."""
 
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
-import pandas as pd
-
-from tfloc.core.modes import MODES, mode_of
+from tfloc.core.modes import MODES, SEQUENCE, mode_of
+from tfloc.core.modes import TRUTH_FREE as FREE_MODE
+from tfloc.core.rows.headline import POOLED, HeadlineRow
 from tfloc.core.thresholds import Thresholds
-from tfloc.evaluation.headline import POOLED, TRUTH_FREE, HeadlineRow, headline, headline_frame
 
 from .mdtable import num, table
+
+TRUTH_FREE = FREE_MODE.key
 
 
 def interval(r: HeadlineRow) -> str:
@@ -35,7 +36,7 @@ def headline_table(rows: list[HeadlineRow]) -> str:
     if not rows:
         return ""
     first = rows[0]
-    unit = "CPU ms/step" if first.mode == "sequence" else "CPU ms/scan"
+    unit = "CPU ms/step" if first.mode == SEQUENCE.key else "CPU ms/scan"
     if first.measure == TRUTH_FREE:  # no truth: no error column, no truth-based figure
         body = [[r.rank, f"`{r.matcher}`", interval(r), num(r.cpu_ms, 2), r.n, verdict(r)] for r in rows]
         return table(["#", "tracker", "believed tracked % [95 % CI]", f"{unit} (median)", "scans",
@@ -57,21 +58,18 @@ def _table_key(r: HeadlineRow) -> str:
     return TRUTH_FREE if r.measure == TRUTH_FREE else r.mode
 
 
-def headline_section(p: pd.DataFrame, modes: dict[str, str], thr: Thresholds, run_dir: Path,
-                     tf=None) -> str:
-    """The report's opening section; writes ``run_dir/headline.csv`` (every table: each dataset,
-    and each mode pooled). ``tf``: the run's truth-free parts (:class:`tfloc.report.truthfree.
-    TruthFree`): datasets without truth are ranked by the verdict, and that ranking comes first."""
-    rows = headline(p, modes, thr, *((tf.beliefs, tf.free, tf.auc) if tf is not None else ()))
-    headline_frame(rows).to_csv(run_dir / "headline.csv", index=False, float_format="%.6g")
+def headline_section(rows: list[HeadlineRow], thr: Thresholds, note: str = "") -> str:
+    """The report's opening section from the run's headline rows (every table: each dataset, and
+    each mode pooled); datasets without truth are ranked by the truth-free verdict, and that
+    ranking comes first (``note``: why there is no current verdict, if so)."""
     if not rows:
-        why = f" ({tf.note})" if tf is not None and tf.note else ""
+        why = f" ({note})" if note else ""
         return f"## Headline\n\n_No scan of this run has ground truth: nothing to rank{why}._\n"
     out = ["## Headline\n"]
     keys = sorted(dict.fromkeys(_table_key(r) for r in rows), key=lambda k: k != TRUTH_FREE)
     for key in keys:
         measure = TRUTH_FREE if key == TRUTH_FREE else None
-        mode = "sequence" if key == TRUTH_FREE else key
+        mode = SEQUENCE.key if key == TRUTH_FREE else key
         mine_all = [r for r in rows if _table_key(r) == key]
         scope = top_scope(mine_all, mode, measure)
         mine = [r for r in mine_all if r.scope == scope]

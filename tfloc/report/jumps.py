@@ -17,9 +17,10 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
+from tfloc.evaluation.sequences import poses as pose_columns
 from tfloc.evaluation.trajectory import JUMP_M
 
-from .figures import MAP_SPACING_M, pose_columns
+from .figures import MAP_SPACING_M
 
 PER_MATCHER = 3  #: jumps drawn per matcher
 CONTEXT = 30  #: scans drawn before and after a jump

@@ -18,7 +18,7 @@ from tfloc.core.pose import angdiff
 from tfloc.core.thresholds import Thresholds
 from tfloc.evaluation.relations import relation_stats
 from tfloc.evaluation.stats import wilson
-from tfloc.io.estimates import read_estimates
+from tfloc.io.rundir import RunDir
 from tfloc.io.scenario import read_scans, read_scenario
 
 #: Kümmerle et al. 2009 (Auton. Robots 27:387-407), MIT CSAIL: errors on its 1172 relations of the
@@ -106,9 +106,9 @@ def write_note(results: Path, datasets: list[Path], thresholds: Thresholds | Non
     datasets (one per initial-guess protocol)."""
     thresholds = thresholds or Thresholds()
     results = Path(results)
-    est_path = results / "estimates.csv"
+    rd = RunDir(results)
     need = ("dataset", "scan_id", "matcher", "dist_err_m", "orient_err_rad", "runtime_s", "status")
-    est = read_estimates(results, need) if est_path.is_file() else None
+    est = rd.results(need) if rd.has_rows() else None
     first = read_scans(read_scenario(datasets[0]))
     odo_t = np.array([s.true.distance_to(s.initial) for s in first])
     lines = [

@@ -1,17 +1,15 @@
 """The report's section for global datasets (``"mode": "global"``): top-1, top-5, ambiguous,
-CPU per scan and cost against the map's free area, per dataset and matcher
-(:mod:`tfloc.evaluation.relocalization`), and ``relocalization.csv``."""
+CPU per scan and cost against the map's free area, per dataset and matcher, from
+``relocalization.csv`` (:mod:`tfloc.evaluation.relocalization`, written by the derive step)."""
 
 from __future__ import annotations
-
-from dataclasses import asdict
-from pathlib import Path
 
 import pandas as pd
 
 from tfloc.core.thresholds import Thresholds
-from tfloc.evaluation.relocalization import free_area_m2, result_from_row, summarize
-from tfloc.io.estimates import status_kinds
+from tfloc.evaluation.metrics import status_kinds
+from tfloc.io.rundir import RunDir
+from tfloc.io.tables import RELOCALIZATION
 
 from .mdtable import num
 from .mdtable import table as md_table
@@ -21,16 +19,10 @@ def _pct(v: float, lo: float, hi: float) -> str:
     return f"{100 * v:.1f} [{100 * lo:.1f}–{100 * hi:.1f}]"
 
 
-def relocalization_section(df: pd.DataFrame, maps: dict[str, object], out_dir: Path,
-                           thresholds: Thresholds) -> str:
-    """The markdown of the global section for the rows ``df`` of global datasets (``maps``:
-    dataset → its map, for the free area); writes ``out_dir/relocalization.csv``."""
-    rows = df.to_dict("records")
-    results = [r for r in (result_from_row(x, thresholds, f"{x['dataset']}/{x['scan_id']}") for x in rows) if r]
-    area = {d: free_area_m2(m) for d, m in maps.items()}
-    summary = summarize(results, area)
-    pd.DataFrame([asdict(s) for s in summary]).to_csv(Path(out_dir) / "relocalization.csv", index=False,
-                                                      float_format="%.6g")
+def relocalization_section(rd: RunDir, df: pd.DataFrame, thresholds: Thresholds) -> str:
+    """The markdown of the global section: the run's ``relocalization.csv`` and, from the rows
+    ``df`` of its global datasets, the local matchers given no guess."""
+    summary = rd.read(RELOCALIZATION)
     invalid = df[status_kinds(df["status"]) == "invalid"].groupby("matcher").size()
     table = md_table(["dataset", "matcher", "n", "top-1 % [95 % CI]", "top-5 % [95 % CI]", "ambiguous %",
                       "no answer %", "CPU ms/scan (median)", "free area m²", "CPU ms per 100 m²"],

@@ -1,11 +1,14 @@
-"""``tfloc report RUN``: RUN/report.md, RUN/summary.csv and RUN/figures/*.png from a run's results.
+"""``tfloc report RUN``'s drawing: RUN/report.md and RUN/figures/*.png from a run's rows and the
+tables derived from them.
 
-Reads ``estimates.csv`` and ``run.json`` (:class:`tfloc.io.rundir.RunDir`), computes the metrics
-(:mod:`tfloc.evaluation.metrics`, :mod:`tfloc.evaluation.summary`) and the paired tests
-(:mod:`tfloc.evaluation.paired`, also written to ``paired.csv``), draws the figures
-(:mod:`tfloc.report.figures`, :mod:`tfloc.report.failures`) and writes the markdown: the
-header (:mod:`tfloc.report.provenance`), the definitions (:mod:`tfloc.report.definitions`), the
-tables (:mod:`tfloc.report.sections`). A timing pass (``tfloc timing RUN``) is linked when present.
+The tables (``headline.csv``, ``summary.csv``, ``paired.csv``, the tracking and global tables,
+the truth-free verdict's) are made by the derive step (:mod:`tfloc.harness.derive`) and read
+here through the store (:class:`tfloc.io.rundir.RunDir`); this module writes no table. It draws
+the figures (:mod:`tfloc.report.figures`, :mod:`tfloc.report.failures`, the landscapes
+:mod:`tfloc.harness.landscape` computed) and writes the markdown: the header
+(:mod:`tfloc.report.provenance`), the headline (:mod:`tfloc.report.headline`), the definitions
+(:mod:`tfloc.report.definitions`), the tables (:mod:`tfloc.report.sections`). A timing pass
+(``tfloc timing RUN``) is linked when present.
 """
 
 from __future__ import annotations
@@ -15,26 +18,22 @@ from pathlib import Path
 
 import pandas as pd
 
-from tfloc.core.run import Run
+from tfloc.core.rows.headline import HeadlineRow
+from tfloc.core.run import RunRecord
 from tfloc.core.thresholds import Thresholds
-from tfloc.evaluation.metrics import prepare, summarize
-from tfloc.evaluation.paired import paired_table
-from tfloc.evaluation.summary import (
-    declaring,
-    scenario_summary,
-    summary_table,
-    write_summary,
-)
-from tfloc.harness.workspace import load_dataset, map_of
-from tfloc.io.estimates import status_kinds
+from tfloc.errors import TflocError
+from tfloc.evaluation.metrics import prepare, status_kinds, summarize
+from tfloc.evaluation.paired import MANY_MATCHERS
+from tfloc.evaluation.summary import scenario_summary
 from tfloc.io.rundir import RunDir
-from tfloc.io.scenario import GLOBAL, SCAN_TO_SCAN, SEQUENCE
+from tfloc.io.scenario import GLOBAL, SCAN_TO_SCAN, SEQUENCE, load_dataset, map_for
+from tfloc.io.tables import HEADLINE, PAIRED
+from tfloc.paper.landscape import LandscapePanel
 
 from . import figures as F
 from . import sections as S
 from .definitions import definitions
 from .failures import draw_failures, failures_section
-from .figures import MANY_MATCHERS
 from .headline import headline_section
 from .landscape import draw_landscapes, landscape_section
 from .provenance import header
@@ -46,17 +45,7 @@ class ReportFiles:
     """What :func:`write_report` wrote."""
 
     report: Path
-    summary: Path
     figures: tuple[Path, ...]
-
-
-
-def load_run(run_dir: Path) -> tuple[pd.DataFrame, Run]:
-    """The rows and the ``run.json`` of a run directory (:class:`~tfloc.io.rundir.RunDir`;
-    ``run.json`` may be missing: provenance unknown, default thresholds)."""
-    rd = RunDir(run_dir)
-    rd.require_results()
-    return rd.results(), rd.info()
 
 
 def _dataset_section(p: pd.DataFrame, name: str, s2s: set[str]) -> str:
@@ -98,15 +87,16 @@ def _paired_section(pt: pd.DataFrame, sweep: bool) -> list[str]:
     return out
 
 
-def render(run_dir: Path, run: dict, p: pd.DataFrame, thr: Thresholds, s2s: set[str],
+def render(run_dir: Path, run: RunRecord, p: pd.DataFrame, thr: Thresholds, s2s: set[str],
            figs: list[Path], pt: pd.DataFrame | None = None, failures: str = "", landscape: str = "",
            line_labels: list[str] | None = None, sweep: bool = False, paper: dict | None = None,
-           headline: str = "") -> str:
+           headline: str = "", stale_code: list[str] | None = None) -> str:
     """The whole report.md text (``sweep``: a parameter sweep, see :data:`MANY_MATCHERS`;
     ``line_labels``: the labels its line figures show; ``paper``: dataset → the paper scenarios
-    it declares; ``headline``: the opening section, :mod:`tfloc.report.headline`)."""
+    it declares; ``headline``: the opening section, :mod:`tfloc.report.headline`; ``stale_code``:
+    the labels whose rows this checkout's code would not make)."""
     paper = paper or {}
-    parts = [header(run_dir, run, p, thr, s2s), headline, definitions(thr, paper)]
+    parts = [header(run_dir, run, p, thr, s2s, stale_code), headline, definitions(thr, paper)]
     truth = p[p["truth"]]
     sc = scenario_summary(truth, paper)
     if not truth.empty and len(sc):
@@ -158,10 +148,9 @@ def render(run_dir: Path, run: dict, p: pd.DataFrame, thr: Thresholds, s2s: set[
     return "\n".join(parts)
 
 
-def label_order(run: dict, p: pd.DataFrame) -> list[str]:
+def label_order(run: RunRecord, p: pd.DataFrame) -> list[str]:
     """The run's matcher labels in the order of its configuration (sorted without run.json)."""
-    order = [m.get("label", m.get("name")) for m in run.get("config", {}).get("matchers", [])]
-    return [m for m in order if m in set(p["matcher"])] or sorted(p["matcher"].unique())
+    return [m for m in run.labels if m in set(p["matcher"])] or sorted(p["matcher"].unique())
 
 
 def line_figure_matchers(p: pd.DataFrame, order: list[str], most: int = 8) -> list[str]:
@@ -173,68 +162,68 @@ def line_figure_matchers(p: pd.DataFrame, order: list[str], most: int = 8) -> li
     return [order[0], *best]
 
 
-def _maps(info: Run, names: set[str]) -> dict:
-    """The maps of the run's datasets ``names``, from the workspace (read once per process)."""
+def _loaded(info: RunRecord, names: set[str]) -> dict:
+    """The run's datasets ``names`` that are on disk: name → (scenario, scans), each read once."""
     out = {}
     for n, d in info.paths.items():
-        scenario, scans = load_dataset(str(d)) if n in names else (None, {})
-        if scans:
-            out[n] = map_of(scenario, next(iter(scans.values())))
+        if n not in names:
+            continue
+        try:
+            out[n] = load_dataset(str(d))
+        except (OSError, TflocError):
+            continue
     return out
 
 
-def _tracking(run_dir: Path, df: pd.DataFrame, info: Run, thr: Thresholds, with_figures: bool) -> str:
-    """The tracking section of a run's sequence datasets (:mod:`tfloc.report.tracking`); their
-    scores per (sequence, matcher) go to ``tracking.csv``."""
-    from .tracking import sequence_scores, tracking_section
-
-    scenarios = {n: load_dataset(str(d))[0] for n, d in info.paths.items() if n in set(df["dataset"])}
-    maps = _maps(info, set(df["dataset"])) if with_figures else {}
-    sequence_scores(df, scenarios, thr).drop(columns="cpu_ms_all").to_csv(
-        run_dir / "tracking.csv", index=False, float_format="%.6g")
-    return tracking_section(df, scenarios, maps, run_dir, thr, figures=with_figures)
+def maps_of(info: RunRecord, names: set[str]) -> dict:
+    """The maps of the run's datasets ``names`` that are on disk (each read once per process)."""
+    return {n: map_for(sc, next(iter(scans.values()))) for n, (sc, scans) in _loaded(info, names).items() if scans}
 
 
-def _relocalization(run_dir: Path, df: pd.DataFrame, info: Run, thr: Thresholds) -> str:
-    """The global section of a run's global datasets (:mod:`tfloc.report.relocalization`)."""
-    from .relocalization import relocalization_section
-
-    maps = _maps(info, set(df["dataset"]))
-    return relocalization_section(df, maps, run_dir, thr)
-
-
-def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
+def write_report(run_dir: str | Path, thresholds: Thresholds | None = None, *,
+                 headline: list[HeadlineRow] | None = None, note: str = "",
+                 landscapes: list[LandscapePanel] = (), stale_code: list[str] | None = None,
                  with_figures: bool = True) -> ReportFiles:
-    """Write report.md, summary.csv and figures/*.png into ``run_dir``; returns their paths.
-    Sequence datasets get the tracking section; the other sections cover the other datasets."""
+    """Write report.md and figures/*.png into ``run_dir`` from its rows and derived tables;
+    returns their paths. ``thresholds``: re-score under other thresholds than the run's (the
+    tables are then the caller's, derived under them); ``headline``: the rows to open with
+    (default: ``headline.csv``); ``note``: why the run has no current truth-free verdict;
+    ``landscapes``: ``tf``'s objective around a few scans, drawn with its section; ``stale_code``:
+    the labels whose rows this checkout's code would not make (``None``: not checked). Sequence
+    datasets get the tracking section; global ones the global section; the others the rest."""
     run_dir = Path(run_dir)
-    df, info = load_run(run_dir)
-    run = info.doc
+    rd = RunDir(run_dir)
+    df, info = rd.results(), rd.info()
     thr = thresholds or info.thresholds
     names = list(df["dataset"].unique())
     seq, glob = info.datasets_in(names, SEQUENCE), info.datasets_in(names, GLOBAL)
     prepared = prepare(df, thr)
-    tf = load_truth_free(run_dir, prepared, sorted(seq), thr)
-    top = headline_section(prepared, {n: info.mode(n) for n in names}, thr, run_dir, tf)
-    tracking = _tracking(run_dir, df[df["dataset"].isin(seq)], info, thr, with_figures) if seq else ""
+    rows = headline if headline is not None else rd.read(HEADLINE)
+    tf = load_truth_free(rd, sorted(seq), note)
+    top = headline_section(rows, thr, tf.note)
+    scenarios = {n: sc for n, (sc, _) in _loaded(info, seq | glob).items()}
+    tracking = ""
     if seq:
+        from .tracking import tracking_section
+
+        maps = maps_of(info, seq) if with_figures else {}
+        tracking = tracking_section(rd, df[df["dataset"].isin(seq)], scenarios, maps, thr, figures=with_figures)
         blind = sorted(n for n in seq if not prepared.loc[prepared["dataset"] == n, "truth"].any())
         tracking += "\n" + truth_free_section(tf, blind)
     if glob:
-        tracking = _relocalization(run_dir, df[df["dataset"].isin(glob)], info, thr) + "\n" + tracking
+        from .relocalization import relocalization_section
+
+        tracking = relocalization_section(rd, df[df["dataset"].isin(glob)], thr) + "\n" + tracking
     if df["dataset"].isin(seq | glob).all():
-        p = prepared
         report = run_dir / "report.md"
-        report.write_text("\n".join([header(run_dir, run, p, thr, set()), top, tracking]))
-        return ReportFiles(report, run_dir / ("tracking.csv" if seq else "relocalization.csv"), ())
+        report.write_text("\n".join([header(run_dir, info, prepared, thr, set(), stale_code), top, tracking]))
+        return ReportFiles(report, ())
     p = prepare(df[~df["dataset"].isin(seq | glob)], thr)
     s2s = info.datasets_in(list(p["dataset"].unique()), SCAN_TO_SCAN)
     paper = {d: s for d, s in info.paper_scenarios().items() if d in set(p["dataset"])}
-    summary = write_summary(summary_table(p, s2s, paper), run_dir / "summary.csv")
-    order = label_order(run, p)
+    order = label_order(info, p)
     sweep = len(order) > MANY_MATCHERS  # a parameter sweep: compare each label with the first only
-    pt = paired_table(p, s2s, reference=order[0] if sweep else None)
-    pt.to_csv(run_dir / "paired.csv", index=False, float_format="%.6g")
+    pt = rd.frame(PAIRED)
     figs: list[Path] = []
     failures = landscape = ""
     line_labels = line_figure_matchers(p, order) if sweep and with_figures else None
@@ -248,9 +237,9 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None,
         figs = [f for f in made if f is not None]
         drawn = p[p["matcher"] == order[0]] if sweep else p
         failures = failures_section(draw_failures(run_dir, drawn, info.paths))
-        binned = sorted(set(declaring(paper, "II")) | set(declaring(paper, "III")))
-        landscape = landscape_section(*draw_landscapes(run_dir, p, info.paths, binned))
+        landscape = landscape_section(*draw_landscapes(run_dir, list(landscapes)))
     report = run_dir / "report.md"
-    text = render(run_dir, run, p, thr, s2s, figs, pt, failures, landscape, line_labels, sweep, paper, top)
+    text = render(run_dir, info, p, thr, s2s, figs, pt, failures, landscape, line_labels, sweep, paper, top,
+                  stale_code)
     report.write_text(text + ("\n" + tracking if tracking else ""))
-    return ReportFiles(report, summary, tuple(figs))
+    return ReportFiles(report, tuple(figs))

@@ -1,9 +1,8 @@
 """The scaling study's README (tables, slopes, one sentence per matcher) and its figure.
 
-:func:`render_scaling` draws them from the study's run directory alone: the typed rows
-(``scaling.csv``, ``prep.csv``, ``skips.csv``; :mod:`tfloc.io.timing_rows`) as tables, the
-configuration and how it was made from ``run.json`` (:func:`provenance`). The tables are
-:mod:`tfloc.evaluation.scaling`'s (levels, slopes, preparation rows); the study itself is
+:func:`render` draws them from the study's tables (``scaling.csv``, ``prep.csv``, ``skips.csv``
+and the derived ``levels.csv`` and ``slopes.csv``: :func:`tfloc.harness.scaling.derive_scaling`)
+and its record (the configuration and how it was made: :func:`provenance`); the study itself is
 ``tfloc scaling`` (:mod:`tfloc.harness.scaling`).
 """
 
@@ -16,11 +15,8 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from tfloc.core.rows.timing import PrepRow, ScanRow, SkipRow
-from tfloc.errors import ResultsError
-from tfloc.evaluation.scaling import GROWS_SLOPE, level_table, prep_slope_table, slope_table
-from tfloc.io.rundir import RunDir
-from tfloc.io.timing_rows import FILES, read_rows, rows_frame
+from tfloc.core.run import RunRecord, Session
+from tfloc.evaluation.scaling import GROWS_SLOPE, prep_slope_table
 
 from .figures import colours
 from .mdtable import num, table
@@ -260,43 +256,26 @@ def _code(git: dict | None) -> str:
     return f"code `{git['commit'][:7]}`" + (" with uncommitted changes" if git.get("dirty") else "")
 
 
-def provenance(doc: dict) -> dict:
+def provenance(run: RunRecord) -> dict:
     """What the README says of how the study was made, from ``run.json``: the command, cores,
     machine, code, the first start, load averages, and wall and CPU seconds over its sessions."""
-    sessions = doc.get("sessions") or [{}]
-    total = {k: round(sum(float(s.get(k) or 0.0) for s in sessions), 1) for k in ("wall_s", "cpu_s")}
-    machine = doc.get("machine") or {}
-    return {"command": doc.get("command"), "cores": sessions[-1].get("cores"), "cpu": machine.get("cpu"),
-            "python": machine.get("python"), "git": doc.get("git") or {},
-            "started": sessions[0].get("started"), "loadavg_start": sessions[0].get("loadavg_start"),
-            "loadavg_end": sessions[-1].get("loadavg_end"), "sessions": len(sessions), **total}
+    sessions = run.sessions or (Session(),)
+    total = {k: round(sum(float(getattr(s, k) or 0.0) for s in sessions), 1) for k in ("wall_s", "cpu_s")}
+    cores = sessions[-1].cores
+    return {"command": run.command, "cores": list(cores) if cores is not None else None, "cpu": run.machine.cpu,
+            "python": run.machine.python, "git": run.git.to_dict(),
+            "started": sessions[0].started, "loadavg_start": list(sessions[0].loadavg_start or []),
+            "loadavg_end": list(sessions[-1].loadavg_end or []), "sessions": len(sessions), **total}
 
 
-def render_scaling(run_dir: Path) -> pd.DataFrame:
-    """``levels.csv``, ``slopes.csv``, ``scaling.png`` and ``README.md`` of the scaling study in
-    ``run_dir``, from the directory alone (module notes); returns the slopes. A directory that
-    holds no scaling study's ``run.json`` is a :class:`ResultsError`."""
-    rd = RunDir(run_dir)
-    info = rd.info()
-    if info.kind != "scaling":
-        raise ResultsError(f"{rd.path}: no scaling study here (its run.json is missing or not of kind "
-                           "'scaling'; run 'tfloc scaling' first)")
-    rows, prep, skips = (rows_frame(read_rows(rd.path / FILES[c], c), c) for c in (ScanRow, PrepRow, SkipRow))
-    return render(rd.path, rows, prep, skips, info.config_doc.get("scaling", {}), provenance(info.doc))
-
-
-def render(out: Path, rows: pd.DataFrame, prep: pd.DataFrame, skips: pd.DataFrame, config: dict,
-           provenance: dict) -> pd.DataFrame:
-    """``levels.csv``, ``slopes.csv``, ``scaling.png`` and ``README.md`` in ``out`` from the
-    study's tables (of ``scaling.csv``, ``prep.csv``, ``skips.csv``), its configuration and how it
-    was made (:func:`provenance`); returns the slopes."""
-    levels = level_table(rows)
-    slopes = slope_table(levels)
-    levels.to_csv(out / "levels.csv", index=False, float_format="%.6g")
-    slopes.to_csv(out / "slopes.csv", index=False, float_format="%.4g")
+def render(out: Path, rows: pd.DataFrame, prep: pd.DataFrame, skips: pd.DataFrame, levels: pd.DataFrame,
+           slopes: pd.DataFrame, run: RunRecord) -> None:
+    """``scaling.png`` and ``README.md`` in ``out`` from the study's tables (``scaling.csv``,
+    ``prep.csv``, ``skips.csv`` and the derived ``levels.csv``, ``slopes.csv``:
+    :func:`tfloc.harness.scaling.derive_scaling`) and its record."""
     write_figure(out / "scaling.png", levels, slopes, prep)
-    write_readme(out / "README.md", rows, levels, slopes, prep, prep_slope_table(prep), skips, config, provenance)
-    return slopes
+    write_readme(out / "README.md", rows, levels, slopes, prep, prep_slope_table(prep), skips, dict(run.study),
+                 provenance(run))
 
 
 def _plain_ticks(ax) -> None:

@@ -8,11 +8,10 @@ from __future__ import annotations
 
 import pandas as pd
 
-from tfloc.evaluation.metrics import summarize
+from tfloc.evaluation.metrics import status_kinds, summarize
 from tfloc.evaluation.outcome import OUTCOMES
 from tfloc.evaluation.paired import ALPHA
 from tfloc.evaluation.paper import PAPER_TF, TABLE_OF, paper_row
-from tfloc.io.estimates import status_kinds
 
 from .mdtable import num, pm, table
 

@@ -1,5 +1,6 @@
-"""``RUN/timing.md``: the side-by-side timing pass (:mod:`tfloc.harness.timing`) as a table, and
-its rows as ``RUN/timing.csv`` (:mod:`tfloc.io.timing_rows`)."""
+"""``RUN/timing.md``: the side-by-side timing pass (:mod:`tfloc.harness.timing`; its rows are
+``RUN/timing.csv``, written by :mod:`tfloc.harness.timing_pass`) as a table, and the report's line
+comparing the run's own CPU times with it."""
 
 from __future__ import annotations
 
@@ -8,12 +9,11 @@ from pathlib import Path
 import pandas as pd
 
 from tfloc.core.run import TimingRecord
-from tfloc.core.rows.timing import TimingRow
 from tfloc.evaluation.contention import MAX_INFLATION, Contention, describe, mark
 from tfloc.evaluation.timing import timing_summary
 from tfloc.io.atomic import replace_atomically
 from tfloc.io.rundir import RunDir
-from tfloc.io.timing_rows import read_rows, rows_frame, write_rows
+from tfloc.io.tables import TIMING
 
 from .mdtable import num, table
 
@@ -62,16 +62,15 @@ def run_cpu_note(run_dir: Path, df: pd.DataFrame) -> list[str]:
     :func:`run_inflation_line`), the pass's contention mark beside it; none without a pass or CPU
     times. ``df``: the run's rows (``cpu_s``, or a prepared table's ``cpu_ms``)."""
     rd = RunDir(run_dir)
-    rows = read_rows(rd.timing_csv, TimingRow)
-    if not rows:
+    t = rd.frame(TIMING)
+    if t.empty:
         return []
     if "cpu_s" not in df and "cpu_ms" in df:
-        df = df.assign(cpu_s=pd.to_numeric(df["cpu_ms"], errors="coerce") / 1000.0)
-    t = rows_frame(rows, TimingRow)
+        df = df.assign(cpu_s=df["cpu_ms"] / 1000.0)
     line = run_inflation_line(timing_summary(t, str(t["matcher"].iloc[0]), df),
                               "its timing pass ([timing.md](timing.md), same scans)")
     last = (rd.info().timing or TimingRecord()).last_session
-    c = Contention.from_record(last.get("contention"))
+    c = Contention.from_record(last.contention)
     tail = (" The timing pass's own contention was not measured (made before the contention probe)."
             if c is None else f" The timing pass itself ran {mark(c)}." if c.contended else "")
     return [line + tail] if line else []
@@ -128,12 +127,9 @@ def timing_markdown(run_name: str, summary: pd.DataFrame, reference: str, info: 
         table(headers, rows)])
 
 
-def write_timing(run_dir: Path, rows: list[TimingRow], summary: pd.DataFrame, reference: str,
-                 info: dict, name: str) -> tuple[Path, Path]:
-    """Write ``timing.csv`` (one row per scan × matcher) and ``timing.md``, each atomically;
-    returns both paths."""
+def write_timing_md(run_dir: Path, summary: pd.DataFrame, reference: str, info: dict, name: str) -> Path:
+    """Write ``timing.md`` atomically (the pass's summary, :func:`timing_markdown`); returns it."""
     rd = RunDir(run_dir)
-    write_rows(rd.timing_csv, rows, TimingRow)
     text = timing_markdown(name, summary, reference, info)
     replace_atomically(rd.timing_md, lambda fh: fh.write(text))
-    return rd.timing_csv, rd.timing_md
+    return rd.timing_md

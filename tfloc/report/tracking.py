@@ -1,8 +1,10 @@
-"""The tracking section of a report: one table per sequence set and figures, from a run's rows.
+"""The tracking section of a report: one table per sequence set and figures, drawn from a run's
+rows and the tracking tables derived from them (``tracking.csv``, ``kidnap.csv``, ``start.csv``:
+:mod:`tfloc.evaluation.sequences`, written by :mod:`tfloc.harness.derive`).
 
-Input: the estimate rows of sequence datasets (a DataFrame as
-:func:`tfloc.io.estimates.read_estimates` gives, one row per scan and matcher, each (dataset,
-matcher)'s rows in scan order as the tracking loop writes them) and the datasets' scenarios.
+Input: the estimate rows of sequence datasets (one row per scan and matcher, each (dataset,
+matcher)'s rows in scan order as the tracking loop writes them), the datasets' scenarios and the
+run directory's store.
 A **sequence set** is the datasets of one condition (``scenario.json`` ``set``, else
 ``condition.name``: easy, rate-1hz, …, real); its table has one row per matcher (dead reckoning, ``odometry``, included as
 the floor): the tracked share pooled over the set's scans with a 95 % bootstrap interval over
@@ -12,10 +14,9 @@ sequences, the longest lost stretch, APE translation RMSE pooled over scans (cm)
 :mod:`tfloc.evaluation.trajectory`. Figures: each sequence's trajectories drawn on the map per
 matcher, the distance error over distance travelled, and each tracker's first jumps
 (:mod:`tfloc.report.jumps`). Sets whose sequences have kidnap events
-(``scenario.json`` ``"kidnaps"``) get a kidnap table too (:func:`kidnap_tables`;
-:mod:`tfloc.evaluation.kidnap`), their events one row each in ``kidnap.csv``. Sets where a
-tracker starts without a pose (its first row's ``info`` says so) get a start table
-(:func:`start_tables`; :mod:`tfloc.evaluation.global_start`), one row per sequence in ``start.csv``.
+(``scenario.json`` ``"kidnaps"``) get a kidnap table too (:func:`kidnap_tables`, from
+``kidnap.csv``). Sets where a tracker starts without a pose (its first row's ``info`` says so)
+get a start table (:func:`start_tables`, from ``start.csv``).
 """
 
 from __future__ import annotations
@@ -29,18 +30,14 @@ import numpy as np
 import pandas as pd
 
 from tfloc.core.thresholds import Thresholds
-from tfloc.evaluation.global_start import SETTLE_M, SETTLE_SCANS, score_start, starts_without_pose
-from tfloc.evaluation.kidnap import HOLD, WITHIN, median_scans, score_kidnaps
+from tfloc.evaluation.global_start import SETTLE_M, SETTLE_SCANS
+from tfloc.evaluation.kidnap import HOLD, WITHIN, median_scans
 from tfloc.evaluation.metrics import has_truth
-from tfloc.evaluation.trajectory import (
-    LOST_DIST_M,
-    LOST_ORIENT_DEG,
-    pooled_share,
-    score_rows,
-)
+from tfloc.evaluation.trajectory import LOST_DIST_M, LOST_ORIENT_DEG, pooled_share
+from tfloc.io.rundir import RunDir
 from tfloc.io.scenario import Scenario
+from tfloc.io.tables import KIDNAP, START, TRACKING
 
-from .figures import pose_columns
 from .jumps import fig_jumps
 from .mdtable import num, table
 from .tracking_figures import DEAD_RECKONING, fig_error_distance, fig_trajectories, order
@@ -48,27 +45,14 @@ from .tracking_figures import DEAD_RECKONING, fig_error_distance, fig_trajectori
 DEFAULT = Thresholds()
 
 
-def condition_of(scenario: Scenario | None, rows: pd.DataFrame) -> str:
-    """The sequence set of a dataset: its scenario's ``set``, else its ``condition.name``, else
-    its rows' group."""
-    extra = scenario.extra if scenario is not None else {}
-    return str(extra.get("set") or (extra.get("condition") or {}).get("name") or rows["group"].iloc[0])
+def _cpu_ms(df: pd.DataFrame) -> dict[tuple[str, str], np.ndarray]:
+    """Per (dataset, tracker), its CPU per step (ms) along the sequence."""
+    return {k: g["cpu_s"].to_numpy(float) * 1e3 for k, g in df.groupby(["dataset", "matcher"], sort=False)}
 
 
-def sequence_scores(df: pd.DataFrame, datasets: dict[str, Scenario],
-                    thresholds: Thresholds = DEFAULT) -> pd.DataFrame:
-    """One row per (dataset, matcher): its condition and every score of
-    :class:`~tfloc.evaluation.trajectory.TrackScore`."""
-    out = []
-    for (ds, m), g in df.groupby(["dataset", "matcher"], sort=False):
-        s = score_rows(g, thresholds).to_dict()
-        out.append({"dataset": ds, "matcher": m, "condition": condition_of(datasets.get(ds), g),
-                    "cpu_ms_all": pd.to_numeric(g["cpu_s"], errors="coerce").to_numpy(float) * 1e3, **s})
-    return pd.DataFrame(out)
-
-
-def condition_table(s: pd.DataFrame) -> str:
-    """The markdown table of one sequence set (rows of :func:`sequence_scores`)."""
+def condition_table(s: pd.DataFrame, cpu_ms: dict[tuple[str, str], np.ndarray]) -> str:
+    """The markdown table of one sequence set (rows of ``tracking.csv``; ``cpu_ms``: each
+    (dataset, tracker)'s CPU per step)."""
     rows = []
     for m in order(s["matcher"]):
         g = s[s["matcher"] == m]
@@ -76,7 +60,7 @@ def condition_table(s: pd.DataFrame) -> str:
         ci = "" if math.isnan(lo) else f" [{100 * lo:.1f}, {100 * hi:.1f}]"
         n = g["n_truth"].to_numpy(float)
         ape = math.sqrt(float((n * g["ape_rmse_m"].to_numpy(float) ** 2).sum() / n.sum())) if n.sum() else math.nan
-        cpu = np.concatenate(list(g["cpu_ms_all"])) if len(g) else np.array([])
+        cpu = np.concatenate([cpu_ms.get((d, m), np.array([])) for d in g["dataset"]]) if len(g) else np.array([])
         cpu = cpu[np.isfinite(cpu)]
         jumps = "—" if m == DEAD_RECKONING else f"{int(g['jumps'].sum())} ({num(g['max_jump_m'].max(), 2)})"
         rows.append([m, f"{100 * share:.1f}{ci}", int(g["losses"].sum()), int(g["recoveries"].sum()),
@@ -88,7 +72,8 @@ def condition_table(s: pd.DataFrame) -> str:
                   "jumps > 1 m (largest, m)", "CPU ms/scan (median)"], rows)
 
 
-def tracking_tables(s: pd.DataFrame, datasets: dict[str, Scenario] | None = None) -> str:
+def tracking_tables(s: pd.DataFrame, cpu_ms: dict[tuple[str, str], np.ndarray],
+                    datasets: dict[str, Scenario] | None = None) -> str:
     """One table per sequence set, each headed with its sequences, scans and metres; a set whose
     sequences run on different maps (different buildings) also gets one table per sequence."""
     parts = []
@@ -96,46 +81,22 @@ def tracking_tables(s: pd.DataFrame, datasets: dict[str, Scenario] | None = None
         maps = {str(datasets[d].map_path) for d in g["dataset"] if datasets and d in datasets}
         if len(maps) > 1:
             for ds, one in g.groupby("dataset", sort=False):
-                parts.append(_set_table(f"{cond}: {ds}", one))
-        parts.append(_set_table(cond, g))
+                parts.append(_set_table(f"{cond}: {ds}", one, cpu_ms))
+        parts.append(_set_table(cond, g, cpu_ms))
     return "\n".join(parts)
 
 
-def _set_table(cond: str, g: pd.DataFrame) -> str:
+def _set_table(cond: str, g: pd.DataFrame, cpu_ms: dict[tuple[str, str], np.ndarray]) -> str:
     """The heading and table of one sequence set (or one sequence)."""
     seqs = g.drop_duplicates("dataset")
     scored, steps = int(seqs["n_truth"].sum()), int(seqs["n_scans"].sum())
     scans = f"{scored} scans" if scored == steps else f"{steps} scans, {scored} of them with truth (scored)"
     return (f"**{cond}** ({len(seqs)} sequence{'s' * (len(seqs) != 1)}: {', '.join(seqs['dataset'])}; "
-            f"{scans}, {seqs['distance_m'].sum():.0f} m)\n\n" + condition_table(g))
-
-
-def kidnap_events(df: pd.DataFrame, datasets: dict[str, Scenario],
-                  thresholds: Thresholds = DEFAULT) -> pd.DataFrame:
-    """One row per (kidnapped dataset, matcher, event): its set, the kidnap scan, scans to
-    relocalize (NaN = never) and, on each (dataset, matcher)'s first event row, its false
-    relocalizations and tracked share."""
-    out = []
-    for (ds, m), g in df.groupby(["dataset", "matcher"], sort=False):
-        sc = datasets.get(ds)
-        kid = (sc.extra.get("kidnaps") or []) if sc is not None else []
-        if not kid:
-            continue
-        pos = {str(sid): i for i, sid in enumerate(g["scan_id"].astype(str))}
-        events = [pos[k] for k in map(str, kid) if k in pos]
-        ks = score_kidnaps(pose_columns(g, "est"), pose_columns(g, "true"), pose_columns(g, "init"), events, thresholds)
-        tracked = score_rows(g, thresholds).tracked
-        for i, (e, n) in enumerate(zip(ks.events, ks.scans_to_relocalize, strict=True)):
-            out.append({"dataset": ds, "matcher": m, "set": condition_of(sc, g),
-                        "kidnap_scan": str(g["scan_id"].iloc[e]),
-                        "scans_to_relocalize": math.nan if n is None else n,
-                        "false_relocalizations": len(ks.false_relocalizations) if i == 0 else 0,
-                        "tracked": tracked if i == 0 else math.nan})
-    return pd.DataFrame(out)
+            f"{scans}, {seqs['distance_m'].sum():.0f} m)\n\n" + condition_table(g, cpu_ms))
 
 
 def kidnap_tables(ev: pd.DataFrame) -> str:
-    """One markdown table per kidnapped set (rows of :func:`kidnap_events`): per matcher the
+    """One markdown table per kidnapped set (rows of ``kidnap.csv``): per matcher the
     events, those relocalized within 20 scans, the median scans to relocalize ("never" counted
     as infinitely many), false relocalizations and the tracked share (pooled over sequences)."""
     parts = []
@@ -158,33 +119,8 @@ def kidnap_tables(ev: pd.DataFrame) -> str:
     return "\n".join(parts)
 
 
-def start_scores(df: pd.DataFrame, datasets: dict[str, Scenario],
-                 thresholds: Thresholds = DEFAULT) -> pd.DataFrame:
-    """One row per (dataset, matcher) of a set where some matcher starts without a pose: its set,
-    whether it did (``info["start"]`` of its first row), the start window (to the first kidnap
-    scan, else the end), scans to converge (NaN = never), the scan it first settled at and
-    whether that place was wrong. Empty when no matcher starts without a pose."""
-    out = []
-    for (ds, m), g in df.groupby(["dataset", "matcher"], sort=False):
-        sc = datasets.get(ds)
-        pos = {str(sid): i for i, sid in enumerate(g["scan_id"].astype(str))}
-        kid = [pos[k] for k in map(str, (sc.extra.get("kidnaps") or []) if sc is not None else []) if k in pos]
-        st = score_start(pose_columns(g, "est"), pose_columns(g, "true"), min(kid, default=len(g)), thresholds)
-        first = g["info"].iloc[0] if "info" in g else ""
-        out.append({"dataset": ds, "matcher": m, "set": condition_of(sc, g),
-                    "no_pose": starts_without_pose(json.loads(first) if isinstance(first, str) and first else {}),
-                    "window": st.window,
-                    "scans_to_converge": math.nan if st.scans_to_converge is None else st.scans_to_converge,
-                    "settled": math.nan if st.settled is None else st.settled, "settled_wrong": st.wrong})
-    st = pd.DataFrame(out)
-    if not len(st) or not st["no_pose"].any():
-        return st.iloc[0:0]
-    sets = set(st.loc[st["no_pose"], "set"])
-    return st[st["set"].isin(sets)].reset_index(drop=True)
-
-
 def start_tables(st: pd.DataFrame) -> str:
-    """One markdown table per set of :func:`start_scores`: per matcher its start (no pose or
+    """One markdown table per set of ``start.csv``: per matcher its start (no pose or
     given), the sequences it converged on within the start window, scans to converge per
     sequence and their median ("never" counted as infinitely many), and the sequences where it
     first settled on a wrong place."""
@@ -248,8 +184,8 @@ def relations_tables(df: pd.DataFrame, datasets: dict[str, Scenario]) -> str:
     """For every sequence that names a relations file (``scenario.json`` ``"relations"``), the
     relation errors of each matcher's tracked trajectory (Kümmerle et al. 2009; mean ± sample
     std, every relation whose two stamps are rows), beside the published figures."""
-    from tfloc.evaluation.relations import relations_path, tracked_relation_stats
-    from tfloc.io.relations import read_relations
+    from tfloc.evaluation.relations import tracked_relation_stats
+    from tfloc.io.relations import read_relations, relations_path
     from tfloc.io.scenario import read_scans
 
     from .relations_note import PUBLISHED_CSAIL
@@ -266,7 +202,7 @@ def relations_tables(df: pd.DataFrame, datasets: dict[str, Scenario]) -> str:
         for m in order(g["matcher"]):
             r = g[g["matcher"] == m]
             st = r["scan_id"].map(stamp).to_numpy(float)
-            est = r[["est_x", "est_y", "est_theta"]].apply(pd.to_numeric, errors="coerce").to_numpy(float)
+            est = r[["est_x", "est_y", "est_theta"]].to_numpy(float)
             x = tracked_relation_stats(st, est, relations)
             rows.append([f"`{m}`", f"{x['n']} of {x['n_relations']}", f"{x['trans_mean_m']:.3f} ± {x['trans_std_m']:.3f}",
                          num(x["trans_max_m"], 2), f"{x['rot_mean_deg']:.2f} ± {x['rot_std_deg']:.2f}",
@@ -302,17 +238,19 @@ def _own_odometry_rules(df: pd.DataFrame) -> list[str]:
     return lines
 
 
-def tracking_section(df: pd.DataFrame, datasets: dict[str, Scenario], maps: dict[str, object],
-                     out_dir: Path, thresholds: Thresholds = DEFAULT,
-                     figures: bool = True) -> str:
+def tracking_section(rd: RunDir, df: pd.DataFrame, datasets: dict[str, Scenario], maps: dict[str, object],
+                     thresholds: Thresholds = DEFAULT, figures: bool = True) -> str:
     """The markdown of the tracking section (tables, then figures written under
-    ``out_dir/figures/tracking/``); ``maps``: dataset name → its map, for the figures. A
-    dataset without truth gets no truth-based figure or table: its trajectories and jumps only
-    (the truth-free verdict ranks it, :mod:`tfloc.report.truthfree`)."""
+    ``RUN/figures/tracking/``); ``df``: the rows of the run's sequence datasets; ``maps``:
+    dataset name → its map, for the figures. A dataset without truth gets no truth-based figure
+    or table: its trajectories and jumps only (the truth-free verdict ranks it,
+    :mod:`tfloc.report.truthfree`)."""
+    out_dir = rd.path
     truth = has_truth(df).groupby(df["dataset"]).any()
     blind = [d for d in df["dataset"].unique() if not truth.get(d, False)]
     everything, df = df, df[~df["dataset"].isin(blind)]
-    s = sequence_scores(df, datasets, thresholds)
+    scores = rd.frame(TRACKING)
+    s = scores[scores["dataset"].isin(set(df["dataset"]))]
     text = ["## Tracking\n",
             "Each sequence tracked scan by scan from the last estimate composed with the odometry "
             "(no reset); truth only for scoring. tracked = within "
@@ -322,22 +260,20 @@ def tracking_section(df: pd.DataFrame, datasets: dict[str, Scenario], maps: dict
             "than 1 m from the prediction it started from (every scan); `odometry` = dead reckoning, "
             "the floor. Every tracker gets the same odometry, each increment composed whole.\n",
             *_own_odometry_rules(everything),
-            tracking_tables(s, datasets) if len(df) else "", relations_tables(df, datasets),
+            tracking_tables(s, _cpu_ms(df), datasets) if len(df) else "", relations_tables(df, datasets),
             own_score_table(df, thresholds) if len(df) else ""]
     if blind:
         text.append(f"Without ground truth: {', '.join(blind)}: no truth-based figure; ranked by the "
                     "truth-free verdict (below); their trajectories and first jumps are drawn.\n")
-    ev = kidnap_events(df, datasets, thresholds)
+    ev = rd.frame(KIDNAP)
     if len(ev):
-        ev.to_csv(Path(out_dir) / "kidnap.csv", index=False, float_format="%.6g")
         text += ["\nKidnap events (the robot moved 5–20 m and turned, unseen by the odometry): "
                  "relocalized = the first scan after the event within the thresholds that stays "
                  "there for 3 scans (never: not before the next event or the end); a false "
                  "relocalization = the estimate jumps > 1 m from its prediction, away from a "
                  "correct pose to a wrong one. Per event: `kidnap.csv`.\n", kidnap_tables(ev)]
-    st = start_scores(df, datasets, thresholds)
+    st = rd.frame(START)
     if len(st):
-        st.to_csv(Path(out_dir) / "start.csv", index=False, float_format="%.6g")
         text += [f"\nThe start, for sets where a tracker starts without a pose (its first row says "
                  "`\"start\": \"global\"`: it ignored the first row's pose; the others, given it, are "
                  "the reference): converged = the first scan within the thresholds that stays there "

@@ -11,10 +11,11 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from tfloc.core.tracker import DeadReckoning
+from tfloc.evaluation.sequences import poses as pose_columns
 from tfloc.evaluation.trajectory import LOST_DIST_M, errors, path_length
 from tfloc.io.scenario import Scenario
 
-from .figures import MAP_SPACING_M, colours, pose_columns
+from .figures import MAP_SPACING_M, colours
 
 DEAD_RECKONING = DeadReckoning.name  # the floor, shown last
 

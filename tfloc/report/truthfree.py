@@ -1,39 +1,34 @@
 """The report's truth-free parts: the verdict's tables, its check against the truth, and every
-tracker's self-assessment (its own confidence as a lost-detector, written to ``selfassess.csv``).
+tracker's self-assessment (its own confidence as a lost-detector, ``selfassess.csv``).
 
-The verdict itself is made by ``tfloc verdict`` (:mod:`tfloc.report.verdict`); this module only
-reads its files. A verdict of other rows than the run's (stale) is not used: the report says so.
+The verdict is made by ``tfloc verdict`` (:mod:`tfloc.harness.verdict`), the self-assessments by
+the derive step (:mod:`tfloc.harness.derive`); this module reads their files through the store
+and draws them. A verdict of other rows than the run's (stale) is not shown: the report says so.
 On a dataset without truth nothing here prints a truth-based figure.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
-from pathlib import Path
+from dataclasses import dataclass, field
 
 import pandas as pd
 
-from tfloc.core.thresholds import Thresholds
+from tfloc.core.rows.tracking import SelfAssessment
 from tfloc.core.traits import confidence_of
-from tfloc.evaluation.headline import Extras, Verdicts
-from tfloc.evaluation.selfassess import FALSE_ALARM, SelfAssessment, self_assessments
+from tfloc.evaluation.selfassess import FALSE_ALARM
 from tfloc.io.rundir import RunDir
+from tfloc.io.tables import SELFASSESS, VERDICT, VERDICT_AGREEMENT, VERDICT_FLAGS
 
 from .mdtable import num, table
-from .verdict import read_verdict
 
 
 @dataclass(frozen=True)
 class TruthFree:
-    """What the headline and the tracking section take from the truth-free files: per-scan
-    beliefs (``dataset, scan_id, matcher, believed``; ``None`` without a verdict), the verdict's
-    score and the self-assessment AUC per (scope, matcher), the verdict and agreement tables, the
-    self-assessments, and a note (why there is no verdict, or ``""``)."""
+    """What the tracking section draws from the truth-free files: the verdict and agreement
+    tables and the flagged stretches (``None`` without a current verdict), the self-assessments,
+    and a note (why there is no verdict, or ``""``)."""
 
-    beliefs: pd.DataFrame | None
-    free: Verdicts
-    auc: Extras
     verdict: pd.DataFrame | None
     agreement: pd.DataFrame | None
     assessments: list[SelfAssessment] = field(default_factory=list)
@@ -41,28 +36,16 @@ class TruthFree:
     flags: pd.DataFrame | None = None
 
 
-def load_truth_free(run_dir: Path, p: pd.DataFrame, sequences: list[str], thr: Thresholds) -> TruthFree:
-    """The truth-free parts of a run (prepared rows ``p``; its sequence datasets ``sequences``);
-    writes ``selfassess.csv`` where a tracker reports a confidence."""
-    rd = RunDir(Path(run_dir))
-    assessments = self_assessments(p, sequences, thr)
-    out = rd.path / "selfassess.csv"
-    if assessments:
-        pd.DataFrame([asdict(a) for a in assessments]).to_csv(out, index=False, float_format="%.6g")
-    else:
-        out.unlink(missing_ok=True)
-    auc = {(a.scope, a.matcher): a.auc for a in assessments}
-    v, note = read_verdict(rd.path) if sequences else (None, "")
-    if v is None or note:
-        return TruthFree(None, {}, auc, None, None, assessments, note)
-    free = {(str(r.dataset), str(r.matcher)): (float(r.score_pct), float(r.lo_pct), float(r.hi_pct))
-            for r in v.itertuples()}
-    beliefs = pd.read_csv(rd.verdict_scans, usecols=["dataset", "scan_id", "matcher", "believed"],
-                          dtype={"dataset": str, "scan_id": str, "matcher": str}) \
-        if rd.verdict_scans.is_file() else None
-    agree = pd.read_csv(rd.verdict_agreement) if rd.verdict_agreement.is_file() else None
-    flags = pd.read_csv(rd.verdict_flags, dtype=str) if rd.verdict_flags.is_file() else None
-    return TruthFree(beliefs, free, auc, v, agree, assessments, "", flags)
+def load_truth_free(rd: RunDir, sequences: list[str], note: str = "") -> TruthFree:
+    """The truth-free parts of a run with sequence datasets ``sequences`` (``note``: why its
+    verdict is missing or stale, ``""`` when it is current)."""
+    assessments = rd.read(SELFASSESS) if sequences else []
+    if not sequences or note or not rd.has(VERDICT):
+        return TruthFree(None, None, assessments, note or ("" if not sequences else
+                                                           "no truth-free verdict yet (tfloc verdict RUN)"))
+    agree = rd.frame(VERDICT_AGREEMENT) if rd.has(VERDICT_AGREEMENT) else None
+    flags = rd.frame(VERDICT_FLAGS) if rd.has(VERDICT_FLAGS) else None
+    return TruthFree(rd.frame(VERDICT), agree, assessments, "", flags)
 
 
 #: flagged stretches listed per recording in the report (the rest: ``verdict_flags.csv``)

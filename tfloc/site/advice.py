@@ -9,7 +9,8 @@ import math
 from dataclasses import dataclass
 
 from tfloc.core.modes import GLOBAL, SEQUENCE, SINGLE
-from tfloc.evaluation.headline import POOLED, TRUTH_FREE
+from tfloc.core.rows.headline import POOLED
+from tfloc.evaluation.headline import TRUTH_FREE
 
 from .board import Board, Column
 from .kinds import REAL, SIMULATED
@@ -61,11 +62,6 @@ def _names(cols: list[Column]) -> str:
     return ", ".join(c.scope for c in cols)
 
 
-def _caveat(cols: list[Column]) -> str:
-    return (" (provisional: rows from the run's older tables, no paired test yet)"
-            if any(c.provisional for c in cols) else "")
-
-
 def cheapest_as_good(board: Board, cols: list[Column], question: str, what: str) -> Statement:
     """The cheapest matcher within :data:`WITHIN_POINTS` of the best share on every column."""
     if not cols:
@@ -80,13 +76,13 @@ def cheapest_as_good(board: Board, cols: list[Column], question: str, what: str)
     if not priced:
         return Statement(question, f"{', '.join(f'`{m}`' for m in ok)} within {WITHIN_POINTS:g} point of the best on "
                                    f"every one of {what} in `results/{run}/`; the run has no CPU figure to "
-                                   f"choose between them{_caveat(cols)}.", (run,))
+                                   f"choose between them.", (run,))
     m = priced[0]
     others = ", ".join(f"`{o}` {_cpu(board, o, cols):.3g} ms" for o in priced[1:])
     rest = f"; also within it: {others}" if others else "; no other matcher is"
     return Statement(question, f"`{m}`: the cheapest matcher within {WITHIN_POINTS:g} point of the best share on "
                                f"every one of {what} ({_names(cols)}: {_shares(board, m, cols)}) at "
-                               f"{_cpu(board, m, cols):.3g} ms CPU or less{rest}{_caveat(cols)}. "
+                               f"{_cpu(board, m, cols):.3g} ms CPU or less{rest}. "
                                f"From `results/{run}/`.", (run,))
 
 
@@ -106,9 +102,7 @@ def leader(board: Board, cols: list[Column], question: str, what: str) -> Statem
             r = board.cell(m, c).row
             if r.verdict == "tied":
                 tied.setdefault(r.next_matcher, []).append(c.scope)
-        if _caveat(cols):
-            sep = "provisional: rows from the run's older tables, no paired test yet"
-        elif len(ahead) == len(cols):
+        if len(ahead) == len(cols):
             sep = "the paired test puts it ahead of the next on every one"
         else:
             sep = f"the paired test puts it ahead of the next on {len(ahead)} of {len(cols)}" + "".join(
@@ -119,7 +113,7 @@ def leader(board: Board, cols: list[Column], question: str, what: str) -> Statem
                                    f"{_shares(board, m, cols)}){cost}; {sep}. From `results/{run}/`.", (run,))
     per = "; ".join(f"{c.scope}: `{firsts[c.key]}`" + (" (ahead)" if firsts[c.key] and board.cell(firsts[c.key], c).best
                                                         else "") for c in cols)
-    return Statement(question, f"No one matcher ranks first on all {what}: {per}{_caveat(cols)}. "
+    return Statement(question, f"No one matcher ranks first on all {what}: {per}. "
                                f"From `results/{run}/`.", (run,))
 
 
@@ -135,7 +129,7 @@ def most_often_near(board: Board, cols: list[Column], question: str, what: str) 
     gap, where = max(gaps)
     worst = f"; its largest gap to the best: {gap:.1f} points on {where}" if gap > WITHIN_POINTS else ""
     return Statement(question, f"`{m}` is within {WITHIN_POINTS:g} point of the best on {len(near[m])} of "
-                               f"{len(cols)} {what}{worst}{_caveat(cols)}. From `results/{run}/`.", (run,))
+                               f"{len(cols)} {what}{worst}. From `results/{run}/`.", (run,))
 
 
 def knows_when_lost(board: Board, question: str) -> Statement:

@@ -8,7 +8,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from tfloc.evaluation.headline import POOLED, TRUTH_FREE, HeadlineRow
+from tfloc.core.rows.headline import POOLED, HeadlineRow
+from tfloc.evaluation.headline import TRUTH_FREE
 from tfloc.report.headline import interval
 
 from .pages import Page
@@ -24,7 +25,6 @@ class Column:
     mode: str
     scope: str
     measure: str
-    provisional: bool = False
     figure: str = ""  # a headline row's extra figure shown instead of its measure (:data:`EXTRAS`)
     note: str = ""  #: shown after the label, e.g. a re-timing's ``contended (×1.42 inflated)``
     kind: str = ""
@@ -120,10 +120,10 @@ def _columns(rr: RunRows, modes: tuple[str, ...], short: bool) -> list[Column]:
         if short and scopes:
             scopes = scopes[:1]
         measure = {r.scope: r.measure for r in rows}
-        cols = [Column(rr.name, mode, s, measure[s], rr.provisional, kind=rr.kinds.get(s, "")) for s in scopes]
+        cols = [Column(rr.name, mode, s, measure[s], kind=rr.kinds.get(s, "")) for s in scopes]
         if not short and cols and measure[cols[0].scope] != TRUTH_FREE:  # the first column's extras
             top, c0 = [r for r in rows if r.scope == cols[0].scope], cols[0]
-            cols[1:1] = [Column(rr.name, mode, c0.scope, c0.measure, rr.provisional, figure=f, kind=c0.kind)
+            cols[1:1] = [Column(rr.name, mode, c0.scope, c0.measure, figure=f, kind=c0.kind)
                          for f in EXTRAS if any(math.isfinite(getattr(r, f)) for r in top)]
         out += cols
     return out

@@ -1,8 +1,9 @@
-"""Everything the site shows, read from a results root once: each page's runs' headline rows
-(:mod:`tfloc.site.rows`), the re-timings and the scaling slopes of the cost page, and the
-leaderboards and statements built from them. With :mod:`tfloc.site.rows` (a run's rows) and
-:mod:`tfloc.site.runs` (its ``run.json`` and datasets), the only modules of the package that read
-the results root's tables; the renderers take what it returns (a run's page reads its notes)."""
+"""Everything the site shows, read from a results root once, each table through the store
+(:class:`tfloc.io.rundir.RunDir`): each page's runs' headline rows (:mod:`tfloc.site.rows`), the
+re-timings and the scaling slopes of the cost page, and the leaderboards and statements built
+from them. With :mod:`tfloc.site.rows` (a run's rows) and :mod:`tfloc.site.runs` (its
+``run.json`` and datasets), the only modules of the site that read a run directory; the
+renderers take what it returns (a run's page reads its notes)."""
 
 from __future__ import annotations
 
@@ -12,12 +13,15 @@ from pathlib import Path
 import pandas as pd
 
 from tfloc.evaluation.contention import Contention, mark
+from tfloc.io.rundir import RunDir
+from tfloc.io.table import Table
+from tfloc.io.tables import SELFASSESS, SLOPES, TIMING, TRACKING, VERDICT_AGREEMENT
 
 from .advice import Statement, statements
 from .board import Board, headline_board, unique_dirs
-from .cost import SLOPES_CSV, cpu_board, slopes_board
+from .cost import cpu_board, slopes_board
 from .pages import COST, Page, load_pages
-from .rows import SOURCES, RunRows, run_rows
+from .rows import RunRows, run_rows
 from .runs import run_info
 from .targets import NATIVE_RUNS, SIMULATED_RUN, targets_markdown
 
@@ -37,10 +41,9 @@ class SiteData:
     self_assessment: str = ""  #: every tracker's self-assessment (Markdown)
 
 
-def _csv(path: Path) -> pd.DataFrame | None:
-    if not path.is_file():
-        return None
-    df = pd.read_csv(path, keep_default_na=False, na_values=[""])
+def _table(run_dir: Path, table: Table) -> pd.DataFrame | None:
+    """``table`` of the run in ``run_dir`` through the store (None where it has none)."""
+    df = RunDir(run_dir).frame(table)
     return None if df.empty else df
 
 
@@ -51,11 +54,11 @@ def collect(root: Path, quick: bool = False, pages: list[Page] | None = None) ->
     pages = pages if pages is not None else load_pages(quick=quick)
     runs = {d: run_rows(root, d) for d in unique_dirs(pages)}
     data = SiteData(root, pages, runs)
-    timing = {d: t for d in runs if (t := _csv(root / d / "timing.csv")) is not None}
+    timing = {d: t for d in runs if (t := _table(root / d, TIMING)) is not None}
     for p in pages:
         if p.key == COST:
             data.boards[COST] = cpu_board(pages, runs, timing, {d: timing_mark(root / d) for d in timing})
-            slopes = {r.dir: s for r in p.runs if (s := _csv(root / r.dir / SLOPES_CSV)) is not None}
+            slopes = {r.dir: s for r in p.runs if (s := _table(root / r.dir, SLOPES)) is not None}
             data.boards[f"{COST}-slopes"] = slopes_board(slopes)
             continue
         data.boards[p.key] = headline_board(p, runs)
@@ -72,8 +75,8 @@ def _truth_free(root: Path) -> tuple[str, str]:
 
     from .truthfree import DEV_STUDY, RUNS, agreement_markdown, selfassess_markdown
 
-    agree = {r: t for r in RUNS if (t := _csv(root / r / "verdict_agreement.csv")) is not None}
-    assess = {r: t for r in RUNS if (t := _csv(root / r / "selfassess.csv")) is not None}
+    agree = {r: t for r in RUNS if (t := _table(root / r, VERDICT_AGREEMENT)) is not None}
+    assess = {r: t for r in RUNS if (t := _table(root / r, SELFASSESS)) is not None}
     dev = {d.name for d in load_study(DEV_STUDY).run.datasets} if Path(DEV_STUDY).is_file() else set()
     return agreement_markdown(agree, dev), selfassess_markdown(assess)
 
@@ -82,20 +85,19 @@ def timing_mark(run_dir: Path) -> str:
     """The contention mark of the run's timing pass (``contended (×f inflated)``; empty when quiet,
     not measured by an older pass, or the run's record is unreadable)."""
     timing = run_info(run_dir).timing   # (run.json's sessions are checked to be tables)
-    last = timing.last_session if timing is not None else {}
-    return mark(Contention.from_record(last.get("contention")))
+    return mark(Contention.from_record(timing.last_session.contention) if timing is not None else None)
 
 
 def _reported(root: Path, runs: dict[str, RunRows], name: str) -> RunRows | None:
     rr = runs.get(name) or run_rows(root, name)
-    return rr if rr.source == SOURCES[0] else None
+    return rr if rr.reported else None
 
 
 def _targets(root: Path, runs: dict[str, RunRows]) -> str:
     """The targets block from the first native run with a headline and ``tracking.csv``."""
     native = None
     for name in NATIVE_RUNS:
-        rr, tracking = _reported(root, runs, name), _csv(root / name / "tracking.csv")
+        rr, tracking = _reported(root, runs, name), _table(root / name, TRACKING)
         if rr is not None and tracking is not None:
             native = (name, rr.rows, tracking)
             break
@@ -110,8 +112,6 @@ def run_note(rr: RunRows | None, name: str, table: str | None = None) -> str:
         return f"`results/{name}/`: not yet run"
     if table is not None:
         return f"`results/{name}/`: `{table}`"
-    if not rr.source:
+    if not rr.reported:
         return f"`results/{name}/`: no headline yet (run `tfloc report results/{name}`)"
-    if rr.provisional:
-        return f"`results/{name}/`: provisional, from `{rr.source}` (no `headline.csv` yet)"
     return f"`results/{name}/`: `headline.csv`"

@@ -10,17 +10,18 @@ import math
 
 import pandas as pd
 
-from tfloc.evaluation.headline import POOLED
+from tfloc.core.rows.headline import POOLED
+from tfloc.io.tables import SLOPES as SLOPES_TABLE
 
 from .board import Board, Cell, Column, order
 from .pages import COST, Page
 from .rows import RunRows
 
 SLOPES = "slopes"  #: the slopes board's key
-SLOPES_CSV = "slopes.csv"  #: the scaling study's file that board reads
+SLOPES_CSV = SLOPES_TABLE.name  #: the scaling study's file that board reads
 
 QUIET = "re-timing"
-#: a run without a pooled CPU figure (provisional rows) shows each dataset's if it has at most this many
+#: a run without a pooled CPU figure shows each dataset's if it has at most this many
 MAX_SPLIT = 3
 
 
@@ -51,7 +52,7 @@ def cpu_board(pages: list[Page], runs: dict[str, RunRows], timing: dict[str, pd.
                 scopes = {r.scope for r in rows if r.scope != POOLED}
                 keep = pooled or ([r for r in rows if r.scope != POOLED] if len(scopes) <= MAX_SPLIT else [])
                 for scope in dict.fromkeys(r.scope for r in keep):
-                    col = Column(ref.dir, mode, scope, "CPU ms", rr.provisional)
+                    col = Column(ref.dir, mode, scope, "CPU ms")
                     columns.append(col)
                     for r in (r for r in keep if r.scope == scope):
                         cells[(r.matcher, col.key)] = Cell(r.cpu_ms, _ms(r.cpu_ms), "", f"median CPU per "

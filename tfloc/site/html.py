@@ -72,7 +72,7 @@ def board_html(board: Board, families: dict[str, Family], labels: dict[str, str]
     heads = ['<th data-first="ascending"><button type="button">matcher</button></th>',
              '<th data-first="ascending"><button type="button">family</button></th>']
     for c in board.columns:
-        what = f"{labels.get(c.run, c.run)}: {c.measure}" + (" (provisional)" if c.provisional else "")
+        what = f"{labels.get(c.run, c.run)}: {c.measure}"
         heads.append(f'<th data-first="{first}" data-col="{html.escape(c.key)}" title="{html.escape(what)}">'
                      f'<button type="button">{html.escape(c.label)}</button>'
                      f'<span class="run">{html.escape(c.run)}</span></th>')

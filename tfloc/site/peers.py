@@ -10,10 +10,12 @@ from pathlib import Path
 
 import pandas as pd
 
+from tfloc.core.rows.headline import POOLED
+from tfloc.io.rundir import RunDir
+from tfloc.io.tables import HEADLINE
 from tfloc.report.mdtable import table
 
 PREFIX = "peers."
-POOLED = "all"
 
 
 def is_peers(name: str) -> bool:
@@ -31,10 +33,11 @@ def _cell(r: pd.Series | None, n: int) -> str:
 def peers_markdown(name: str, root: Path) -> str:
     """Block ``peers.RUN.M1.M2...`` from ``root/RUN/headline.csv`` (module notes)."""
     run, *matchers = name.removeprefix(PREFIX).split(".")
-    path = root / run / "headline.csv"
+    rd = RunDir(root / run)
+    path = rd.file(HEADLINE)
     if not path.is_file() or not matchers:
         return f"_Not yet: no {path.relative_to(root.parent) if root.parent in path.parents else path}._\n"
-    df = pd.read_csv(path, keep_default_na=False, na_values=[""])
+    df = rd.frame(HEADLINE)
     df = df[df["mode"] == df["mode"].iloc[0]] if len(df) else df   # the run's first mode
     scopes = list(dict.fromkeys(df["scope"]))
     body = []

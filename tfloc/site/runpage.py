@@ -12,6 +12,8 @@ import os
 from pathlib import Path
 from urllib.parse import unquote, urlsplit
 
+from tfloc.core.run import RunRecord
+
 from .html import markdown, shell
 from .runs import run_info
 
@@ -24,23 +26,21 @@ def anchor(note: str) -> str:
     return "note-" + note.replace(".", "-").lower()
 
 
-def provenance_html(run: dict) -> str:
+def provenance_html(run: RunRecord) -> str:
     """The run's provenance as a definition list (what ``run.json`` records)."""
-    git, machine, sessions = run.get("git", {}), run.get("machine", {}), run.get("sessions", [])
-    commit = git.get("commit", "") or "unknown"
-    items = [("commit", commit + (" (with uncommitted changes)" if git.get("dirty") else "")),
-             ("run", str(run.get("config", {}).get("name", "")))]
-    if sessions:
-        first, last = sessions[0].get("started", ""), sessions[-1].get("ended", sessions[-1].get("started", ""))
-        items.append(("dates", f"{first} → {last} ({len(sessions)} session{'s' * (len(sessions) != 1)})"))
-    if machine:
-        items.append(("machine", ", ".join(f"{k} {v}" for k, v in machine.items() if v not in ("", None))))
-    versions = run.get("versions", {})
-    if versions:
-        items.append(("versions", ", ".join(f"{k} {v}" for k, v in versions.items())))
-    matchers = [m.get("label", "") for m in run.get("config", {}).get("matchers", [])]
-    if matchers:
-        items.append(("matchers", ", ".join(matchers)))
+    items = [("commit", (run.git.commit or "unknown") + (" (with uncommitted changes)" if run.git.dirty else "")),
+             ("run", run.name or "")]
+    if run.sessions:
+        first, last = run.sessions[0].started, run.sessions[-1].ended or run.sessions[-1].started
+        n = len(run.sessions)
+        items.append(("dates", f"{first} → {last} ({n} session{'s' * (n != 1)})"))
+    if run.exists:
+        m = run.machine.to_dict()
+        items.append(("machine", ", ".join(f"{k} {v}" for k, v in m.items() if v not in ("", None, "?"))))
+    if run.versions:
+        items.append(("versions", ", ".join(f"{k} {v}" for k, v in run.versions.items())))
+    if run.matchers:
+        items.append(("matchers", ", ".join(run.labels)))
     body = "".join(f"<dt>{html.escape(k)}</dt><dd>{html.escape(v)}</dd>" for k, v in items)
     return f'<section id="provenance"><h2>Provenance (run.json)</h2><dl class="prov">{body}</dl></section>'
 
@@ -94,7 +94,7 @@ def note_html(text: str, run_dir: Path, page_dir: Path, rendered: set[str]) -> s
 def write_run_page(run_dir: Path, page_dir: Path, title: str, home: str) -> Path:
     """``page_dir/index.html`` for the run in ``run_dir``; returns its path."""
     page_dir.mkdir(parents=True, exist_ok=True)
-    run = run_info(run_dir).doc
+    run = run_info(run_dir)
     notes = [n for n in NOTES if (run_dir / n).is_file()]
     notes += sorted(p.name for p in run_dir.glob("*.md") if p.name not in notes)
     rendered = set(notes)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tfloc.core.run import Run
+from tfloc.core.run import RunRecord
 from tfloc.errors import TflocError
 from tfloc.io.rundir import RunDir
 from tfloc.io.scenario import read_scenario
@@ -20,16 +20,16 @@ from .kinds import dataset_kind
 SCENARIOS = Path("data/scenarios")
 
 
-def run_info(run_dir: Path) -> Run:
-    """The run's checked ``run.json`` (an empty :class:`~tfloc.core.run.Run` when it has none
+def run_info(run_dir: Path) -> RunRecord:
+    """The run's checked ``run.json`` (an empty :class:`~tfloc.core.run.RunRecord` when it has none
     or it is malformed)."""
     try:
         return RunDir(run_dir).info()
     except TflocError:
-        return Run()
+        return RunRecord()
 
 
-def dataset_kinds(info: Run, names: list[str], base: Path | None = None) -> dict[str, str]:
+def dataset_kinds(info: RunRecord, names: list[str], base: Path | None = None) -> dict[str, str]:
     """Dataset name → ``real`` or ``simulated`` (:func:`tfloc.site.kinds.dataset_kind`) for the
     ``names`` whose ``scenario.json`` is readable; the others are left out (kind unknown). A
     relative directory is tried as it is (from where the verb runs) and, with ``base`` (the

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import pandas as pd
 
 from tfloc.core.modes import SEQUENCE
-from tfloc.evaluation.headline import POOLED, HeadlineRow
+from tfloc.core.rows.headline import POOLED, HeadlineRow
 from tfloc.report.mdtable import table
 
 from .kinds import SIMULATED

@@ -28,7 +28,8 @@ class LevelRow:
 @dataclass(frozen=True)
 class SlopeRow:
     """How one matcher's median CPU grows along an axis: the log-log slope over ``levels``, ms per
-    unit of size, the first and last levels' CPU (ms) and sizes, and whether it ``grows``."""
+    unit of size, the first and last levels' CPU (ms) and sizes, and whether it ``grows`` (None:
+    one level only)."""
 
     axis: str
     kind: str
@@ -40,4 +41,4 @@ class SlopeRow:
     last_ms: float
     first_size: float
     last_size: float
-    grows: bool
+    grows: bool | None

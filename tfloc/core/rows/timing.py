@@ -1,7 +1,7 @@
 """The rows of the timing measurements: the timing pass's and the scaling study's.
 
 Like :class:`~tfloc.core.result.ResultRow`, each is a frozen dataclass that every producer,
-reader and table passes around; text exists only at the edge (:mod:`tfloc.io.timing_rows`:
+reader and table passes around; text exists only at the edge (:mod:`tfloc.io.table`:
 ``timing.csv``, ``scaling.csv``, ``prep.csv``, ``skips.csv``, whose columns are these fields in
 order). Times per call are in milliseconds, preparation times in seconds, memory in MB; a value
 not measured is NaN (an empty cell). A status is a :class:`~tfloc.core.result.Status`; a

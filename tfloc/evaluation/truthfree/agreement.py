@@ -12,47 +12,16 @@ tracked). It *agrees* where ρ ≥ :data:`MIN_RHO` and the top is the same or ti
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 from scipy.stats import spearmanr
 
+from tfloc.core.rows.verdict import Agreement, TrackerCheck
 from tfloc.evaluation.paired import ALPHA
 from tfloc.evaluation.stats import mcnemar_exact
 
 #: the rank correlation a verdict must reach to agree with the truth (issue's criterion)
 MIN_RHO = 0.8
-
-
-@dataclass(frozen=True)
-class TrackerCheck:
-    """One tracker's verdict against the truth on one recording (% and scans with truth)."""
-
-    dataset: str
-    matcher: str
-    score_pct: float
-    truth_pct: float
-    truth_scans: int
-    wrong: int
-    missed_losses: int
-    false_alarms: int
-
-
-@dataclass(frozen=True)
-class Agreement:
-    """The verdict's ranking against the truth's on one recording (module notes)."""
-
-    dataset: str
-    trackers: int
-    rho: float
-    truth_top: str
-    verdict_top: str
-    top: str  # "same", "tied" (the paired test does not separate them) or "different"
-    p_top: float
-    wrong_pct: float
-    missed_losses: int
-    false_alarms: int
-    agrees: bool
 
 
 def tracker_checks(dataset: str, matchers: list[str], scores: list[float], believed: np.ndarray,

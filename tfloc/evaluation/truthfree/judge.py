@@ -12,6 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tfloc.core.rows.verdict import VerdictRow
+
 from . import belief as B
 from . import odometry as O
 from .config import TruthFreeConfig
@@ -45,31 +47,6 @@ def judge(est: np.ndarray, init: np.ndarray, fit: np.ndarray, methods: list[str 
     odo = O.disagrees(dist, turn, env, cfg.odometry_factor)
     believed = B.believed(agree, known, fit, odo, cfg.fit_margin)
     return Judgement(fit, B.best_fit(fit), agree, known, support, dist, turn, odo, env, believed)
-
-
-@dataclass(frozen=True)
-class VerdictRow:
-    """One tracker's truth-free verdict on one recording (percentages in %, counts of scans).
-
-    ``score_pct`` [``lo_pct``, ``hi_pct``]: the believed-tracked share and its interval
-    (:mod:`.score`); ``consensus_pct``: scans where the others had a consensus; ``agree_pct``: of
-    those, the share it agreed with; ``fit_pct``: its mean fit share; ``odometry_pct``: scans
-    whose correction disagrees with the odometry; ``jumps``: corrections beyond ``jump_m``;
-    ``reconverged_pct``: restarts that came back (of ``restarts``; NaN where none ran)."""
-
-    dataset: str
-    matcher: str
-    score_pct: float
-    lo_pct: float
-    hi_pct: float
-    scans: int
-    consensus_pct: float
-    agree_pct: float
-    fit_pct: float
-    odometry_pct: float
-    jumps: int
-    reconverged_pct: float
-    restarts: int
 
 
 def _pct(x: np.ndarray) -> float:

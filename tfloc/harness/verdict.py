@@ -20,7 +20,6 @@ a verdict of other rows.
 
 from __future__ import annotations
 
-import hashlib
 import math
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
@@ -29,23 +28,28 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from tfloc.core.run import Run, RunMatcher
+from tfloc.core.rows.verdict import POOLED, Agreement, FlagRow, TrackerCheck, VerdictRow
+from tfloc.core.run import RunMatcher, RunRecord
 from tfloc.core.traits import method_of
+from tfloc.errors import ResultsError
 from tfloc.evaluation.metrics import tracked as tracked_rows
 from tfloc.evaluation.recording import check_recording
+from tfloc.evaluation.sequences import poses
 from tfloc.evaluation.trajectory import pooled_share
 from tfloc.evaluation.truthfree import reconverge as R
-from tfloc.evaluation.truthfree.agreement import Agreement, TrackerCheck, agreement, tracker_checks
+from tfloc.evaluation.truthfree.agreement import agreement, tracker_checks
 from tfloc.evaluation.truthfree.config import TruthFreeConfig
-from tfloc.evaluation.truthfree.judge import Judgement, VerdictRow, judge, verdict_rows
+from tfloc.evaluation.truthfree.judge import Judgement, judge, verdict_rows
 from tfloc.evaluation.truthfree.mapfit import fit_shares, scan_points
-from tfloc.harness.restarts import restart_ends
-from tfloc.harness.workspace import load_dataset, load_matcher, map_of
-from tfloc.io.rundir import RunDir
-from tfloc.io.scenario import SEQUENCE
+from tfloc.io.rundir import RunDir, VerdictRecord
+from tfloc.io.scenario import SEQUENCE, load_dataset
+from tfloc.io.tables import VERDICT, VERDICT_AGREEMENT, VERDICT_CHECKS, VERDICT_FLAGS, VERDICT_SCANS
 from tfloc.maps.fields import distance_field
 
-POOLED = "all"
+from .identity import derived_code
+from .restarts import restart_ends
+from .workspace import load_matcher, map_of
+
 DEFAULT = TruthFreeConfig()
 
 
@@ -64,10 +68,6 @@ class Recording:
     tracked: np.ndarray
 
 
-def _poses(g: pd.DataFrame, prefix: str) -> np.ndarray:
-    return g[[f"{prefix}_x", f"{prefix}_y", f"{prefix}_theta"]].apply(pd.to_numeric, errors="coerce").to_numpy(float)
-
-
 def recording(df: pd.DataFrame, name: str, order: list[str], scan_ids: list[str], thr) -> Recording:
     """The :class:`Recording` of dataset ``name`` from a run's rows (trackers without a row for
     every scan are left out: an interrupted sequence is not judged)."""
@@ -80,11 +80,11 @@ def recording(df: pd.DataFrame, name: str, order: list[str], scan_ids: list[str]
             continue
         g = g.loc[scan_ids]
         labels.append(m)
-        est.append(_poses(g, "est"))
-        init.append(_poses(g, "init"))
+        est.append(poses(g, "est"))
+        init.append(poses(g, "init"))
         tracked.append(tracked_rows(g, thr))
         if truth is None:
-            truth = pd.to_numeric(g["true_x"], errors="coerce").notna().to_numpy(bool)
+            truth = g["true_x"].notna().to_numpy(bool)
     n = len(scan_ids)
     shape = (len(labels), n)
     return Recording(name, labels, np.array(est).reshape(*shape, 3), np.array(init).reshape(*shape, 3),
@@ -101,19 +101,10 @@ class Verdict:
     scans: pd.DataFrame
     checks: list[TrackerCheck]
     agreements: list[Agreement]
-    flags: pd.DataFrame = field(default_factory=pd.DataFrame)
+    flags: list[FlagRow] = field(default_factory=list)
 
 
-def rows_hash(path: Path) -> str:
-    """SHA-256 of the rows file a verdict judged."""
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for chunk in iter(lambda: fh.read(1 << 20), b""):
-            h.update(chunk)
-    return h.hexdigest()
-
-
-def _order(info: Run, df: pd.DataFrame) -> list[str]:
+def _order(info: RunRecord, df: pd.DataFrame) -> list[str]:
     labels = info.labels
     present = set(df["matcher"])
     return [m for m in labels if m in present] or sorted(present)
@@ -185,8 +176,6 @@ def judge_run(run_dir: str | Path, cfg: TruthFreeConfig = DEFAULT, restarts: boo
     df, info = rd.results(), rd.info()
     names = [n for n in df["dataset"].unique() if n in info.datasets_in(list(df["dataset"].unique()), SEQUENCE)]
     if not names:
-        from tfloc.errors import ResultsError
-
         raise ResultsError(f"{run_dir}: no sequence dataset: the truth-free verdict judges trackers along "
                            "recordings (tfloc bench on a sequence dataset first)")
     order, thr = _order(info, df), info.thresholds
@@ -203,7 +192,7 @@ def judge_run(run_dir: str | Path, cfg: TruthFreeConfig = DEFAULT, restarts: boo
         flagged = np.zeros(len(scans), bool)
         for f in check.flags:
             flagged[f.first:f.last + 1] = True
-            flags.append({"dataset": name, **f.record()})
+            flags.append(FlagRow(name, f.kind, f.first_id, f.last_id, f.scans, f.duration_s, f.message))
         the_map = map_of(scenario, scans[0])
         field = distance_field(the_map, cfg.field_resolution_m, cap=4 * cfg.fit_tol_m, pad=1.0)
         points = scan_points(np.stack([s.ranges for s in scans]), scenario.laser)
@@ -222,39 +211,21 @@ def judge_run(run_dir: str | Path, cfg: TruthFreeConfig = DEFAULT, restarts: boo
         log(f"{name}: judged {len(rec.matchers)} trackers over {len(scans)} scans ({check.summary()})")
     rows += pooled_rows(rows, beliefs)
     scans_df = pd.concat(tables, ignore_index=True) if tables else pd.DataFrame()
-    return Verdict(rows, scans_df, checks, agreements, pd.DataFrame(flags))
-
-
-def _frame(items: list) -> pd.DataFrame:
-    return pd.DataFrame([asdict(x) for x in items])
+    return Verdict(rows, scans_df, checks, agreements, flags)
 
 
 def write_verdict(run_dir: str | Path, cfg: TruthFreeConfig = DEFAULT, restarts: bool = True,
                   log: Callable[[str], None] = print) -> Verdict:
-    """:func:`judge_run`, then its files and ``run.json``'s ``verdict`` record (module notes)."""
+    """:func:`judge_run`, then its files and ``run.json``'s ``verdict`` record: the rules, whether
+    restarts ran, the hash of the rows judged and the identity of the code that judged them."""
     rd = RunDir(Path(run_dir))
     v = judge_run(run_dir, cfg, restarts, log)
-    _frame(v.rows).to_csv(rd.verdict, index=False, float_format="%.6g")
-    v.scans.to_csv(rd.verdict_scans, index=False, float_format="%.5g")
-    for path, items in ((rd.verdict_checks, v.checks), (rd.verdict_agreement, v.agreements)):
+    rd.write(VERDICT, v.rows)
+    rd.write(VERDICT_SCANS, v.scans)
+    for table, items in ((VERDICT_CHECKS, v.checks), (VERDICT_AGREEMENT, v.agreements), (VERDICT_FLAGS, v.flags)):
         if items:
-            _frame(items).to_csv(path, index=False, float_format="%.6g")
+            rd.write(table, items)
         else:
-            path.unlink(missing_ok=True)
-    if len(v.flags):
-        v.flags.to_csv(rd.verdict_flags, index=False)
-    else:
-        rd.verdict_flags.unlink(missing_ok=True)
-    rd.update({"verdict": {"config": asdict(cfg), "restarts": restarts, "rows_sha256": rows_hash(rd.estimates)}})
+            rd.remove(table)
+    rd.record_verdict(VerdictRecord(asdict(cfg), restarts, rd.rows_sha256(), derived_code(__name__)))
     return v
-
-
-def read_verdict(run_dir: str | Path) -> tuple[pd.DataFrame | None, str]:
-    """A run's ``verdict.csv`` and a note: ``""`` when it judged the run's current rows, else why
-    it is missing or stale (``None`` when there is no verdict)."""
-    rd = RunDir(Path(run_dir))
-    if not rd.verdict.is_file():
-        return None, "no truth-free verdict yet (tfloc verdict RUN)"
-    record = (rd.info().doc.get("verdict") or {})
-    stale = rd.estimates.is_file() and record.get("rows_sha256") not in (None, rows_hash(rd.estimates))
-    return pd.read_csv(rd.verdict), ("the verdict judged other rows than the run's (tfloc verdict RUN)" if stale else "")

@@ -16,8 +16,11 @@ from pathlib import Path
 
 import pandas as pd
 
+from tfloc.core.rows.verdict import SweepRow
 from tfloc.errors import ConfigError
 from tfloc.evaluation.truthfree.config import TruthFreeConfig
+from tfloc.io.rundir import RunDir
+from tfloc.io.tables import VERDICT_SWEEP
 
 from .verdict import DEFAULT, judge_run
 
@@ -52,11 +55,11 @@ def sweep(run_dir: str | Path, configs: list[tuple[str, TruthFreeConfig]],
     for name, cfg in configs:
         v = judge_run(run_dir, cfg, restarts=False, log=lambda _m: None)
         for a in v.agreements:
-            rows.append({"config": name, **asdict(a)})
+            rows.append(SweepRow(config=name, **asdict(a)))
         agree = sum(a.agrees for a in v.agreements)
         rhos = [a.rho for a in v.agreements if not math.isnan(a.rho)]
         log(f"{name}: agrees on {agree} of {len(v.agreements)} recordings; "
             f"rho min {min(rhos):.2f}" if rhos else f"{name}: no recording with truth")
-    df = pd.DataFrame(rows)
-    df.to_csv(Path(run_dir) / "verdict_sweep.csv", index=False, float_format="%.6g")
-    return df
+    rd = RunDir(Path(run_dir))
+    rd.write(VERDICT_SWEEP, rows)
+    return rd.frame(VERDICT_SWEEP)

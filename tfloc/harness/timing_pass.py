@@ -5,11 +5,12 @@ write ``RUN/timing.csv`` and ``RUN/timing.md``, record it in ``RUN/run.json``.
 the one ``run.json`` records (:func:`tfloc.harness.timing.stale`): the same fingerprint, complete,
 with its files: nothing is timed ("already complete: timing.md is current"); otherwise, or with
 ``regenerate``, the run is re-timed (:func:`tfloc.harness.timing.run_timing`), summarised
-(:func:`tfloc.evaluation.timing.timing_summary`, from the typed rows' table) and written
-(:func:`tfloc.report.timing.write_timing`), the record marked complete only once both files are;
-its session records the cores and the CPU model it ran on (``cpu``: absolute CPU times compare
-only on one model, :mod:`tfloc.report.timing_verify`) and the probe's ``contention``.
-It lives in the report layer because it writes ``timing.md``; the measuring is the harness's.
+(:func:`tfloc.evaluation.timing.timing_summary`, from the typed rows' table) and written: the
+rows through the store, ``timing.md`` by the ``draw`` the caller passes
+(:func:`tfloc.report.timing.write_timing_md`, from the command line), the record marked complete
+only once both files are; its session records the cores and the CPU model it ran on (``cpu``:
+absolute CPU times compare only on one model, :mod:`tfloc.harness.timing_verify`) and the
+probe's ``contention``.
 
 A pass the contention probe finds contended (:mod:`tfloc.evaluation.contention`) is timed again
 after ``wait_s`` seconds, up to ``retries`` times, then refused with a one-line
@@ -24,12 +25,19 @@ import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+import pandas as pd
+
 from tfloc.core.rows.timing import TimingRow
 from tfloc.errors import TflocError
 from tfloc.evaluation.contention import Contention, describe
 from tfloc.evaluation.timing import timing_summary
-from tfloc.harness.runner import load_average
-from tfloc.harness.timing import (
+from tfloc.io.rundir import RunDir
+from tfloc.io.scenario import SEQUENCE
+from tfloc.io.table import frame_of
+from tfloc.io.tables import TIMING
+
+from .runner import load_average
+from .timing import (
     NO_PASS,
     TimingParams,
     read_run,
@@ -38,13 +46,10 @@ from tfloc.harness.timing import (
     stale,
     timing_fingerprint,
 )
-from tfloc.io.rundir import RunDir
-from tfloc.io.scenario import SEQUENCE
-from tfloc.io.timing_rows import rows_frame
-
-from .timing import write_timing
 
 Log = Callable[[str], None]
+#: writes ``timing.md``: (run directory, summary, reference, the pass's provenance, run name) → its path
+Draw = Callable[[Path, pd.DataFrame, str, dict, str], Path]
 RETRIES = 2    # a contended pass is timed again this many times before it is refused
 WAIT_S = 60.0  # seconds between those tries
 
@@ -61,7 +66,7 @@ def timing_pass(run_dir: Path, per_stratum: int | None = None, warmup: int | Non
                 reference: str | None = None, regenerate: bool = False,
                 progress: Callable[[int, int], None] | None = None, *, seed: int | None = None,
                 cores: Sequence[int] | None = None, log: Log | None = None, allow_contended: bool = False,
-                retries: int = RETRIES, wait_s: float = WAIT_S) -> Path:
+                retries: int = RETRIES, wait_s: float = WAIT_S, draw: Draw | None = None) -> Path:
     """Re-time the run in ``run_dir`` side by side unless its recorded timing pass is current
     (module notes); returns the run directory.
 
@@ -70,7 +75,8 @@ def timing_pass(run_dir: Path, per_stratum: int | None = None, warmup: int | Non
     run's first), ``seed`` the sampling seed (default fixed), ``cores`` where to pin (default the
     last allowed core; not part of the pass's fingerprint). ``progress(done, total)`` is told of
     every scan timed; ``log`` (default: standard error) gets why it re-times, the summary table
-    and where it wrote. A bad parameter or a run without rows is a :class:`~tfloc.errors.TflocError`;
+    and where it wrote; ``draw`` writes ``timing.md`` (none: the pass is left without it, so not
+    complete). A bad parameter or a run without rows is a :class:`~tfloc.errors.TflocError`;
     contended passes are retried or refused as the module notes say."""
     log = log or _stderr
     rd = RunDir(run_dir)
@@ -91,8 +97,12 @@ def timing_pass(run_dir: Path, per_stratum: int | None = None, warmup: int | Non
     rows, meta = timed_quietly(lambda: run_timing(rd.path, params.per_stratum, params.seed, cores, params.warmup,
                                                   progress, run=(df, info), sample=sample),
                                log, allow_contended, retries, wait_s, str(rd.path))
-    summary = timing_summary(rows_frame(rows, TimingRow), params.reference, df)
-    csv_path, md_path = write_timing(rd.path, rows, summary, params.reference, meta, info.name or rd.path.name)
+    summary = timing_summary(frame_of(rows, TimingRow), params.reference, df)
+    csv_path = rd.write(TIMING, rows)
+    if draw is None:
+        log(f"timing: {csv_path} (no timing.md drawn: the pass is not complete)")
+        return rd.path
+    md_path = draw(rd.path, summary, params.reference, meta, info.name or rd.path.name)
     rd.close_timing(load_average(), cores=meta["cores"], cpu=meta["cpu"], scans=meta["scans"],
                     contention=meta["contention"])
     log(summary[["matcher", "cpu_median_ms", "ratio_to_reference", "run_over_quiet"]].to_string(

@@ -34,17 +34,18 @@ from pathlib import Path
 
 import pandas as pd
 
-from tfloc.core.run import Run, TimingRecord
 from tfloc.core.rows.timing import TimingRow
+from tfloc.core.run import RunRecord, TimingRecord
 from tfloc.errors import ConfigError
 from tfloc.evaluation.contention import MAX_INFLATION, Contention, describe
 from tfloc.evaluation.timing import between_ratios, outside, reference_of, verify_ratios, within
 from tfloc.harness.runner import cpu_model
-from tfloc.harness.timing import WARMUP, read_run, run_timing
 from tfloc.io.rundir import RunDir
 from tfloc.io.scenario import SEQUENCE
-from tfloc.io.timing_rows import read_rows, rows_frame
+from tfloc.io.table import frame_of
+from tfloc.io.tables import TIMING
 
+from .timing import WARMUP, read_run, run_timing
 from .timing_pass import RETRIES, WAIT_S, Log, _stderr, timed_quietly
 
 TOLERANCE = 1.3
@@ -83,14 +84,14 @@ def apart_from(then: Contention | None, limit: float = MAX_INFLATION) -> Callabl
     return apart
 
 
-def committed_cpu(info: Run) -> tuple[str | None, str]:
+def committed_cpu(info: RunRecord) -> tuple[str | None, str]:
     """The CPU model the committed pass of the run ``info`` was timed on and where it was read:
     the pass's last session (``timing``'s ``cpu``), else the run's machine (``machine.cpu``: a
     pass recorded before it named its CPU), else ``(None, "not recorded")``."""
-    cpu = (info.timing or TimingRecord()).last_session.get("cpu")
+    cpu = (info.timing or TimingRecord()).last_session.cpu
     if isinstance(cpu, str) and cpu.strip():
         return cpu.strip(), "the timing pass's record"
-    cpu = (info.doc.get("machine") or {}).get("cpu")
+    cpu = info.machine.cpu if info.machine.cpu != "?" else None
     if isinstance(cpu, str) and cpu.strip():
         return cpu.strip(), "the run's machine.cpu: the timing record names none"
     return None, "not recorded"
@@ -106,7 +107,7 @@ def other_cpu(then: str | None, now: str | None) -> str | None:
             "comparing the matchers' ratios to one another, measured side by side")
 
 
-def _models(info: Run, here: str, log: Log) -> str | None:
+def _models(info: RunRecord, here: str, log: Log) -> str | None:
     """Log the committed pass's CPU model (and where it was read) and this machine's ``here``,
     then, on another model, the line saying so (:func:`other_cpu`); returns that line or None."""
     model, source = committed_cpu(info)
@@ -129,12 +130,12 @@ def verify_pass(run_dir: Path, per_stratum: int | None = None, cores: Sequence[i
     log = log or _stderr
     rd = RunDir(run_dir)
     df, info = read_run(rd.path)
-    committed = rows_frame(read_rows(rd.timing_csv, TimingRow), TimingRow)
+    committed = rd.frame(TIMING)
     if committed.empty:
         raise ConfigError(f"{rd.path}: no timing pass to verify (no timing.csv; tfloc timing {rd.path} makes one)")
     record = info.timing or TimingRecord()
     fp = record.fingerprint or {}
-    then = Contention.from_record(record.last_session.get("contention"))
+    then = Contention.from_record(record.last_session.contention)
     sequences = sorted(info.datasets_in(list(df["dataset"].unique()), SEQUENCE))
     sample = committed_sample(committed, sequences, per_stratum)
     warmup = int(fp.get("warmup", WARMUP))
@@ -147,7 +148,7 @@ def verify_pass(run_dir: Path, per_stratum: int | None = None, cores: Sequence[i
                                                   run=(df, info), sample=sample),
                                log, allow_contended, retries, wait_s, f"{rd.path} (verify)",
                                apart=None if other else apart_from(then))
-    table = verify_ratios(committed, rows_frame(rows, TimingRow))
+    table = verify_ratios(committed, frame_of(rows, TimingRow))
     try:
         between = between_ratios(table, reference)
     except ValueError as exc:
