@@ -406,10 +406,9 @@ def _retimed_as(run_dir: Path, monkeypatch, factors: dict[str, float], calls: li
     own probe, its calibration's best round ×4 the committed pass's (far outside ×1.25)."""
     from dataclasses import replace
 
+    from tfloc.evaluation.contention import Contention
     from tfloc.io.table import read_rows
     from tfloc.io.tables import TIMING
-
-    from tfloc.evaluation.contention import Contention
 
     committed = read_rows(run_dir / "timing.csv", TIMING)
     quiet_far = Contention(16.0, 16.0, 16.8, 10, 0.0).to_record()
@@ -427,13 +426,12 @@ def test_verify_on_another_cpu_model_compares_the_matchers_ratios_to_one_another
     reference are compared side by side (a uniform ×1.8 passes, one matcher twice as slow
     relative to it fails), the machine ratio is no reason to retry and nothing is called
     contended; on the same model the same re-timing is retried and refused as today."""
-    from tfloc.io.table import write
-    from tfloc.io.tables import TIMING
-
     from tfloc.evaluation.contention import Contention
     from tfloc.harness.runner import cpu_model
     from tfloc.harness.timing_pass import ContendedError
     from tfloc.harness.timing_verify import verify_pass
+    from tfloc.io.table import write
+    from tfloc.io.tables import TIMING
 
     run_dir = _copy(small_run, tmp_path)
     timing_pass(run_dir, 1, 1, allow_contended=True, draw=write_timing_md, log=lambda s: None)
