@@ -141,16 +141,6 @@ def _vec(p: Pose):  # noqa: ANN202 - an amcl.Vector3D
     return _amcl.Vector3D(float(p.x), float(p.y), float(p.theta))
 
 
-REGISTRY = {"amcl-wheel": {
-    "class": "AmclWheelTracker",
-    "summary": ("a **tracker**: Nav2's AMCL through the `amcl` wheel (Python bindings of "
-                "`nav2_amcl`, beam model only), the port's fidelity reference; licence GPL-3.0; "
-                "optional: `pip install 'tfloc[amcl]'`"),
-    "docs": "baselines/amcl-wheel.md",
-    "files": ["baselines/_amcl_common.py"],
-}}
-
-
 class AmclWheelTracker:
     """Nav2's AMCL run scan by scan (the :class:`~tfloc.core.tracker.Tracker` protocol); no
     single-scan mode (no ``localize``). See the module docstring and ``docs/baselines/amcl-wheel.md``."""
@@ -271,3 +261,8 @@ class AmclWheelTracker:
         scan.ranges = np.column_stack((r, self._bearings)).tolist()
         return scan
 
+
+REGISTRY = {"amcl-wheel": {"class": "AmclWheelTracker", "docs": "baselines/amcl-wheel.md", "files": ["baselines/_amcl_common.py"], "summary": (
+    "a **tracker**: Nav2's AMCL through the `amcl` wheel (Python bindings of `nav2_amcl`, "
+    "beam model only), the port's fidelity reference; licence GPL-3.0; optional: `pip install"
+    " 'tfloc[amcl]'`")}}

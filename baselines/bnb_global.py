@@ -174,16 +174,6 @@ def probability_grid(map_: object, resolution: float, sigma: float, depth: int) 
     return cached(map_, key, lambda: build_probability_grid(map_, resolution, sigma, depth))
 
 
-REGISTRY = {"bnb-global": {
-    "class": "BranchAndBoundGlobalMatcher",
-    "summary": ("Cartographer's branch-and-bound scan matcher (Hess et al. 2016, Sec. V) over the "
-                "whole map and all headings: the reference for **global** problems (no initial "
-                "guess; [docs/global.md](global.md))"),
-    "docs": "baselines/bnb-global.md",
-    "files": ["baselines/_bnb_kernels.py"],
-}}
-
-
 class BranchAndBoundGlobalMatcher(Configured):
     """Cartographer's fast correlative scan matcher over the whole map (see the module docstring)."""
 
@@ -296,3 +286,9 @@ class BranchAndBoundGlobalMatcher(Configured):
     def score(self, problem: Problem, pose: Pose) -> float:
         """``1 −`` the mean interpolated grid probability of the (filtered) returns at ``pose`` (lower is better)."""
         return self._score(self._grid(problem), self._points(problem), pose)
+
+
+REGISTRY = {"bnb-global": {"class": "BranchAndBoundGlobalMatcher", "docs": "baselines/bnb-global.md", "files": ["baselines/_bnb_kernels.py"], "summary": (
+    "Cartographer's branch-and-bound scan matcher (Hess et al. 2016, Sec. V) over the whole "
+    "map and all headings: the reference for **global** problems (no initial guess; "
+    "[docs/global.md](global.md))")}}

@@ -72,13 +72,6 @@ class _Grid:
     block_starts: np.ndarray  # (B,) offsets of each block's first translation, in cells
 
 
-REGISTRY = {"csm-corr": {
-    "class": "CorrelativeMatcher",
-    "summary": "Olson's real-time correlative scan matching (±3.5 m, ±20°, multi-resolution)",
-    "docs": "baselines/csm-corr.md",
-}}
-
-
 class CorrelativeMatcher(Configured):
     """Olson's real-time correlative scan matcher over the protocol's window (see the module docstring)."""
 
@@ -183,3 +176,7 @@ class CorrelativeMatcher(Configured):
         """Negative mean likelihood of the scan endpoints at ``pose`` (in [-1, 0]; lower is better)."""
         field = self._field(problem)
         return -float(np.mean(field.likelihood_at(pose.transform(problem.points))))
+
+
+REGISTRY = {"csm-corr": {"class": "CorrelativeMatcher", "docs": "baselines/csm-corr.md", "summary": (
+    "Olson's real-time correlative scan matching (±3.5 m, ±20°, multi-resolution)")}}

@@ -82,14 +82,6 @@ class _NoAnswer(Exception):
     """A step could not produce a transform (too few corners, hypotheses or inliers; bad scale)."""
 
 
-REGISTRY = {"cv-corners": {
-    "class": "CvCornersMatcher",
-    "summary": ("ShortStraw corners, fair rigid hypotheses, OpenCV `estimateAffinePartial2D` "
-                "(RANSAC)"),
-    "docs": "baselines/cv-corners.md",
-}}
-
-
 class CvCornersMatcher:
     """Corner matching with fair rigid hypotheses, refined by OpenCV (see the module docstring)."""
 
@@ -192,3 +184,7 @@ class CvCornersMatcher:
         inl = partner[0] >= 0
         n = int(inl.sum())
         return float(-n + (dist[0, inl].mean() / self.config.inlier_tol if n else 0.0))
+
+
+REGISTRY = {"cv-corners": {"class": "CvCornersMatcher", "docs": "baselines/cv-corners.md", "summary": (
+    "ShortStraw corners, fair rigid hypotheses, OpenCV `estimateAffinePartial2D` (RANSAC)")}}

@@ -115,14 +115,6 @@ def _target(problem_map: object, cfg: Config) -> _Target:
     return cached(problem_map, key, build)
 
 
-REGISTRY = {"gicp": {
-    "class": "GicpMatcher",
-    "summary": ("small_gicp GICP on the 2D points stacked in three layers (z = 0, ±5 cm), gates 2 →"
-                " 0.1 m; licence MIT; optional: `pip install 'tfloc[gicp]'`"),
-    "docs": "baselines/gicp.md",
-}}
-
-
 class GicpMatcher:
     """small_gicp GICP on layered 2D points with a coarse-to-fine gate schedule (see the module docstring)."""
 
@@ -177,3 +169,8 @@ class GicpMatcher:
             maha = np.einsum("ni,ni->n", d, np.linalg.solve(fused, d[..., None])[..., 0])
             cost[ok] = np.minimum(maha, cap)
         return float(np.mean(cost))
+
+
+REGISTRY = {"gicp": {"class": "GicpMatcher", "docs": "baselines/gicp.md", "summary": (
+    "small_gicp GICP on the 2D points stacked in three layers (z = 0, ±5 cm), gates 2 → 0.1 "
+    "m; licence MIT; optional: `pip install 'tfloc[gicp]'`")}}

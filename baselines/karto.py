@@ -113,16 +113,6 @@ def _check_window(size_name: str, res_name: str, c: Config) -> None:
                              f"{size} / {resolution}", (size_name, res_name))
 
 
-REGISTRY = {"karto": {
-    "class": "KartoMatcher",
-    "summary": ("OpenKarto's correlative scan matcher (`karto-scanmatcher`, as in slam_toolbox) "
-                "against virtual scans of the map, ±3.5 m / ±20° coarse then fine; licence LGPL-3.0"
-                " (OpenKarto; the wheel ships the GPL-3.0 text); optional: `pip install "
-                "'tfloc[karto]'`, Python ≤ 3.11 only"),
-    "docs": "baselines/karto.md",
-}}
-
-
 class KartoMatcher:
     """OpenKarto's correlative matcher, coarse then fine, against virtual scans of the map (see the module docstring)."""
 
@@ -236,3 +226,10 @@ def _scan(laser: LaserSpec, ranges: np.ndarray, pose: Pose, threshold: float, nu
     r = np.where(laser.valid(ranges), ranges, beyond)
     p = ksm.Pose2(pose.x, pose.y, pose.theta)
     return ksm.LocalizedRangeScan(cfg, r.tolist(), p, p, num, 0.0)
+
+
+REGISTRY = {"karto": {"class": "KartoMatcher", "docs": "baselines/karto.md", "summary": (
+    "OpenKarto's correlative scan matcher (`karto-scanmatcher`, as in slam_toolbox) against "
+    "virtual scans of the map, ±3.5 m / ±20° coarse then fine; licence LGPL-3.0 (OpenKarto; "
+    "the wheel ships the GPL-3.0 text); optional: `pip install 'tfloc[karto]'`, Python ≤ 3.11"
+    " only")}}

@@ -52,15 +52,6 @@ class Config:
     local: KartoConfig = field(default_factory=KartoConfig)
 
 
-REGISTRY = {"karto-gated": {
-    "class": "KartoGatedTracker",
-    "summary": ("a **tracker**: `karto` matched only when slam_toolbox's `shouldProcessScan` gate "
-                "passes (between, the odometry carries the pose). Its package's shipped values are "
-                "the preset `karto-track`"),
-    "docs": "baselines/karto.md",
-}}
-
-
 class KartoGatedTracker(ConfiguredTracker):
     """``karto`` matched only when slam_toolbox's gate passes (see the module docstring). ``info``
     of each step: ``matched`` (whether Karto ran) and ``travel_m`` (odometry since the last match)."""
@@ -116,3 +107,9 @@ class KartoGatedTracker(ConfiguredTracker):
 
     def reset(self, pose: Pose) -> None:
         self.pose = pose
+
+
+REGISTRY = {"karto-gated": {"class": "KartoGatedTracker", "docs": "baselines/karto.md", "summary": (
+    "a **tracker**: `karto` matched only when slam_toolbox's `shouldProcessScan` gate passes "
+    "(between, the odometry carries the pose). Its package's shipped values are the preset "
+    "`karto-track`")}}

@@ -72,14 +72,6 @@ def _voxel_map(problem_map: object, voxel: float, max_points: int, spacing: floa
     return cached(problem_map, ("kiss-voxels", round(voxel, 9), max_points, round(spacing, 9)), build)
 
 
-REGISTRY = {"kiss-icp": {
-    "class": "KissIcpMatcher",
-    "summary": ("KISS-ICP `Registration.align_points_to_map` on a `VoxelHashMap`, voxel schedule 2 "
-                "→ 0.1 m"),
-    "docs": "baselines/kiss-icp.md",
-}}
-
-
 class KissIcpMatcher:
     """KISS-ICP registration to the map with a voxel schedule (see the module docstring)."""
 
@@ -126,3 +118,8 @@ class KissIcpMatcher:
         d = self._distances(problem, pose)
         cost = np.where(d <= voxel, d**2 / (kernel + d**2), 1.0)
         return float(np.mean(cost))
+
+
+REGISTRY = {"kiss-icp": {"class": "KissIcpMatcher", "docs": "baselines/kiss-icp.md", "summary": (
+    "KISS-ICP `Registration.align_points_to_map` on a `VoxelHashMap`, voxel schedule 2 → 0.1 "
+    "m")}}

@@ -88,14 +88,6 @@ class _AdaptiveStage:
         return Estimate(matrix_to_pose(t), True, info={"sigma": self.sigma})
 
 
-REGISTRY = {"kiss-icp-adaptive": {
-    "class": "KissIcpAdaptiveTracker",
-    "summary": ("a **tracker**: KISS-ICP with its pipeline's own adaptive threshold (gate 3σ, "
-                "kernel σ/3). Its package's shipped values are the preset `kiss-icp-track`"),
-    "docs": "baselines/kiss-icp.md",
-}}
-
-
 class KissIcpAdaptiveTracker(ConfiguredTracker):
     """KISS-ICP with its adaptive threshold along a sequence (see the module docstring)."""
 
@@ -129,3 +121,8 @@ class KissIcpAdaptiveTracker(ConfiguredTracker):
             self._threshold._update_model_deviation(model_deviation=deviation)
         self.pose = est.pose
         return est
+
+
+REGISTRY = {"kiss-icp-adaptive": {"class": "KissIcpAdaptiveTracker", "docs": "baselines/kiss-icp.md", "summary": (
+    "a **tracker**: KISS-ICP with its pipeline's own adaptive threshold (gate 3σ, kernel "
+    "σ/3). Its package's shipped values are the preset `kiss-icp-track`")}}

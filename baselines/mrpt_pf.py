@@ -141,20 +141,6 @@ def _program(config: Config) -> ExternalProgram:
     return ExternalProgram("pf-localization", PACKAGE, _version(), INI, render_ini(text, config.ini_values()))
 
 
-REGISTRY = {"mrpt-pf": {
-    "class": "MrptPfTracker",
-    "summary": ("a **tracker**, an **external program**: MRPT's own particle-filter localization, "
-                "Debian `mrpt-apps`' `pf-localization` (MRPT 2.5.8: KLD sampling, likelihood "
-                "field), run as it ships with `localization_demo.ini`'s filter options, headless; "
-                "presets `mrpt-pf-optimal` (the auxiliary PF with the optimal proposal) and "
-                "`mrpt-pf-lf-dense` (every 5th beam), each from MRPT's files "
-                "([docs/baselines/mrpt-pf.md](baselines/mrpt-pf.md)); missing program: one line, "
-                "`apt-get install mrpt-apps` (`make browser` installs it)"),
-    "docs": "baselines/mrpt-pf.md",
-    "files": ["baselines/_mrpt_files.py"],
-}}
-
-
 class MrptPfTracker:
     """MRPT's ``pf-localization`` along a sequence (module notes); external program."""
 
@@ -202,3 +188,12 @@ class MrptPfTracker:
         per_scan, how = split_cpu(cpu, n, own)
         info = tuple({"sqrt_tr_cov": float(s)} for s in spread)
         return BatchAnswer(poses, cpu, run.wall_s, per_scan, how, info)
+
+
+REGISTRY = {"mrpt-pf": {"class": "MrptPfTracker", "docs": "baselines/mrpt-pf.md", "files": ["baselines/_mrpt_files.py"], "summary": (
+    "a **tracker**, an **external program**: MRPT's own particle-filter localization, Debian "
+    "`mrpt-apps`' `pf-localization` (MRPT 2.5.8: KLD sampling, likelihood field), run as it "
+    "ships with `localization_demo.ini`'s filter options, headless; presets `mrpt-pf-optimal`"
+    " (the auxiliary PF with the optimal proposal) and `mrpt-pf-lf-dense` (every 5th beam), "
+    "each from MRPT's files ([docs/baselines/mrpt-pf.md](baselines/mrpt-pf.md)); missing "
+    "program: one line, `apt-get install mrpt-apps` (`make browser` installs it)")}}

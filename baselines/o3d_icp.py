@@ -61,13 +61,6 @@ class Config:
     min_fitness: float = 0.5  #: converged needs this open3d fitness (0–1)
 
 
-REGISTRY = {"o3d-icp": {
-    "class": "Open3dIcpMatcher",
-    "summary": "open3d point-to-line ICP, coarse-to-fine gates 2 → 0.1 m",
-    "docs": "baselines/o3d-icp.md",
-}}
-
-
 class Open3dIcpMatcher(Configured):
     """open3d point-to-line ICP with a coarse-to-fine gate schedule (see the module docstring)."""
 
@@ -107,3 +100,7 @@ class Open3dIcpMatcher(Configured):
         geom = map_geometry(problem.map, self.config.map_spacing)
         dist, res = point_to_line_residuals(geom, pose.transform(problem.points))
         return float(np.mean(np.where(dist <= gate, np.minimum(res, gate), gate)))
+
+
+REGISTRY = {"o3d-icp": {"class": "Open3dIcpMatcher", "docs": "baselines/o3d-icp.md", "summary": (
+    "open3d point-to-line ICP, coarse-to-fine gates 2 → 0.1 m")}}

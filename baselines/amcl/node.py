@@ -107,20 +107,6 @@ class Config:
     seed: int = 0  #: seed of the filter's drand48 stream
 
 
-REGISTRY = {"amcl": {
-    "class": "AmclTracker",
-    "summary": ("a **tracker** (sequence datasets only, no single-scan mode): a numba port of "
-                "Nav2's AMCL (`nav2_amcl`: KLD-sampling, recovery injection, the heaviest cluster's"
-                " mean, the differential motion model, the likelihood-field and beam models, Nav2's"
-                " update gate, global initialisation), Nav2's parameter names and defaults; "
-                "fidelity tested against the `amcl` wheel "
-                "([docs/baselines/amcl.md](baselines/amcl.md)); licence LGPL-2.1-or-later (a "
-                "translation of nav2_amcl; a module per `nav2_amcl` source file)"),
-    "docs": "baselines/amcl.md",
-    "files": ["baselines/amcl/", "baselines/_amcl_common.py"],
-}}
-
-
 class AmclTracker:
     """Nav2's AMCL as a :class:`~tfloc.core.tracker.Tracker` (no single-scan mode). See the module
     docstring and ``docs/baselines/amcl.md``. For reports, untimed and read-only: :meth:`belief`
@@ -339,3 +325,12 @@ class AmclTracker:
                                      c.sigma_hit, c.lambda_short)
         return likelihood_field(poses, weights, scan, self._bearings, self._step,
                                        self._range_max, self._table, self._off_map, *nav.geometry)
+
+
+REGISTRY = {"amcl": {"class": "AmclTracker", "docs": "baselines/amcl.md", "files": ["baselines/amcl/", "baselines/_amcl_common.py"], "summary": (
+    "a **tracker** (sequence datasets only, no single-scan mode): a numba port of Nav2's AMCL"
+    " (`nav2_amcl`: KLD-sampling, recovery injection, the heaviest cluster's mean, the "
+    "differential motion model, the likelihood-field and beam models, Nav2's update gate, "
+    "global initialisation), Nav2's parameter names and defaults; fidelity tested against the"
+    " `amcl` wheel ([docs/baselines/amcl.md](baselines/amcl.md)); licence LGPL-2.1-or-later "
+    "(a translation of nav2_amcl; a module per `nav2_amcl` source file)")}}

@@ -79,22 +79,6 @@ class Config:
     occupied_probability: float = 0.9  #: P of a cell the map calls occupied (kMaxProbability)
 
 
-REGISTRY = {"cartographer-local": {
-    "class": "CartographerLocalMatcher",
-    "summary": ("condition, \"Cartographer's local matcher against the map\" (Cartographer never "
-                "matches scan-to-map; `rotation_weight` 40 is meant for an IMU heading): a port of "
-                "Cartographer's 2D local scan matching against the map's probability grid (its "
-                "voxel and adaptive voxel filters, the optional real-time correlative matcher, the "
-                "Ceres matcher with bicubic interpolation and its priors towards the prediction), "
-                "`trajectory_builder_2d.lua`'s values; meant for sequences (it pulls towards its "
-                "guess); preset `cartographer-local-csm` turns the online correlative matcher on as"
-                " cartographer_ros's `revo_lds.lua` "
-                "([docs/baselines/cartographer-local.md](baselines/cartographer-local.md))"),
-    "docs": "baselines/cartographer-local.md",
-    "files": ["baselines/cartographer/"],
-}}
-
-
 class CartographerLocalMatcher(Configured):
     """Cartographer's local scan matching against the map (see the module docstring)."""
 
@@ -150,3 +134,14 @@ class CartographerLocalMatcher(Configured):
             return 0.5 * w**2 * (1.0 - MIN_PROBABILITY) ** 2
         cost, _, _ = cost_at(self._grid(problem), pose.transform(points))
         return float(0.5 * w**2 * np.mean(cost**2))
+
+
+REGISTRY = {"cartographer-local": {"class": "CartographerLocalMatcher", "docs": "baselines/cartographer-local.md", "files": ["baselines/cartographer/"], "summary": (
+    "condition, \"Cartographer's local matcher against the map\" (Cartographer never matches "
+    "scan-to-map; `rotation_weight` 40 is meant for an IMU heading): a port of Cartographer's"
+    " 2D local scan matching against the map's probability grid (its voxel and adaptive voxel"
+    " filters, the optional real-time correlative matcher, the Ceres matcher with bicubic "
+    "interpolation and its priors towards the prediction), `trajectory_builder_2d.lua`'s "
+    "values; meant for sequences (it pulls towards its guess); preset "
+    "`cartographer-local-csm` turns the online correlative matcher on as cartographer_ros's "
+    "`revo_lds.lua` ([docs/baselines/cartographer-local.md](baselines/cartographer-local.md))")}}

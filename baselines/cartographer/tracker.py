@@ -65,18 +65,6 @@ class _Sampler:
         return False
 
 
-REGISTRY = {"cartographer": {
-    "class": "CartographerTracker",
-    "summary": ("Cartographer's pure-localization loop (`backpack_2d_localization.lua`, wheel "
-                "odometry, online CSM): local SLAM on its own submaps, constraints to frozen "
-                "submaps of the map by branch and bound then Ceres, the sparse pose optimisation "
-                "every 20 nodes, the pure-localization trimmer; publishes the map-frame pose "
-                "([docs/baselines/cartographer.md](baselines/cartographer.md))"),
-    "docs": "baselines/cartographer.md",
-    "files": ["baselines/cartographer/"],
-}}
-
-
 class CartographerTracker:
     """Cartographer's pure-localization loop run scan by scan (module notes)."""
 
@@ -267,3 +255,11 @@ class CartographerTracker:
         self._nodes = [n for n in self._nodes if n["index"] in kept_nodes]
         self._inter = [t for t in self._inter if t[1] in kept_nodes]
         self._pending = [t for t in self._pending if t[1] in kept_nodes]
+
+
+REGISTRY = {"cartographer": {"class": "CartographerTracker", "docs": "baselines/cartographer.md", "files": ["baselines/cartographer/"], "summary": (
+    "Cartographer's pure-localization loop (`backpack_2d_localization.lua`, wheel odometry, "
+    "online CSM): local SLAM on its own submaps, constraints to frozen submaps of the map by "
+    "branch and bound then Ceres, the sparse pose optimisation every 20 nodes, the "
+    "pure-localization trimmer; publishes the map-frame pose "
+    "([docs/baselines/cartographer.md](baselines/cartographer.md))")}}

@@ -151,9 +151,11 @@ def _edit(path: Path) -> None:
 
 
 def test_an_edit_resumes_or_stops_by_what_imports_it(tmp_path: Path) -> None:
-    """An edit of a module no matcher imports leaves the run complete (rows kept); an edit of one
-    matcher's module stops the resume with one line naming that matcher alone; ``--regenerate``
-    re-runs that matcher's tasks only."""
+    """An edit of a module no matcher imports leaves the run complete (rows kept); an edit of the
+    code that derives the tables leaves the rows current and the tables stale, re-made from the
+    rows by ``tfloc report`` (no matcher runs); an edit of one matcher's module stops the resume
+    with one line naming that matcher alone; ``--regenerate`` re-runs that matcher's tasks only,
+    and the tables wait for the next report."""
     src, data = _copy_package(tmp_path), _small_dataset(tmp_path)
     env = {**os.environ, "PYTHONPATH": str(src)}
     env.pop("TFLOC_NUMBA_CACHE_DIR", None)  # the kernels are this checkout's: share its cache
@@ -164,14 +166,32 @@ def test_an_edit_resumes_or_stops_by_what_imports_it(tmp_path: Path) -> None:
                                "o3d-icp,csm-corr", "--out", str(run), "--jobs", "1", "--no-progress", *extra],
                               cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
 
+    def tfloc(*args: str) -> subprocess.CompletedProcess:
+        return subprocess.run([sys.executable, "-m", "tfloc.cli", *args], cwd=tmp_path, env=env,
+                              capture_output=True, text=True, timeout=600)
+
+    def derived_stale() -> list[str]:
+        code = "import sys; from tfloc.harness.derive import stale; print(stale(sys.argv[1]))"
+        return eval(subprocess.run([sys.executable, "-c", code, str(run)], cwd=tmp_path, env=env,  # noqa: S307
+                                   capture_output=True, text=True, timeout=300).stdout)
+
     first = bench()
     assert first.returncode == 0, first.stderr
+    assert tfloc("report", str(run), "--no-figures").returncode == 0
+    assert derived_stale() == []
     rows = (run / "estimates.csv").read_text()
     for unused in ("datasets/spacing.py", "report/report.py", "site/board.py"):
         _edit(src / "tfloc" / unused)
         again = bench()
         assert again.returncode == 0 and "already complete" in again.stderr, (unused, again.stderr)
         assert (run / "estimates.csv").read_text() == rows
+    # the code that derives the tables changes: the rows stay current, the tables are re-made from them
+    _edit(src / "tfloc" / "evaluation" / "headline.py")
+    assert "already complete" in bench().stderr
+    assert derived_stale() == ["the code that derives them changed"]
+    stamp = (run / "estimates.csv").stat().st_mtime_ns
+    assert tfloc("report", str(run), "--no-figures").returncode == 0
+    assert derived_stale() == [] and (run / "estimates.csv").stat().st_mtime_ns == stamp
     _edit(src / "tfloc" / "baselines" / "csm_corr.py")
     stop = bench()
     lines = stop.stderr.strip().splitlines()
@@ -185,3 +205,4 @@ def test_an_edit_resumes_or_stops_by_what_imports_it(tmp_path: Path) -> None:
     now = (run / "estimates.csv").read_text().splitlines()
     assert kept and all(ln in now for ln in kept), "o3d-icp's rows are kept as they were"
     assert sum(",csm-corr," in ln for ln in now) == 4
+    assert derived_stale() == ["the run's rows changed"]  # the tables wait for tfloc report

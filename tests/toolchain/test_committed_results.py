@@ -1,7 +1,9 @@
 """Every committed run directory was made by a verb of the package from a clean tree: its
-run.json records the code that answered (tfloc's answering source) and no uncommitted change to
-it; every report opens with its headline table beside its headline.csv; the names its tables
-use are matchers or presets a user can pass to any verb, each for the configuration it labels."""
+run.json records, per matcher, the code that made its rows, and that code is this checkout's; its
+derived tables (headline, summary, tracking, …) and its report record the code that derived them
+from its rows, also this checkout's; every report opens with its headline table beside its
+headline.csv; the names its tables use are matchers or presets a user can pass to any verb, each
+for the configuration it labels."""
 
 from __future__ import annotations
 
@@ -10,21 +12,50 @@ import json
 from pathlib import Path
 
 import pytest
-from _paths import RESULTS
+from _paths import RESULTS, ROOT
 
+from tfloc.cli.report import REPORT, REPORT_CODE
 from tfloc.core.matcher import factory_of
 from tfloc.core.presets import resolve
+from tfloc.harness.derive import PRODUCER as TABLES
+from tfloc.harness.derive import stale
+from tfloc.harness.identity import ROW_CODE, derived_code, matcher_code
+from tfloc.harness.scaling_matchers import ROW_CODE as SCALING_ROW_CODE
+from tfloc.io.rundir import RunDir
 
 RUNS = sorted(p.parent for p in RESULTS.rglob("run.json") if "site" not in p.parts)
 
 
 @pytest.mark.parametrize("run", RUNS, ids=lambda p: p.relative_to(RESULTS).as_posix())
-def test_a_committed_run_was_made_from_a_clean_tree_and_names_its_code(run: Path) -> None:
-    doc = json.loads((run / "run.json").read_text())
-    git = doc.get("git") or {}
-    assert git.get("commit") and git.get("dirty") is False, f"{run}: made from {git}"
-    code = (doc.get("fingerprint") or {}).get("tfloc")
-    assert isinstance(code, dict) and len(code.get("source", "")) == 64, f"{run}: no code identity"
+def test_a_committed_run_was_made_from_a_clean_tree_by_this_checkouts_code(run: Path) -> None:
+    """Each matcher's rows by the code that decides them (its import closure with the harness's
+    row code) as it is in this checkout: an edit a matcher does not import leaves it so."""
+    info = RunDir(run).info(required=True)
+    assert info.git.commit and info.git.dirty is False, f"{run}: made from {info.git}"
+    matchers = (info.fingerprint or {}).get("matchers") or {}
+    assert matchers and all(len(m.get("source", "")) == 64 for m in matchers.values()), \
+        f"{run}: no code identity per matcher"
+    row_code = SCALING_ROW_CODE if info.kind == "scaling" else ROW_CODE
+    stale = [label for label, m in matchers.items()
+             if matcher_code(factory_of(m["name"]), row_code)["source"] != m["source"]]
+    assert not stale, f"{run}: rows of {', '.join(stale)} were made by other code than this checkout's"
+
+
+DERIVED = [r for r in RUNS if RunDir(r).info().kind == "bench" and (r / "headline.csv").is_file()]
+
+
+@pytest.mark.parametrize("run", DERIVED, ids=lambda p: p.relative_to(RESULTS).as_posix())
+def test_a_committed_runs_tables_were_derived_by_this_checkouts_code(run: Path) -> None:
+    """The tables were derived from the rows the run holds (where they are committed) by this
+    checkout's deriving code, and its report drawn by this checkout's drawing code."""
+    rd = RunDir(run)
+    derived = rd.info().derived
+    assert TABLES in derived and derived[TABLES].code == derived_code("tfloc.harness.derive"), \
+        f"{run}: its tables were derived by other code (tfloc report {run.relative_to(ROOT)})"
+    assert not stale(run), f"{run}: {stale(run)}"
+    if (run / "report.md").is_file():
+        assert derived.get(REPORT) is not None and derived[REPORT].code == derived_code(*REPORT_CODE), \
+            f"{run}/report.md drawn by other code (tfloc report {run.relative_to(ROOT)})"
 
 
 REPORTS = [r for r in RUNS if (r / "report.md").is_file()]

@@ -7,11 +7,12 @@ may import the layers it re-exports, and no module of the package imports it.
 
 from __future__ import annotations
 
-import ast
 from pathlib import Path
 
 import pytest
 from _paths import ROOT
+
+from tfloc.harness.imports import imports_in
 
 #: Bottom to top. Each entry is a module or package prefix of ``tfloc``.
 LAYERS = (
@@ -47,27 +48,17 @@ def package_files() -> list[Path]:
     return sorted([*(ROOT / "tfloc").rglob("*.py"), *(ROOT / "baselines").rglob("*.py")])
 
 
+KNOWN = None
+
+
 def imports_of(path: Path, source: str | None = None) -> set[str]:
     """Every ``tfloc`` module a file imports (at any depth, type-checking blocks included,
-    relative imports resolved)."""
-    name = module_name(path)
-    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
-    found = set()
-    for node in ast.walk(ast.parse(path.read_text() if source is None else source)):
-        if isinstance(node, ast.Import):
-            found |= {a.name for a in node.names if a.name.split(".")[0] == "tfloc"}
-        elif isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = package.split(".")[: len(package.split(".")) - node.level + 1]
-                target = ".".join(base + ([node.module] if node.module else []))
-            else:
-                target = node.module or ""
-            if target.split(".")[0] != "tfloc":
-                continue
-            for a in node.names:  # `from tfloc.x import y` may import the module tfloc.x.y
-                sub = f"{target}.{a.name}"
-                found.add(sub if any(module_name(f) == sub for f in package_files()) else target)
-    return found
+    relative imports resolved: :func:`tfloc.harness.imports.imports_in`, the graph code identity
+    is built on)."""
+    global KNOWN
+    KNOWN = KNOWN or {module_name(f) for f in package_files()}
+    return imports_in(path.read_text() if source is None else source, module_name(path),
+                      path.name == "__init__.py", KNOWN)
 
 
 def layer(module: str) -> int | None:

@@ -198,6 +198,7 @@ def run_one(args: argparse.Namespace, cfg: RunConfig) -> int:
     from tfloc.harness.runner import execute_local
     from tfloc.harness.runner import run as run_benchmark
     from tfloc.io.estimates import status_counts
+    from tfloc.io.rundir import RunDir
 
     check_imports(cfg, args.allow_import)
     tls = {k: getattr(args, k) for k in ("tls_ca_file", "tls_cert", "tls_key") if getattr(args, k)}
@@ -210,10 +211,11 @@ def run_one(args: argparse.Namespace, cfg: RunConfig) -> int:
         executor = execute_dask(args.scheduler, security(args.scheduler, **tls))
     out = run_benchmark(cfg, progress=args.progress, executor=executor, regenerate=args.regenerate,
                         retry_errors=args.retry_errors)
-    counts = status_counts(out / "estimates.csv")
+    rows = RunDir(out).estimates
+    counts = status_counts(rows)
     print(f"rows: {sum(counts.values())} (" + ", ".join(f"{k} {n}" for k, n in counts.items()) + ")",
           file=sys.stderr)
-    print(f"results: {out / 'estimates.csv'}  (report: tfloc report {out})", file=sys.stderr)
+    print(f"results: {rows}  (report: tfloc report {out})", file=sys.stderr)
     if counts["error"]:
         print(f"tfloc bench: {counts['error']} task(s) raised an error (see the error: rows); after a fix, "
               "rerun them with --retry-errors", file=sys.stderr)

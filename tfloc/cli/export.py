@@ -25,9 +25,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from tfloc.harness.export import export_tum
+    from tfloc.io.rundir import RunDir
 
     run_dir = args.run
-    if not (run_dir / "estimates.csv").is_file() and (Path("results") / run_dir / "estimates.csv").is_file():
+    if not RunDir(run_dir).has_rows() and RunDir(Path("results") / run_dir).has_rows():
         run_dir = Path("results") / run_dir
     for e in export_tum(run_dir, args.tum, args.datasets):
         where = e.path if e.path is not None else "(nothing written)"

@@ -71,6 +71,7 @@ def _one(args: argparse.Namespace, config: Path, reference: Path, summarise, rul
 
     from tfloc.evaluation import guard
     from tfloc.harness.config import load_config, parse_matchers
+    from tfloc.io.rundir import RunDir
     from tfloc.io.table import read_frame, write
 
     cfg = load_config(config)
@@ -85,7 +86,7 @@ def _one(args: argparse.Namespace, config: Path, reference: Path, summarise, rul
             current = pd.concat([keep, current]).sort_values(list(guard.KEY), ignore_index=True)
         write(reference, table, current)
         record = reference.with_suffix(".run.json")  # the code and configuration that made it
-        shutil.copyfile(Path(cfg.out) / "run.json", record)
+        shutil.copyfile(RunDir(cfg.out).run_json, record)
         print(f"updated {reference} (made as {record} records):\n{guard.format_changes(old, current)}")
         return None
     if not reference.exists():

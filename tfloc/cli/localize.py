@@ -35,6 +35,7 @@ from tfloc.harness.workspace import (
     use_map,
     warm,
 )
+from tfloc.io.rundir import ESTIMATES
 from tfloc.io.scenario import iter_scans, read_scenario
 
 from ._matcher import matcher_from_args
@@ -53,7 +54,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
                    help="a matcher parameter, VALUE in TOML syntax (repeatable): --param spacing=0.5, "
                         "--param gates=[1.0,0.5], --param select=tf")
-    p.add_argument("--out", type=Path, default=Path("estimates.csv"),
+    p.add_argument("--out", type=Path, default=Path(ESTIMATES),
                    help="output CSV, one row per scan (default: estimates.csv)")
     p.add_argument("--limit", type=int, default=None, help="only the first N scans")
 

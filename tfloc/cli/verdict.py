@@ -36,11 +36,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from tfloc.harness.verdict_sweep import parse_sweep, sweep
+    from tfloc.io.rundir import RunDir
+    from tfloc.io.tables import VERDICT_SWEEP
 
     if args.sweep:
         configs = parse_sweep(args.sweep)
         sweep(args.run, configs)
-        print(f"sweep: {args.run / 'verdict_sweep.csv'} ({len(configs)} configurations)")
+        print(f"sweep: {RunDir(args.run).file(VERDICT_SWEEP)} ({len(configs)} configurations)")
         return 0
     return judge(args.run, restarts=not args.no_restarts)
 
@@ -49,9 +51,11 @@ def judge(run: Path, restarts: bool = True) -> int:
     """The verdict of the run directory ``run``, written, with one line per recording against
     the truth (the study step ``verdict`` calls it)."""
     from tfloc.harness.verdict import write_verdict
+    from tfloc.io.rundir import RunDir
+    from tfloc.io.tables import VERDICT
 
     v = write_verdict(run, restarts=restarts)
-    print(f"verdict: {run / 'verdict.csv'} ({len(v.rows)} rows)")
+    print(f"verdict: {RunDir(run).file(VERDICT)} ({len(v.rows)} rows)")
     for a in v.agreements:
         print(f"{a.dataset}: against the truth rho {a.rho:.2f}, top {a.verdict_top} ({a.top}; truth's "
               f"{a.truth_top}){'' if a.agrees else ': DISAGREES'}")

@@ -174,15 +174,6 @@ class NoParameters:
     """The configuration of a matcher that takes none."""
 
 
-REGISTRY = {"odometry": {
-    "class": "DeadReckoning",
-    "summary": ("a **tracker**: dead reckoning, the prediction alone (the start pose composed with "
-                "the odometry); the floor of every tracking table; on a single scan it answers its "
-                "guess unchanged"),
-    "docs": "tracking.md",
-}}
-
-
 class DeadReckoning(Configured):
     """``odometry``: the prediction alone, the floor of every tracking table. Run along a
     sequence (:class:`LocalTracker`) it composes the odometry from the start pose (dead
@@ -196,3 +187,9 @@ class DeadReckoning(Configured):
 
     def localize(self, problem: Problem) -> Estimate:
         return Estimate(problem.initial, True)
+
+
+REGISTRY = {"odometry": {"class": "DeadReckoning", "docs": "tracking.md", "summary": (
+    "a **tracker**: dead reckoning, the prediction alone (the start pose composed with the "
+    "odometry); the floor of every tracking table; on a single scan it answers its guess "
+    "unchanged")}}

@@ -193,7 +193,7 @@ def summarize(results: Iterable[ScanResult],
 
 
 def summarize_rows(rows: Iterable[tuple[int, Mapping[str, Any]]], thresholds: Thresholds,
-                   free_area: Mapping[str, float] | None = None, path: str = "estimates.csv") -> list[GlobalSummary]:
+                   free_area: Mapping[str, float] | None = None, path: str = "rows") -> list[GlobalSummary]:
     """:func:`summarize` of ``estimates.csv`` rows ``(line, row)`` (as
     :func:`tfloc.io.estimates.read_rows` gives them); rows without truth or ``invalid:`` are left
     out; a malformed ``info`` raises :class:`ResultsError` naming ``path:line``."""

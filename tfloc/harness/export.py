@@ -106,7 +106,7 @@ def export_tum(run_dir: str | Path, out_dir: str | Path, datasets_root: Path | N
     """Write ``out_dir/<dataset>/{reference,initial,<matcher>}.tum`` for a run (``<dataset>``: the
     last part of the run's dataset name or path); returns what was written."""
     run_dir, out_dir = Path(run_dir), Path(out_dir)
-    rows = _read_rows(run_dir / "estimates.csv")
+    rows = _read_rows(RunDir(run_dir).estimates)
     by_ds: dict[str, list[dict]] = {}
     for r in rows:
         by_ds.setdefault(r["dataset"], []).append(r)
@@ -122,7 +122,7 @@ def export_tum(run_dir: str | Path, out_dir: str | Path, datasets_root: Path | N
                 stamps[r["scan_id"]] = float(len(stamps)) if how != "stamp" else math.nan
         if any(math.isnan(v) for v in stamps.values()):
             bad = next(k for k, v in stamps.items() if math.isnan(v))
-            raise DatasetError(f"{run_dir / 'estimates.csv'}: scan {bad!r} of dataset {ds!r} is not in {d}/scans.csv")
+            raise DatasetError(f"{RunDir(run_dir).estimates}: scan {bad!r} of dataset {ds!r} is not in {d}/scans.csv")
         roles: dict[tuple[str, str], dict[str, np.ndarray | None]] = {}
         for r in drows:
             sid = r["scan_id"]

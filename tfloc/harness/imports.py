@@ -15,7 +15,7 @@ from __future__ import annotations
 import ast
 import hashlib
 import importlib.util
-from collections.abc import Iterable, Mapping
+from collections.abc import Container, Iterable, Mapping
 from functools import cache
 from pathlib import Path
 
@@ -72,17 +72,17 @@ def _read(path: Path) -> str:
         return ""
 
 
-@cache
-def _imports(module: str, mtime_ns: int) -> frozenset[str]:
-    """The tfloc modules ``module``'s source names (``mtime_ns`` keys the cache to the file)."""
-    files = module_files()
-    path = files[module]
-    is_package = path.name == "__init__.py"
+def imports_in(source: str, module: str, is_package: bool, known: Container[str]) -> set[str]:
+    """The tfloc modules ``source`` (the text of ``module``, a package's ``__init__`` where
+    ``is_package``) imports, at any depth, relative imports resolved; ``known``: the modules
+    there are (``from pkg import name`` counts as the module ``pkg.name`` where that is one, else
+    as the deepest known module the dotted name ``pkg`` names; the packages above a module are
+    :func:`imports_of`'s)."""
     package = module if is_package else module.rpartition(".")[0]
     try:
-        tree = ast.parse(_read(path))
+        tree = ast.parse(source)
     except SyntaxError:
-        return frozenset()
+        return set()
     found: set[str] = set()
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
@@ -99,16 +99,22 @@ def _imports(module: str, mtime_ns: int) -> frozenset[str]:
         for target, name in targets:
             if target.split(".")[0] != "tfloc":
                 continue
-            sub = f"{target}.{name}" if name else None
-            if sub in files:
-                found.add(sub)
-            # the deepest module the dotted name names (an attribute import names its module)
+            if name and f"{target}.{name}" in known:  # `from pkg import module`
+                found.add(f"{target}.{name}")
+                continue
             t = target
-            while t and t not in files:
+            while t and t not in known:
                 t = t.rpartition(".")[0]
             if t:
                 found.add(t)
-    return frozenset(found)
+    return found
+
+
+@cache
+def _imports(module: str, mtime_ns: int) -> frozenset[str]:
+    """The tfloc modules ``module``'s source names (``mtime_ns`` keys the cache to the file)."""
+    path = module_files()[module]
+    return frozenset(imports_in(_read(path), module, path.name == "__init__.py", module_files()))
 
 
 def imports_of(module: str) -> frozenset[str]:

@@ -47,6 +47,7 @@ from tfloc.errors import ConfigError
 from tfloc.evaluation.timing import reference_of
 from tfloc.io.rundir import RunDir
 from tfloc.io.scenario import SEQUENCE, load_dataset
+from tfloc.io.tables import TIMING
 
 from .contention import Probe
 from .fingerprint import differences
@@ -148,7 +149,7 @@ def stale(rd: RunDir, record: TimingRecord | None, fp: dict) -> list[str]:
         return ["timing.md records no fingerprint (made by an older tfloc)" if rd.timing_md.exists() else NO_PASS]
     old = dict(record.fingerprint or {})
     out = [] if record.complete else ["the last timing pass did not finish"]
-    out += [f"{f}: none" for f in ("timing.csv", "timing.md") if not (rd.path / f).exists()]
+    out += [f"{f.name}: none" for f in (rd.file(TIMING), rd.timing_md) if not f.exists()]
     params = [f"{k} {json.dumps(old.get(k))} → {json.dumps(fp[k])}" for k in asdict(TimingParams()) if old.get(k) != fp[k]]
     out += params
     if old.get("run") != fp["run"]:

@@ -277,15 +277,16 @@ class RunDir:
                       **extra: Any) -> None:
         """Write ``run.json`` for a new session: ``doc`` (configuration, environment, datasets,
         fingerprint) with the sessions so far plus this one (``n_tasks`` tasks, ``n_done`` of them
-        done before, ``extra`` fields, e.g. the cores it is pinned to); the timing pass's record
-        is kept (its own fingerprint says whether it is still current)."""
+        done before, ``extra`` fields, e.g. the cores it is pinned to); the records of the timing
+        pass, the verdict and the derived tables are kept (each says itself whether it is still
+        current: its fingerprint, the hash of the rows it read)."""
         try:
             old = self._doc()
         except ResultsError:
             old = {}
         session = {"started": _now(), "tasks": n_tasks, "already_done": n_done, "loadavg_start": loadavg,
                    **extra}
-        kept = {"timing": old["timing"]} if "timing" in old and "timing" not in doc else {}
+        kept = {k: old[k] for k in ("timing", "verdict", "derived") if k in old and k not in doc}
         self.write_doc({**doc, **kept, "sessions": list(old.get("sessions", [])) + [session]})
 
     def _set(self, fields: dict[str, Any], **session: Any) -> None:

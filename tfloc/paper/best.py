@@ -34,16 +34,6 @@ BEST = TfConfig(err_norm="l1", spacing=0.1, window=3, orientation_step=math.radi
                 simplex_size=2.0, heading_clamp=math.radians(15.0), keep_best=True)
 
 
-REGISTRY = {"tf-best": {
-    "class": "TurningFunctionBestMatcher",
-    "summary": ("the paper's method with the best-measured reading of each ambiguity of its text "
-                "(Err the area between the graphs, S = 0.1 m, w = 3, orientation step 2.5°, simplex"
-                " 2 m, heading change clamped to ±15°, the best answer kept), each chosen on the "
-                "reading study's development split; no extra stage"),
-    "docs": "single-scan.md",
-}}
-
-
 class TurningFunctionBestMatcher(TurningFunctionMatcher):
     """``tf-best``: :class:`~tfloc.paper.matcher.TurningFunctionMatcher` with the readings of :data:`BEST`."""
 
@@ -51,3 +41,10 @@ class TurningFunctionBestMatcher(TurningFunctionMatcher):
 
     def __init__(self, config: TfConfig | None = None, **overrides) -> None:
         super().__init__(config or BEST, **overrides)
+
+
+REGISTRY = {"tf-best": {"class": "TurningFunctionBestMatcher", "docs": "single-scan.md", "summary": (
+    "the paper's method with the best-measured reading of each ambiguity of its text (Err the"
+    " area between the graphs, S = 0.1 m, w = 3, orientation step 2.5°, simplex 2 m, heading "
+    "change clamped to ±15°, the best answer kept), each chosen on the reading study's "
+    "development split; no extra stage")}}

@@ -257,17 +257,6 @@ def simplex(cost: _Cost, start: Pose, size: float, rng: np.random.Generator) -> 
     return min(pts, key=f), it
 
 
-REGISTRY = {"tf": {
-    "class": "TurningFunctionMatcher",
-    "summary": ("the paper's method, as written; where the text is wrong or ambiguous the reading "
-                "that works is chosen and documented (Alg. 1's squared distance, Alg. 3's squared "
-                "path, Alg. 5's missing shrink step, W = worst, the seven orientations, the scan "
-                "polygon closed through the sensor, no-return beams)"),
-    "docs": "single-scan.md",
-    "files": ["tfloc/paper/corners.py", "tfloc/paper/turning.py"],
-}}
-
-
 class TurningFunctionMatcher(Configured):
     """The paper's method (``tf``): turning-function scan matching with a Nelder–Mead simplex."""
 
@@ -343,3 +332,10 @@ class TurningFunctionMatcher(Configured):
         if real is None:
             return float(self.config.penalty)
         return float(_Cost(problem, self.config, real).errors(pose.as_array()[None, :])[0][0])
+
+
+REGISTRY = {"tf": {"class": "TurningFunctionMatcher", "docs": "single-scan.md", "files": ["tfloc/paper/corners.py", "tfloc/paper/turning.py"], "summary": (
+    "the paper's method, as written; where the text is wrong or ambiguous the reading that "
+    "works is chosen and documented (Alg. 1's squared distance, Alg. 3's squared path, Alg. "
+    "5's missing shrink step, W = worst, the seven orientations, the scan polygon closed "
+    "through the sensor, no-return beams)")}}

@@ -118,18 +118,6 @@ def distinct(poses: np.ndarray, count: int, separation: float, heading_separatio
     return keep
 
 
-REGISTRY = {"tf-global": {
-    "class": "TurningFunctionGlobalMatcher",
-    "summary": ("the project's own **global** localizer (no initial guess): a place index of "
-                "virtual scans over the whole map (built once per map, cached on disk) searched by "
-                "a heading-invariant turning-function and range signature plus a robust sector "
-                "range profile, its best places resolved by `tf-plus`, ranked by `tf-plus`'s "
-                "selection cost ([docs/tf-global.md](tf-global.md))"),
-    "docs": "tf-global.md",
-    "files": ["tfloc/relocalize/"],
-}}
-
-
 class TurningFunctionGlobalMatcher:
     """``tf-global``: turning-function place index → ``tf-plus``'s stages per place → its
     selection cost."""
@@ -223,3 +211,11 @@ class TurningFunctionGlobalMatcher:
         if pose is None:
             return math.nan
         return self.resolver.score(problem, pose)
+
+
+REGISTRY = {"tf-global": {"class": "TurningFunctionGlobalMatcher", "docs": "tf-global.md", "files": ["tfloc/relocalize/"], "summary": (
+    "the project's own **global** localizer (no initial guess): a place index of virtual "
+    "scans over the whole map (built once per map, cached on disk) searched by a "
+    "heading-invariant turning-function and range signature plus a robust sector range "
+    "profile, its best places resolved by `tf-plus`, ranked by `tf-plus`'s selection cost "
+    "([docs/tf-global.md](tf-global.md))")}}

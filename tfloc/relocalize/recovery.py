@@ -114,16 +114,6 @@ class TfPlusRecoverConfig:
     relocalizer: TfGlobalConfig = TfGlobalConfig()
 
 
-REGISTRY = {"tf-plus-recover": {
-    "class": "TfPlusRecoverTracker",
-    "summary": ("a **tracker**: `tf-plus` from the prediction; when `tf-plus`'s own score says lost"
-                " (2 scans above 2 cm RMS residual, chosen on `seq-kidnap-dev`) it asks `tf-global`"
-                " (no guess) and takes its answer if it scores better; kidnapped sequences: "
-                "`benchmarks/kidnap.toml`, [docs/kidnap.md](kidnap.md)"),
-    "docs": "kidnap.md",
-}}
-
-
 class TfPlusRecoverTracker(RecoveringTracker):
     """``tf-plus-recover``: ``tf-plus`` tracking, ``tf-global`` when lost (module notes), the
     registered tracker. Its rule's values were chosen on the development sequence
@@ -147,3 +137,9 @@ class TfPlusRecoverTracker(RecoveringTracker):
         super().warm(map, laser, ranges, pose)
         self.prepare(Problem(map, laser, ranges, None))
 
+
+REGISTRY = {"tf-plus-recover": {"class": "TfPlusRecoverTracker", "docs": "kidnap.md", "summary": (
+    "a **tracker**: `tf-plus` from the prediction; when `tf-plus`'s own score says lost (2 "
+    "scans above 2 cm RMS residual, chosen on `seq-kidnap-dev`) it asks `tf-global` (no "
+    "guess) and takes its answer if it scores better; kidnapped sequences: "
+    "`benchmarks/kidnap.toml`, [docs/kidnap.md](kidnap.md)")}}

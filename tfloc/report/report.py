@@ -122,7 +122,7 @@ def render(run_dir: Path, run: RunRecord, p: pd.DataFrame, thr: Thresholds, s2s:
         parts += _scan_to_map_tables(s2m)
     if pt is not None and len(pt):
         parts += _paired_section(pt, sweep)
-    if (run_dir / "timing.md").is_file():
+    if RunDir(run_dir).timing_md.is_file():
         parts.append("## Quiet re-timing\n\nA side-by-side timing pass of a stratified sample of this "
                      "run's scans in one pinned process: [timing.md](timing.md).\n")
     if landscape:
@@ -215,7 +215,7 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None, *,
 
         tracking = relocalization_section(rd, df[df["dataset"].isin(glob)], thr) + "\n" + tracking
     if df["dataset"].isin(seq | glob).all():
-        report = run_dir / "report.md"
+        report = rd.report
         report.write_text("\n".join([header(run_dir, info, prepared, thr, set(), stale_code), top, tracking]))
         return ReportFiles(report, ())
     p = prepare(df[~df["dataset"].isin(seq | glob)], thr)
@@ -238,7 +238,7 @@ def write_report(run_dir: str | Path, thresholds: Thresholds | None = None, *,
         drawn = p[p["matcher"] == order[0]] if sweep else p
         failures = failures_section(draw_failures(run_dir, drawn, info.paths))
         landscape = landscape_section(*draw_landscapes(run_dir, list(landscapes)))
-    report = run_dir / "report.md"
+    report = rd.report
     text = render(run_dir, info, p, thr, s2s, figs, pt, failures, landscape, line_labels, sweep, paper, top,
                   stale_code)
     report.write_text(text + ("\n" + tracking if tracking else ""))

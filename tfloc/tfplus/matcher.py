@@ -101,20 +101,6 @@ def pick(cost: np.ndarray, poses: np.ndarray, vp: Pose, tie_tolerance: float) ->
     return tied[near.index(min(near))]
 
 
-REGISTRY = {"tf-plus": {
-    "class": "TurningFunctionPlusMatcher",
-    "summary": ("the project's own variant: turning-function heading seeds, a coarse grid on a "
-                "distance field, batched point-to-line refinement, selection with a see-through "
-                "check ([docs/tf-plus.md](tf-plus.md), ablation: "
-                "`benchmarks/tfplus-ablation.toml`). the preset `tf-plus-changed` is its "
-                "**changed-world** configuration (`tfloc/presets.toml`: unmapped objects and "
-                "missing furniture bounded in every stage; opt-in, "
-                "[docs/robustness.md](robustness.md))"),
-    "docs": "tf-plus.md",
-    "files": ["tfloc/tfplus/"],
-}}
-
-
 class TurningFunctionPlusMatcher(Configured):
     """``tf-plus``: turning-function heading seed, coarse grid, point-to-line refinement."""
 
@@ -226,3 +212,12 @@ class TurningFunctionPlusMatcher(Configured):
 
 
 __all__ = ["TfPlusConfig", "TurningFunctionPlusMatcher", "heading_seeds", "pick", "tf_errs"]
+
+
+REGISTRY = {"tf-plus": {"class": "TurningFunctionPlusMatcher", "docs": "tf-plus.md", "files": ["tfloc/tfplus/"], "summary": (
+    "the project's own variant: turning-function heading seeds, a coarse grid on a distance "
+    "field, batched point-to-line refinement, selection with a see-through check "
+    "([docs/tf-plus.md](tf-plus.md), ablation: `benchmarks/tfplus-ablation.toml`). the preset"
+    " `tf-plus-changed` is its **changed-world** configuration (`tfloc/presets.toml`: "
+    "unmapped objects and missing furniture bounded in every stage; opt-in, "
+    "[docs/robustness.md](robustness.md))")}}

@@ -102,18 +102,6 @@ def _far(a: Pose, b: Pose, metres: float, radians: float) -> bool:
     return a.distance_to(b) > metres or abs(wrap_angle(a.theta - b.theta)) > radians
 
 
-REGISTRY = {"tf-plus-track": {
-    "class": "TfPlusTracker",
-    "summary": ("a **tracker**: `tf-plus` along a sequence that weighs the odometry's prediction "
-                "when the scan is ambiguous (a jump must explain the scan 1.5 times better than the"
-                " best pose near the prediction; an odometry increment the robot cannot have made "
-                "is also tried as no motion; a trusted prediction is searched in a window of the "
-                "odometry's noise, widened when the scan does not fit), chosen on the MIT CSAIL "
-                "native log ([docs/tracking.md](tracking.md))"),
-    "docs": "tracking.md",
-}}
-
-
 class TfPlusTracker(LocalTracker):
     """``tf-plus-track``: ``tf-plus`` along a sequence with the rules of the module notes.
     ``info`` of each step adds ``widened`` (the trusted window's answer did not fit and the
@@ -242,3 +230,12 @@ class TfPlusTracker(LocalTracker):
         return Estimate(est.pose, est.converged, est.iterations, est.evaluations,
                         {**est.info, "widened": widened, "jump": jump, "kept": kept,
                          "doubted_odometry": doubted, "score": fit if math.isfinite(fit) else None})
+
+
+REGISTRY = {"tf-plus-track": {"class": "TfPlusTracker", "docs": "tracking.md", "summary": (
+    "a **tracker**: `tf-plus` along a sequence that weighs the odometry's prediction when the"
+    " scan is ambiguous (a jump must explain the scan 1.5 times better than the best pose "
+    "near the prediction; an odometry increment the robot cannot have made is also tried as "
+    "no motion; a trusted prediction is searched in a window of the odometry's noise, widened"
+    " when the scan does not fit), chosen on the MIT CSAIL native log "
+    "([docs/tracking.md](tracking.md))")}}
