@@ -57,7 +57,9 @@ def run(args: argparse.Namespace) -> int:
     if not args.results.is_dir():
         raise ConfigError(f"{args.results}: no such results directory")
     out = args.out or args.results / ("site-quick" if args.only_quick else "site")
-    data = build_site(args.results, out, quick=args.only_quick)
+    from tfloc.harness.identity import derived_code
+
+    data = build_site(args.results, out, quick=args.only_quick, generator=derived_code("tfloc.site.build")[:12])
     shown = sum(1 for r in data.runs.values() if r.rows)
     missing = [n for n, r in data.runs.items() if not r.exists]
     unreported = [n for n, r in data.runs.items() if r.exists and not r.reported]

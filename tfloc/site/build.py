@@ -21,8 +21,9 @@ def families_of(data: SiteData) -> dict[str, Family]:
     return {m: family(m) for b in data.boards.values() for m in b.matchers}
 
 
-def build_site(root: Path, out: Path, quick: bool = False) -> SiteData:
-    """Write the site for results root ``root`` into ``out`` (replaced); returns what it showed."""
+def build_site(root: Path, out: Path, quick: bool = False, generator: str = "") -> SiteData:
+    """Write the site for results root ``root`` into ``out`` (replaced), each page naming the
+    identity of the code that drew it (``generator``); returns what it showed."""
     root, out = Path(root), Path(out)
     data = collect(root, quick=quick)
     if (out / "runs").is_dir():
@@ -31,9 +32,9 @@ def build_site(root: Path, out: Path, quick: bool = False) -> SiteData:
     labels = {r.dir: r.label for p in data.pages for r in p.runs}
     for name, rr in data.runs.items():
         if rr.exists:
-            write_run_page(rr.path, out / "runs" / name, labels.get(name, name), "../../index.html")
+            write_run_page(rr.path, out / "runs" / name, labels.get(name, name), "../../index.html", generator)
     shown = os.path.relpath(root.resolve(), out.resolve()).replace(os.sep, "/")
-    (out / "index.html").write_text(index_html(data, families_of(data), f"the results root {shown}/"),
+    (out / "index.html").write_text(index_html(data, families_of(data), f"the results root {shown}/", generator),
                                     encoding="utf-8")
     return data
 

@@ -37,14 +37,16 @@ def inline(text: str) -> str:
     return markdown().renderInline(text)
 
 
-def shell(title: str, body: str, home: str = "") -> str:
-    """A complete page: ``body`` inside the shell; ``home``: the relative link to the index."""
+def shell(title: str, body: str, home: str = "", generator: str = "") -> str:
+    """A complete page: ``body`` inside the shell; ``home``: the relative link to the index;
+    ``generator``: the identity of the code that drew it (a ``<meta name="generator">``)."""
     css = (STATIC / "site.css").read_text(encoding="utf-8")
     js = (STATIC / "site.js").read_text(encoding="utf-8")
     back = f'<p><a href="{html.escape(home)}">← all leaderboards</a></p>' if home else ""
-    return (f"<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-            f"<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
-            f"<link rel=\"icon\" href=\"data:,\"><title>{html.escape(title)}</title>"
+    return ("<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+            "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
+            + (f"<meta name=\"generator\" content=\"tfloc site {html.escape(generator)}\">" if generator else "")
+            + f"<link rel=\"icon\" href=\"data:,\"><title>{html.escape(title)}</title>"
             f"<style>\n{css}</style></head>\n<body>\n<header class=\"top\">{back}</header>\n"
             f"<main>\n{body}\n</main>\n<script>\n{js}</script>\n</body></html>\n")
 
@@ -113,7 +115,7 @@ def _notes(data: SiteData, dirs: list[str], slopes: frozenset[str] = frozenset()
     return f'<ul class="note">{items}</ul>'
 
 
-def index_html(data: SiteData, families: dict[str, Family], results_label: str) -> str:
+def index_html(data: SiteData, families: dict[str, Family], results_label: str, generator: str = "") -> str:
     """The index page."""
     labels = {r.dir: r.label for p in data.pages for r in p.runs}
     toc = "".join(f'<a href="#{p.key}">{html.escape(p.title)}</a>' for p in data.pages)
@@ -144,4 +146,4 @@ def index_html(data: SiteData, families: dict[str, Family], results_label: str) 
         parts.append("".join(sec))
     parts.append(f'<footer class="muted">Written by <code>tfloc site</code> from {html.escape(results_label)}; '
                  f"the page → run mapping is <code>tfloc/site/pages.toml</code>.</footer>")
-    return shell("tfloc leaderboards", "\n".join(parts))
+    return shell("tfloc leaderboards", "\n".join(parts), generator=generator)

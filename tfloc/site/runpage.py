@@ -91,8 +91,9 @@ def note_html(text: str, run_dir: Path, page_dir: Path, rendered: set[str]) -> s
     return md.renderer.render(tokens, md.options, {})
 
 
-def write_run_page(run_dir: Path, page_dir: Path, title: str, home: str) -> Path:
-    """``page_dir/index.html`` for the run in ``run_dir``; returns its path."""
+def write_run_page(run_dir: Path, page_dir: Path, title: str, home: str, generator: str = "") -> Path:
+    """``page_dir/index.html`` for the run in ``run_dir`` (``generator``: the identity of the code
+    that draws it); returns its path."""
     page_dir.mkdir(parents=True, exist_ok=True)
     run = run_info(run_dir)
     notes = [n for n in NOTES if (run_dir / n).is_file()]
@@ -106,5 +107,5 @@ def write_run_page(run_dir: Path, page_dir: Path, title: str, home: str) -> Path
         parts.append(f'<section class="report" id="{anchor(n)}"><p class="muted">{html.escape(n)}</p>{body}</section>')
     parts.append(provenance_html(run))
     out = page_dir / "index.html"
-    out.write_text(shell(f"{title} — tfloc", "\n".join(parts), home), encoding="utf-8")
+    out.write_text(shell(f"{title} — tfloc", "\n".join(parts), home, generator), encoding="utf-8")
     return out
